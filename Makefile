@@ -1,0 +1,37 @@
+# hexcnc: top-level make front.
+#
+# Every build target first makes sure the Debian packages are there (mk/deps.sh is a fast
+# no-op when they are), then runs the real build in mk/build.mk, which reads pkg-config.
+#
+#   make            build bin/ and lib/
+#   make deps       install missing Debian packages
+#   make test       build and run every test (unit, HAL-graph, G-code, end to end)
+#   make sanitize   the same tests built with ASan + UBSan (in build/san/)
+#   make bench      run the benchmarks
+#   make run        run the simulated TMU hexapod on the paper's programs
+#   make install PREFIX=/usr/local
+
+PREFIX ?= /usr/local
+BUILD_MAKE = $(MAKE) --no-print-directory -f mk/build.mk
+
+.PHONY: all deps test sanitize bench run experiment install clean fuzz
+all: deps
+	@$(BUILD_MAKE) all
+deps:
+	@sh mk/deps.sh
+test: deps
+	@$(BUILD_MAKE) test
+sanitize: deps
+	@$(BUILD_MAKE) O=build/san SAN=1 test
+bench: deps
+	@$(BUILD_MAKE) bench
+run: deps
+	@$(BUILD_MAKE) run
+experiment: deps
+	@$(BUILD_MAKE) experiment
+fuzz: deps
+	@$(BUILD_MAKE) fuzz
+install: deps
+	@$(BUILD_MAKE) install PREFIX=$(PREFIX)
+clean:
+	rm -rf build bin lib

@@ -1,0 +1,59 @@
+/* canon.c: the in-memory canonical program (a growable array of canonical commands). */
+#include "interp/canon.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const canon_names[CANON_TYPE_COUNT] = {
+    [CANON_TRAVERSE] = "TRAVERSE",       [CANON_FEED] = "FEED",
+    [CANON_ARC] = "ARC",                 [CANON_DWELL] = "DWELL",
+    [CANON_FEED_RATE] = "FEED_RATE",     [CANON_FEED_MODE] = "FEED_MODE",
+    [CANON_PATH_MODE] = "PATH_MODE",     [CANON_SPINDLE_SPEED] = "SPINDLE_SPEED",
+    [CANON_SPINDLE_ON] = "SPINDLE_ON",   [CANON_SPINDLE_STOP] = "SPINDLE_STOP",
+    [CANON_TOOL_CHANGE] = "TOOL_CHANGE", [CANON_COOLANT] = "COOLANT",
+    [CANON_COMMENT] = "COMMENT",         [CANON_PAUSE] = "PAUSE",
+    [CANON_PROGRAM_END] = "PROGRAM_END", [CANON_OFFSETS] = "OFFSETS",
+};
+
+const char *canon_type_name(enum canon_type t)
+{
+    return (unsigned)t < CANON_TYPE_COUNT ? canon_names[t] : "?";
+}
+
+void canon_prog_init(struct canon_prog *p)
+{
+    memset(p, 0, sizeof *p);
+}
+
+void canon_prog_free(struct canon_prog *p)
+{
+    for (size_t i = 0; i < p->count; i++)
+        if (p->cmds[i].type == CANON_COMMENT)
+            free((char *)p->cmds[i].text);
+    free(p->cmds);
+    canon_prog_init(p);
+}
+
+int canon_prog_sink(void *ctx, const struct canon_cmd *cmd)
+{
+    struct canon_prog *p = ctx;
+    if (p->count == p->cap) {
+        size_t cap = p->cap ? p->cap * 2 : 256;
+        struct canon_cmd *n = realloc(p->cmds, cap * sizeof *n);
+        if (!n)
+            return -1;
+        p->cmds = n;
+        p->cap = cap;
+    }
+    struct canon_cmd *c = &p->cmds[p->count];
+    *c = *cmd;
+    if (cmd->type == CANON_COMMENT) {
+        c->text = strdup(cmd->text ? cmd->text : "");
+        if (!c->text)
+            return -1;
+    } else {
+        c->text = NULL;
+    }
+    p->count++;
+    return 0;
+}

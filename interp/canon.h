@@ -1,0 +1,82 @@
+/* canon.h: the canonical command stream from the interpreter to the motion planner. */
+#ifndef HEXCNC_CANON_H
+#define HEXCNC_CANON_H
+
+#include <stddef.h>
+
+/*
+ * Units and frames: every position in this stream is a pose in machine coordinates, the
+ * frame the kinematics takes (X Y Z mm, A B C deg): work offsets (G54..G59, G92) and the
+ * tool length offset are already applied, inch programs already converted. Feeds are mm/min
+ * for linear motion (rotary-only moves: deg/min), whatever the program's F units were.
+ * The start of every move is the end of the previous one (the interpreter's initial
+ * position is given to it by its caller).
+ */
+enum canon_type {
+    CANON_TRAVERSE,        /* G0: rapid to end */
+    CANON_FEED,            /* G1 (and compensated G141/G142 lines): straight feed to end */
+    CANON_ARC,             /* G2/G3 (and the corner arcs of G141/G142): arc/helix to end */
+    CANON_DWELL,           /* G4: seconds */
+    CANON_FEED_RATE,       /* F changed: feed_mm_min */
+    CANON_FEED_MODE,       /* G93/G94: value = 1 for inverse time, 0 for units/min */
+    CANON_PATH_MODE,       /* G61 (value 0) / G64 (value = blend tolerance mm, 0 = none) */
+    CANON_SPINDLE_SPEED,   /* S: value = rpm */
+    CANON_SPINDLE_ON,      /* M3 (value = +1) / M4 (value = -1) */
+    CANON_SPINDLE_STOP,    /* M5 */
+    CANON_TOOL_CHANGE,     /* M6: ivalue = tool number */
+    CANON_COOLANT,         /* M7 (ivalue 7), M8 (8), M9 (9) */
+    CANON_COMMENT,         /* ( ... ): text */
+    CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */
+    CANON_PROGRAM_END,     /* M2 / M30 (ivalue 2 or 30) */
+    CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]) */
+    CANON_TYPE_COUNT
+};
+
+/* One arc: in the plane through `center` normal to `normal` (unit vector, right-handed),
+ * from the previous end to end[0..2], turning counter-clockwise about `normal` when
+ * rotation > 0 and clockwise when < 0; |rotation| - 1 extra full turns (LinuxCNC's
+ * convention). The component of the motion along `normal` and the A B C axes change
+ * linearly with the angle (helix). plane is 17, 18 or 19 for G17/G18/G19 arcs, 0 for 3-D
+ * arcs the compensation made (any normal). */
+struct canon_arc {
+    double center[3];      /* mm, machine frame */
+    double normal[3];      /* unit */
+    int rotation;          /* signed turn count, see above */
+    int plane;             /* 17, 18, 19, or 0 */
+};
+
+struct canon_cmd {
+    enum canon_type type;
+    int line;              /* source line number (1-based) in `file` */
+    const char *file;      /* program file name (owned by the interpreter, outlives the stream) */
+    double end[6];         /* TRAVERSE, FEED, ARC: target pose, machine frame */
+    double feed_mm_min;    /* FEED, ARC: the feed in force (FEED_RATE: the new feed) */
+    double inverse_time_min; /* FEED, ARC under G93: minutes the move must take, else 0 */
+    double value;          /* DWELL s, PATH_MODE tol, SPINDLE_* rpm/dir, FEED_MODE */
+    int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
+    int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
+    double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
+    struct canon_arc arc;  /* ARC only */
+    const char *text;      /* COMMENT text (owned by the interpreter) */
+};
+
+/* Where the interpreter sends commands. Return 0 to continue, non-zero to stop the
+ * interpreter (its status is then INTERP_ERR_SINK). */
+typedef int (*canon_sink_fn)(void *ctx, const struct canon_cmd *cmd);
+
+/* A growable in-memory program: the whole canonical stream of one program, so that a
+ * program is interpreted and verified completely before any motion starts. */
+struct canon_prog {
+    struct canon_cmd *cmds;
+    size_t count;
+    size_t cap;
+    double start[6];       /* pose the program starts from */
+};
+void canon_prog_init(struct canon_prog *p);
+void canon_prog_free(struct canon_prog *p);
+/* A canon_sink_fn that appends to a struct canon_prog (ctx); it copies COMMENT text, so the
+ * program owns everything it holds. Returns -1 on allocation failure. */
+int canon_prog_sink(void *ctx, const struct canon_cmd *cmd);
+const char *canon_type_name(enum canon_type t);
+
+#endif

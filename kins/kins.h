@@ -1,0 +1,105 @@
+/* kins.h: the kinematics plugin boundary (one ops table per model, loaded by name). */
+#ifndef HEXCNC_KINS_H
+#define HEXCNC_KINS_H
+
+#include <stddef.h>
+
+/* A pose: X Y Z in mm, A B C in degrees, R = Rz(C)·Ry(B)·Rx(A). Index with KINS_X.. KINS_C. */
+enum { KINS_X, KINS_Y, KINS_Z, KINS_A, KINS_B, KINS_C, KINS_POSE_DIM };
+
+/* Most joints any model has (the hexapod has 6; trivial may have up to 9 for tests). */
+#define KINS_MAX_JOINTS 9
+
+/* Every kinematics call returns one of these; 0 is success. kins_strerror() gives the text. */
+enum kins_status {
+    KINS_OK = 0,
+    KINS_ERR_CONFIG,         /* a configuration key is missing or wrong (message names it) */
+    KINS_ERR_NOMEM,          /* allocation failed */
+    KINS_ERR_PLUGIN,         /* plugin not found, not loadable, or without its ops table */
+    KINS_ERR_UNREACHABLE,    /* pose outside the workspace: some leg length out of range */
+    KINS_ERR_LEG_RANGE,      /* a given leg length is outside [min, max] */
+    KINS_ERR_IMPOSSIBLE,     /* leg lengths no pose can have (assembly impossible) */
+    KINS_ERR_SINGULAR,       /* Jacobian singular (or above the condition threshold) */
+    KINS_ERR_NO_CONVERGE,    /* forward solve hit its iteration limit without converging */
+    KINS_ERR_ARG,            /* bad argument (NaN, wrong count) */
+    KINS_STATUS_COUNT
+};
+const char *kins_strerror(int status);
+
+/* Configuration is read through a lookup function so kins/ needs no INI library:
+ * get(ctx, "KINS", "BASE_RADIUS") returns the value text or NULL when the key is absent. */
+struct kins_config {
+    const char *(*get)(void *ctx, const char *section, const char *key);
+    void *ctx;
+};
+
+/* Extra results of a forward solve. */
+struct kins_fwd_info {
+    int iterations;          /* Newton iterations used */
+    double residual_mm;      /* largest leg-length residual at the end, mm */
+};
+
+/* Result of kins_check(). */
+struct kins_check {
+    int reachable;           /* 1 if every leg is within [min, max] */
+    int worst_leg;           /* leg (0-based) closest to or beyond its limit */
+    double leg_margin_mm;    /* distance of the worst leg to its nearest limit; < 0 beyond it */
+    double condition;        /* condition number of the Jacobian (1 = perfect, inf = singular) */
+    int near_singular;       /* 1 if condition exceeds the configured threshold */
+};
+
+struct kins;
+
+/* The ops table a plugin exports as `const struct kins_ops kins_<name>_ops` ('-' -> '_'). */
+struct kins_ops {
+    const char *name;        /* "hexapod", "trivial" */
+    /* Builds an instance from configuration; on failure writes a message naming the
+     * section and key into err and returns a status. */
+    int (*create)(const struct kins_config *cfg, struct kins **out, char *err, size_t errlen);
+    void (*destroy)(struct kins *k);
+    /* pose[6] -> joints[njoints] (mm). Fails with KINS_ERR_UNREACHABLE when a leg is out
+     * of range; joints are still written so callers can report by how much. */
+    int (*inverse)(struct kins *k, const double pose[KINS_POSE_DIM], double *joints);
+    /* joints -> pose. pose holds the starting guess on entry (warm start) and the result
+     * on KINS_OK only; on failure it is left unchanged. info may be NULL. */
+    int (*forward)(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                   struct kins_fwd_info *info);
+    /* Leg rates (mm/s) from pose and pose velocity (mm/s, deg/s) through the Jacobian. */
+    int (*leg_rates)(struct kins *k, const double pose[KINS_POSE_DIM],
+                     const double pose_vel[KINS_POSE_DIM], double *rates);
+    /* Reachability and singularity measure of a pose (not on the servo hot path). */
+    int (*check)(struct kins *k, const double pose[KINS_POSE_DIM], struct kins_check *out);
+};
+
+/* Base of every instance; concrete models embed it first. */
+struct kins {
+    const struct kins_ops *ops;
+    int njoints;                       /* number of joints (legs) */
+    double joint_min[KINS_MAX_JOINTS]; /* leg length limits, mm */
+    double joint_max[KINS_MAX_JOINTS];
+    double home[KINS_POSE_DIM];        /* home pose: the forward solver's cold start */
+    void *plugin_handle;               /* dlopen handle when loaded from a .so, else NULL */
+};
+
+/* Finds an ops table by name: first the models linked into this program, then the shared
+ * object <dir>/kins/<name>.so, dir from $HEXCNC_PLUGIN_DIR, else ../lib next to the
+ * executable, else the install prefix. NULL with a message in err when not found. */
+const struct kins_ops *kins_find(const char *name, void **handle, char *err, size_t errlen);
+
+/* Loads kinematics `name` (e.g. from [KINS] KINEMATICS) and creates an instance. */
+int kins_load(const char *name, const struct kins_config *cfg, struct kins **out,
+              char *err, size_t errlen);
+/* Destroys an instance and closes its plugin. NULL is fine. */
+void kins_free(struct kins *k);
+
+/* Thin wrappers for callers. */
+static inline int kins_inverse(struct kins *k, const double *pose, double *joints)
+{ return k->ops->inverse(k, pose, joints); }
+static inline int kins_forward(struct kins *k, const double *joints, double *pose,
+                               struct kins_fwd_info *info)
+{ return k->ops->forward(k, joints, pose, info); }
+static inline int kins_leg_rates(struct kins *k, const double *pose, const double *vel,
+                                 double *rates)
+{ return k->ops->leg_rates(k, pose, vel, rates); }
+
+#endif

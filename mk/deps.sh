@@ -1,0 +1,20 @@
+#!/bin/sh
+# Installs the Debian packages hexcnc needs, only those that are missing.
+# Used by `make deps`; safe to run again.
+set -eu
+PKGS="build-essential pkg-config check libmodbus-dev libeigen3-dev liblcm-dev liblcm-bin \
+libinih-dev libglib2.0-dev iproute2 util-linux"
+missing=""
+for p in $PKGS; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -z "$missing" ]; then
+    echo "deps: all packages present"
+    exit 0
+fi
+echo "deps: installing:$missing"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends $missing
