@@ -1,0 +1,173 @@
+/* stepgen.c: HAL component `stepgen`, a simulated step generator in position mode. */
+#include "sim/stepgen.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/*
+ * One channel per leg, as LinuxCNC's stepgen in position mode (control type 0). Each servo
+ * period `stepgen.update` chooses a step rate that makes the motor follow position-cmd
+ * within maxvel and maxaccel, integrates it, and counts whole steps. position-fb is the
+ * step count divided by the scale: what an encoder-less stepper machine really knows.
+ *
+ * The controller, per period dt, with p the internal (unquantised) motor position:
+ *
+ *     vc  = (cmd - cmd_prev) / dt            velocity the command is moving at
+ *     d   = cmd - p - vc dt                  what is left if the motor just matched vc
+ *     r   = a (sqrt(dt^2 + 2 |d| / a) - dt)  catch-up speed from which the motor can still
+ *                                            stop within |d|: r dt + r^2 / 2a = |d|
+ *     v   = clamp(vc + sign(d) r, +-maxvel), then within +-maxaccel dt of the last v
+ *
+ * For small |d| the catch-up is r ~ |d| / dt (close the gap in one period); for large |d|
+ * it is the braking curve sqrt(2 a |d|). Since r dt <= |d| it never steps past the
+ * command on its own; only the acceleration clamp can cause a small overshoot, when the
+ * command itself breaks the limits.
+ */
+
+/* Pins and parameters of one channel. */
+struct stepgen_chan {
+    double *pos_cmd;          /* in: commanded position, mm */
+    bool *enable;             /* in: generate steps only when true */
+    double *pos_fb;           /* out: counts / scale, mm (quantised) */
+    int32_t *counts;          /* out: whole steps since start */
+    double *vel_fb;           /* out: step rate / scale, mm/s */
+    double scale;             /* param: steps per mm (sign sets the direction) */
+    double maxvel;            /* param: mm/s, 0 = no limit */
+    double maxaccel;          /* param: mm/s^2, 0 = no limit */
+    struct stepgen_state st;  /* the controller's state */
+};
+
+/* The loaded component: all channels of one `loadrt stepgen count=N`. */
+struct stepgen_comp {
+    int count;                       /* channels */
+    struct stepgen_chan chan[STEPGEN_MAX_CHAN];
+};
+
+/* The catch-up speed (mm/s) from which a motor braking at accel_mm_s2 stops within
+ * dist_mm, given that it first moves for one period dt_s at that speed. */
+static double stepgen_catchup(double dist_mm, double accel_mm_s2, double dt_s)
+{
+    if (accel_mm_s2 <= 0.0)
+        return dist_mm / dt_s;
+    return accel_mm_s2 * (sqrt(dt_s * dt_s + 2.0 * dist_mm / accel_mm_s2) - dt_s);
+}
+
+/* Limits x to [-lim, lim]; lim <= 0 means no limit. */
+static double stepgen_clamp(double x, double lim)
+{
+    if (lim <= 0.0)
+        return x;
+    return x > lim ? lim : (x < -lim ? -lim : x);
+}
+
+void stepgen_state_init(struct stepgen_state *s, double pos_mm)
+{
+    memset(s, 0, sizeof *s);
+    s->pos_mm = pos_mm;
+    s->cmd_prev_mm = pos_mm;
+}
+
+int64_t stepgen_step(struct stepgen_state *s, const struct stepgen_limits *lim,
+                     double cmd_mm, bool enable, double dt_s)
+{
+    if (!s->primed) {
+        /* The first command after start only sets the reference, so that a machine that
+         * powers up away from zero does not see a huge command velocity. */
+        s->cmd_prev_mm = cmd_mm;
+        s->primed = true;
+    }
+    double vc = (cmd_mm - s->cmd_prev_mm) / dt_s;
+    s->cmd_prev_mm = cmd_mm;
+    double v;
+    if (enable) {
+        double d = cmd_mm - s->pos_mm - vc * dt_s;
+        double r = stepgen_catchup(fabs(d), lim->maxaccel_mm_s2, dt_s);
+        v = stepgen_clamp(vc + (d < 0.0 ? -r : r), lim->maxvel_mm_s);
+    } else {
+        v = 0.0;  /* a disabled stepper gets no pulses: it stands still */
+    }
+    double dv_max = lim->maxaccel_mm_s2 * dt_s;
+    if (lim->maxaccel_mm_s2 > 0.0 && enable)
+        v = s->vel_mm_s + stepgen_clamp(v - s->vel_mm_s, dv_max);
+    s->vel_mm_s = v;
+    s->pos_mm += v * dt_s;
+    /* Whole steps: the motor moves in increments of 1/scale; round to the nearest. */
+    s->counts = (int64_t)llround(s->pos_mm * lim->scale);
+    return s->counts;
+}
+
+/* The thread function: every channel, one period. */
+static void stepgen_update(void *arg, long period_ns)
+{
+    struct stepgen_comp *c = arg;
+    double dt_s = (double)period_ns * 1e-9;
+    for (int i = 0; i < c->count; i++) {
+        struct stepgen_chan *ch = &c->chan[i];
+        if (ch->scale == 0.0)
+            continue;  /* unconfigured: nothing sensible to count */
+        struct stepgen_limits lim = { ch->scale, ch->maxvel, ch->maxaccel };
+        int64_t n = stepgen_step(&ch->st, &lim, *ch->pos_cmd, *ch->enable, dt_s);
+        *ch->counts = (int32_t)n;
+        *ch->pos_fb = (double)n / ch->scale;
+        *ch->vel_fb = ch->st.vel_mm_s;
+    }
+}
+
+/* Creates the pins and parameters of channel i. */
+static int stepgen_chan_new(struct hal *h, struct stepgen_chan *ch, int i)
+{
+    int rc;
+    if ((rc = hal_pin_float_newf(h, HAL_IN, &ch->pos_cmd, "stepgen.%d.position-cmd", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &ch->enable, "stepgen.%d.enable", i)) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &ch->pos_fb, "stepgen.%d.position-fb", i)) ||
+        (rc = hal_pin_s32_newf(h, HAL_OUT, &ch->counts, "stepgen.%d.counts", i)) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &ch->vel_fb, "stepgen.%d.velocity-fb", i)) ||
+        (rc = hal_param_float_newf(h, HAL_RW, &ch->scale, "stepgen.%d.position-scale", i)) ||
+        (rc = hal_param_float_newf(h, HAL_RW, &ch->maxvel, "stepgen.%d.maxvel", i)) ||
+        (rc = hal_param_float_newf(h, HAL_RW, &ch->maxaccel, "stepgen.%d.maxaccel", i)))
+        return rc;
+    ch->scale = 1.0;  /* LinuxCNC's default: one step per unit until setp says otherwise */
+    stepgen_state_init(&ch->st, 0.0);
+    return HAL_OK;
+}
+
+/* Parses `count=N` (default 1) from the loadrt arguments. */
+static int stepgen_parse_count(struct hal *h, int argc, char **argv, int *count)
+{
+    *count = 1;
+    for (int i = 0; i < argc; i++) {
+        if (strncmp(argv[i], "count=", 6) != 0)
+            return hal_error(h, HAL_ERR_ARG, "stepgen: unknown argument '%s' (expected count=N)",
+                             argv[i]);
+        char *end;
+        long n = strtol(argv[i] + 6, &end, 10);
+        if (*end || n < 1 || n > STEPGEN_MAX_CHAN)
+            return hal_error(h, HAL_ERR_ARG, "stepgen: count must be 1..%d, not '%s'",
+                             STEPGEN_MAX_CHAN, argv[i] + 6);
+        *count = (int)n;
+    }
+    return HAL_OK;
+}
+
+/* `loadrt stepgen count=N`: N channels and one funct, stepgen.update. */
+static int stepgen_load(struct hal *h, int argc, char **argv)
+{
+    int count, rc;
+    if ((rc = stepgen_parse_count(h, argc, argv, &count)))
+        return rc;
+    struct stepgen_comp *c = calloc(1, sizeof *c);
+    if (!c)
+        return hal_error(h, HAL_ERR_NOMEM, "stepgen: out of memory");
+    if ((rc = hal_on_destroy(h, free, c))) {
+        free(c);
+        return rc;
+    }
+    c->count = count;
+    for (int i = 0; i < count; i++)
+        if ((rc = stepgen_chan_new(h, &c->chan[i], i)))
+            return rc;
+    return hal_export_functf(h, stepgen_update, c, "stepgen.update");
+}
+
+const struct hal_comp_type hal_comp_stepgen = { "stepgen", stepgen_load };
