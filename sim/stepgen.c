@@ -1,7 +1,6 @@
 /* stepgen.c: HAL component `stepgen`, a simulated step generator in position mode. */
 #include "sim/stepgen.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,18 +10,7 @@
  * within maxvel and maxaccel, integrates it, and counts whole steps. position-fb is the
  * step count divided by the scale: what an encoder-less stepper machine really knows.
  *
- * The controller, per period dt, with p the internal (unquantised) motor position:
- *
- *     vc  = (cmd - cmd_prev) / dt            velocity the command is moving at
- *     d   = cmd - p - vc dt                  what is left if the motor just matched vc
- *     r   = a (sqrt(dt^2 + 2 |d| / a) - dt)  catch-up speed from which the motor can still
- *                                            stop within |d|: r dt + r^2 / 2a = |d|
- *     v   = clamp(vc + sign(d) r, +-maxvel), then within +-maxaccel dt of the last v
- *
- * For small |d| the catch-up is r ~ |d| / dt (close the gap in one period); for large |d|
- * it is the braking curve sqrt(2 a |d|). Since r dt <= |d| it never steps past the
- * command on its own; only the acceleration clamp can cause a small overshoot, when the
- * command itself breaks the limits.
+ * The controller itself is in stepgen_core.c (pure, so tests can drive it alone).
  */
 
 /* Pins and parameters of one channel. */
@@ -43,59 +31,6 @@ struct stepgen_comp {
     int count;                       /* channels */
     struct stepgen_chan chan[STEPGEN_MAX_CHAN];
 };
-
-/* The catch-up speed (mm/s) from which a motor braking at accel_mm_s2 stops within
- * dist_mm, given that it first moves for one period dt_s at that speed. */
-static double stepgen_catchup(double dist_mm, double accel_mm_s2, double dt_s)
-{
-    if (accel_mm_s2 <= 0.0)
-        return dist_mm / dt_s;
-    return accel_mm_s2 * (sqrt(dt_s * dt_s + 2.0 * dist_mm / accel_mm_s2) - dt_s);
-}
-
-/* Limits x to [-lim, lim]; lim <= 0 means no limit. */
-static double stepgen_clamp(double x, double lim)
-{
-    if (lim <= 0.0)
-        return x;
-    return x > lim ? lim : (x < -lim ? -lim : x);
-}
-
-void stepgen_state_init(struct stepgen_state *s, double pos_mm)
-{
-    memset(s, 0, sizeof *s);
-    s->pos_mm = pos_mm;
-    s->cmd_prev_mm = pos_mm;
-}
-
-int64_t stepgen_step(struct stepgen_state *s, const struct stepgen_limits *lim,
-                     double cmd_mm, bool enable, double dt_s)
-{
-    if (!s->primed) {
-        /* The first command after start only sets the reference, so that a machine that
-         * powers up away from zero does not see a huge command velocity. */
-        s->cmd_prev_mm = cmd_mm;
-        s->primed = true;
-    }
-    double vc = (cmd_mm - s->cmd_prev_mm) / dt_s;
-    s->cmd_prev_mm = cmd_mm;
-    double v;
-    if (enable) {
-        double d = cmd_mm - s->pos_mm - vc * dt_s;
-        double r = stepgen_catchup(fabs(d), lim->maxaccel_mm_s2, dt_s);
-        v = stepgen_clamp(vc + (d < 0.0 ? -r : r), lim->maxvel_mm_s);
-    } else {
-        v = 0.0;  /* a disabled stepper gets no pulses: it stands still */
-    }
-    double dv_max = lim->maxaccel_mm_s2 * dt_s;
-    if (lim->maxaccel_mm_s2 > 0.0 && enable)
-        v = s->vel_mm_s + stepgen_clamp(v - s->vel_mm_s, dv_max);
-    s->vel_mm_s = v;
-    s->pos_mm += v * dt_s;
-    /* Whole steps: the motor moves in increments of 1/scale; round to the nearest. */
-    s->counts = (int64_t)llround(s->pos_mm * lim->scale);
-    return s->counts;
-}
 
 /* The thread function: every channel, one period. */
 static void stepgen_update(void *arg, long period_ns)

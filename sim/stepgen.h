@@ -37,7 +37,7 @@ struct stepgen_state {
     double vel_mm_s;          /* step rate of the last period, mm/s */
     double cmd_prev_mm;       /* position-cmd of the last period, mm */
     int64_t counts;           /* whole steps */
-    bool primed;              /* cmd_prev_mm holds a real command */
+    bool primed;              /* enabled once: from then on only steps move the motor */
 };
 
 /* Starts a channel at pos_mm, at rest. */
