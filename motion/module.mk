@@ -1,0 +1,1 @@
+# motion/: segment queue, velocity planner, servo-period interpolator, and its HAL component.

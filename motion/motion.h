@@ -1,0 +1,169 @@
+/* motion.h: the segment queue, velocity planner and servo-period interpolator (no HAL). */
+#ifndef HEXCNC_MOTION_H
+#define HEXCNC_MOTION_H
+
+#include <stddef.h>
+
+#include "interp/canon.h"
+#include "kins/kins.h"
+
+/*
+ * Use:
+ *   struct motion_config c;  motion_config_default(&c);  (or motion_config_read(&c, &get, ..))
+ *   motion_create(&c, kins, &m, err, len);      kins stays the caller's, must outlive m
+ *   motion_load(m, &prog, err, len);            plans the whole program; a program that cannot
+ *                                                run (unreachable pose, leg limits) fails here,
+ *                                                naming file and line, before any motion
+ *   motion_start(m);
+ *   every servo period: motion_feedback(m, legs_fb);  motion_step(m, period_s, &out);
+ *   motion_pause / motion_resume / motion_abort / motion_set_feed_override / motion_estop
+ *   motion_destroy(m);
+ * Nothing here allocates or plans after motion_load: motion_step is cheap and bounded.
+ */
+
+/* Every call returns one of these; 0 is success. motion_strerror() gives the text. */
+enum motion_status {
+    MOTION_OK = 0,
+    MOTION_ERR_NOMEM,        /* allocation failed */
+    MOTION_ERR_CONFIG,       /* a configuration value is missing or wrong (message names it) */
+    MOTION_ERR_ARG,          /* bad argument (NULL, NaN, negative period) */
+    MOTION_ERR_STATE,        /* not allowed in this state (e.g. load while running) */
+    MOTION_ERR_PROGRAM,      /* the program holds a move that cannot be planned (zero feed,
+                              * degenerate arc); message names file and line */
+    MOTION_ERR_UNREACHABLE,  /* a pose along a move is outside the workspace */
+    MOTION_ERR_KINS,         /* the kinematics failed otherwise (singular, ...) */
+    MOTION_ERR_FERROR,       /* following error beyond its limit: fault */
+    MOTION_ERR_ESTOP,        /* emergency stop: fault */
+    MOTION_STATUS_COUNT
+};
+const char *motion_strerror(int status);
+
+/* What the machine is doing. */
+enum motion_state {
+    MOTION_IDLE = 0,         /* holding still; a loaded program waits for motion_start */
+    MOTION_RUNNING,          /* following the program */
+    MOTION_PAUSING,          /* decelerating along the path to a pause */
+    MOTION_PAUSED,           /* stopped on the path (pause, M0/M1); motion_resume continues */
+    MOTION_STOPPING,         /* decelerating along the path after motion_abort */
+    MOTION_DONE,             /* program end reached */
+    MOTION_FAULT,            /* e-stop or following error: stopped, see motion_last_error */
+    MOTION_STATE_COUNT
+};
+const char *motion_state_name(enum motion_state s);
+
+/* Limits of one joint (leg), from [JOINT_n]. */
+struct motion_joint_config {
+    double max_vel_mm_s;     /* MAX_VELOCITY, mm/s (deg/s for a rotary joint of trivial kins) */
+    double max_acc_mm_s2;    /* MAX_ACCELERATION, mm/s^2 */
+    double ferror_mm;        /* FERROR: following-error limit at MAX_VELOCITY, mm */
+    double min_ferror_mm;    /* MIN_FERROR: following-error limit at standstill, mm */
+};
+
+/* Everything the planner needs, filled by the caller (or by motion_config_read). */
+struct motion_config {
+    double servo_period_s;          /* [EMCMOT] SERVO_PERIOD (ns in the INI), s */
+    double setpoint_period_s;       /* [TRAJ] SETPOINT_PERIOD: drive set-point period, s;
+                                     * 0 = servo period */
+    double max_lin_vel_mm_s;        /* [TRAJ] MAX_LINEAR_VELOCITY, mm/s (also the rapid rate) */
+    double max_lin_acc_mm_s2;       /* [TRAJ] MAX_LINEAR_ACCELERATION, mm/s^2 */
+    double max_ang_vel_deg_s;       /* [TRAJ] MAX_ANGULAR_VELOCITY, deg/s, per rotary axis */
+    double max_ang_acc_deg_s2;      /* [TRAJ] MAX_ANGULAR_ACCELERATION, deg/s^2 */
+    double default_lin_vel_mm_s;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY, mm/s: feed of a move
+                                     * programmed before any F word (canon feed 0) */
+    double kin_tol_mm;              /* [TRAJ] KINEMATIC_TOLERANCE, mm: largest deviation of the
+                                     * tool point from the programmed path when the drives move
+                                     * legs linearly between set points; <= 0 disables the
+                                     * limiter (for comparison only) */
+    double kin_tol_deg;             /* [TRAJ] KINEMATIC_ANGULAR_TOLERANCE, deg: the same for
+                                     * orientation */
+    double blend_tol_mm;            /* [TRAJ] BLEND_TOLERANCE, mm: G64 tolerance used when the
+                                     * program gives G64 without P (canon value 0) */
+    int optional_stop;              /* [TRAJ] OPTIONAL_STOP: 1 = M1 pauses like M0 (default) */
+    int njoints;                    /* joints configured (the kinematics' count) */
+    struct motion_joint_config joint[KINS_MAX_JOINTS]; /* [JOINT_0..] */
+};
+
+/* Sensible defaults: 1 kHz, 100 mm/s, 1000 mm/s^2, 30 deg/s, 0.001 mm, 6 legs of 100 mm/s,
+ * 1000 mm/s^2, FERROR 1 mm, MIN_FERROR 0.1 mm. */
+void motion_config_default(struct motion_config *c);
+/* Reads the keys listed above through cfg->get (the INI: [EMCMOT], [TRAJ], [JOINT_n] for
+ * n < njoints); absent keys keep the defaults. MOTION_ERR_CONFIG with a message naming
+ * [SECTION]KEY when a value is not a positive number. */
+int motion_config_read(struct motion_config *c, const struct kins_config *cfg, int njoints,
+                       char *err, size_t errlen);
+
+struct motion;
+
+/* Creates a motion instance for kinematics k (borrowed). Message in err on failure. */
+int motion_create(const struct motion_config *cfg, struct kins *k, struct motion **out,
+                  char *err, size_t errlen);
+void motion_destroy(struct motion *m);
+
+/* Plans the whole program: every move sampled along its length through the inverse
+ * kinematics (reachability, leg rate and acceleration limits, kinematic-error bound), then
+ * the velocity profile. The program is copied; prog may be freed afterwards. Allowed in IDLE,
+ * DONE and FAULT (clears the fault); the pose jumps to prog->start. On failure the message
+ * names file:line and what is wrong; the previous program is dropped. */
+int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size_t errlen);
+/* Starts the loaded program (IDLE with a program -> RUNNING). */
+int motion_start(struct motion *m);
+
+/* Summary of the plan made by motion_load. */
+struct motion_plan_info {
+    double time_s;           /* planned duration at feed override 1, dwells included, s */
+    double length_mm;        /* XYZ path length of all moves, mm */
+    size_t segments;         /* segments (moves, dwells, pauses) */
+    size_t samples;          /* path samples (knots) checked through the kinematics */
+    double max_leg_vel_mm_s[KINS_MAX_JOINTS]; /* largest planned leg rate per leg, mm/s */
+    int limited_by_legs;     /* samples where leg limits lowered the speed below the feed */
+    int limited_by_kin_tol;  /* samples where the kinematic-error bound lowered it */
+};
+int motion_plan_info(const struct motion *m, struct motion_plan_info *out);
+
+/* What one servo period produces. */
+struct motion_out {
+    double pose[KINS_POSE_DIM];        /* commanded pose: mm, deg */
+    double pose_vel[KINS_POSE_DIM];    /* its rate: mm/s, deg/s */
+    double joint_pos[KINS_MAX_JOINTS]; /* leg position commands, mm */
+    double joint_vel[KINS_MAX_JOINTS]; /* leg rate commands, mm/s */
+    double ferror_mm[KINS_MAX_JOINTS]; /* last following error (command - feedback), mm */
+    int njoints;
+    int line;                          /* program line being executed (0 before any) */
+    const char *file;                  /* its file (NULL before any) */
+    enum motion_state state;
+    int status;                        /* MOTION_OK, or the fault's status */
+    double path_vel;                   /* path speed: mm/s (deg/s on rotary-only moves) */
+    double time_elapsed_s;             /* since motion_start, s */
+    double time_remaining_s;           /* from the plan at feed override 1, s */
+    double distance_done_mm;           /* XYZ path length covered, mm */
+    double distance_total_mm;          /* XYZ path length of the program, mm */
+    double feed_override;              /* override in effect now (ramps to the requested) */
+};
+
+/* Advances the clock by period_s and fills out. In FAULT, IDLE, PAUSED and DONE the pose
+ * holds. Returns the status of a fault raised during this period, else MOTION_OK. */
+int motion_step(struct motion *m, double period_s, struct motion_out *out);
+
+/* Leg position feedback, mm, one per joint: compared with the command of the previous period
+ * (the one the drives were following). Beyond the limit (MIN_FERROR at standstill growing to
+ * FERROR at MAX_VELOCITY, LinuxCNC's rule) the machine stops at once in MOTION_FAULT and
+ * motion_last_error names the leg, the amount and the program line. */
+int motion_feedback(struct motion *m, const double *joints_fb_mm);
+
+/* Decelerates along the path to a stop (RUNNING -> PAUSING -> PAUSED). */
+int motion_pause(struct motion *m);
+/* Continues after a pause or an M0/M1 stop. */
+int motion_resume(struct motion *m);
+/* Decelerates along the path to a stop, then drops the program (-> STOPPING -> IDLE). */
+int motion_abort(struct motion *m);
+/* Feed override 0..2 (clamped); applied smoothly within the acceleration limits, and never
+ * beyond a leg or machine speed limit. */
+int motion_set_feed_override(struct motion *m, double scale);
+/* Emergency stop: command freezes where it is, state FAULT (status MOTION_ERR_ESTOP). */
+int motion_estop(struct motion *m);
+
+enum motion_state motion_get_state(const struct motion *m);
+/* The last error or fault message ("" when none): file:line and what happened. */
+const char *motion_last_error(const struct motion *m);
+
+#endif
