@@ -69,6 +69,10 @@ struct kins_ops {
                      const double pose_vel[KINS_POSE_DIM], double *rates);
     /* Reachability and singularity measure of a pose (not on the servo hot path). */
     int (*check)(struct kins *k, const double pose[KINS_POSE_DIM], struct kins_check *out);
+    /* Where the tool tip is at this pose: in the base (machine frame) and in the platform
+     * frame, mm; either output may be NULL. NULL when the model has no tool (trivial). */
+    int (*tool_point)(struct kins *k, const double pose[KINS_POSE_DIM], double tip_base_mm[3],
+                      double tip_platform_mm[3]);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -81,14 +85,25 @@ struct kins {
     void *plugin_handle;               /* dlopen handle when loaded from a .so, else NULL */
 };
 
-/* Finds an ops table by name: first the models linked into this program, then the shared
- * object <dir>/kins/<name>.so, dir from $HEXCNC_PLUGIN_DIR, else ../lib next to the
- * executable, else the install prefix. NULL with a message in err when not found. */
+/* Finds the ops table of kinematics `name` in its shared object: the first of
+ *   $HEXCNC_PLUGIN_DIR/kins/<name>.so, <dir of /proc/self/exe>/../lib/kins/<name>.so,
+ *   <install prefix>/lib/hexcnc/kins/<name>.so
+ * that exists is dlopen()ed and its symbol kins_<name>_ops ('-' -> '_') returned; *handle
+ * receives the dlopen handle (close it with dlclose, or let kins_free do it). Models linked
+ * into the program are not searched: a program that wants them statically passes
+ * &kins_<name>_ops to kins_create(). NULL with a message in err naming the plugin and every
+ * path tried when no file exists, the file does not load, or it lacks the ops symbol. */
 const struct kins_ops *kins_find(const char *name, void **handle, char *err, size_t errlen);
 
-/* Loads kinematics `name` (e.g. from [KINS] KINEMATICS) and creates an instance. */
+/* Loads kinematics `name` (e.g. from [KINS] KINEMATICS) through kins_find() and creates an
+ * instance from cfg; the instance owns the plugin handle. KINS_ERR_PLUGIN or the model's
+ * create status on failure, with the message in err. */
 int kins_load(const char *name, const struct kins_config *cfg, struct kins **out,
               char *err, size_t errlen);
+/* Creates an instance of a model linked into the program (e.g. &kins_hexapod_ops), without
+ * dlopen: for tests and tools. Same statuses and messages as kins_load(). */
+int kins_create(const struct kins_ops *ops, const struct kins_config *cfg, struct kins **out,
+                char *err, size_t errlen);
 /* Destroys an instance and closes its plugin. NULL is fine. */
 void kins_free(struct kins *k);
 
@@ -101,5 +116,15 @@ static inline int kins_forward(struct kins *k, const double *joints, double *pos
 static inline int kins_leg_rates(struct kins *k, const double *pose, const double *vel,
                                  double *rates)
 { return k->ops->leg_rates(k, pose, vel, rates); }
+static inline int kins_check_pose(struct kins *k, const double *pose, struct kins_check *out)
+{ return k->ops->check(k, pose, out); }
+static inline int kins_tool_point(struct kins *k, const double *pose, double *tip_base_mm,
+                                  double *tip_platform_mm)
+{ return k->ops->tool_point ? k->ops->tool_point(k, pose, tip_base_mm, tip_platform_mm)
+                            : KINS_ERR_ARG; }
+
+/* The models this library links in, for kins_create(). */
+extern const struct kins_ops kins_hexapod_ops;
+extern const struct kins_ops kins_trivial_ops;
 
 #endif

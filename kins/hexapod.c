@@ -1,0 +1,183 @@
+/* hexapod.c: the 6-UPS Stewart platform: create, inverse, leg rates, checks, tool point. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kins/hexapod.h"
+#include "kins/hexapod_math.h"
+#include "kins/kins_svd.h"
+
+/* Splits a pose (mm, deg) into the platform origin and its orientation. */
+static int hexapod_pose_frame(const double pose[KINS_POSE_DIM], double t_mm[3],
+                              struct hexapod_rot *o)
+{
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        if (!isfinite(pose[j]))
+            return KINS_ERR_ARG;
+    t_mm[0] = pose[KINS_X];
+    t_mm[1] = pose[KINS_Y];
+    t_mm[2] = pose[KINS_Z];
+    hexapod_rot_from_rad(o, pose[KINS_A] * HEXAPOD_RAD_PER_DEG,
+                         pose[KINS_B] * HEXAPOD_RAD_PER_DEG, pose[KINS_C] * HEXAPOD_RAD_PER_DEG);
+    return KINS_OK;
+}
+
+/* Inverse kinematics: leg i length = |t + R·p_i - b_i|. */
+static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    int st = KINS_OK;
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        joints[i] = lg.len_mm[i];
+        if (lg.len_mm[i] < k->joint_min[i] || lg.len_mm[i] > k->joint_max[i])
+            st = KINS_ERR_UNREACHABLE;
+    }
+    return st;
+}
+
+/* Leg rates (mm/s) = J · pose velocity, the angle rates turned into an angular velocity. */
+static int hexapod_leg_rates(struct kins *k, const double pose[KINS_POSE_DIM],
+                             const double pose_vel[KINS_POSE_DIM], double *rates)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], row[KINS_POSE_DIM];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        if (!isfinite(pose_vel[j]))
+            return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        hexapod_jac_row(&o, &lg, i, HEXAPOD_RAD_PER_DEG, row);
+        double r = 0.0;
+        for (int j = 0; j < KINS_POSE_DIM; j++)
+            r += row[j] * pose_vel[j];
+        rates[i] = r;
+    }
+    return KINS_OK;
+}
+
+/* Leg margins and the condition number of the Jacobian with the angle columns scaled by
+ * the lever arm, so that the number does not depend on mm-versus-radian units. */
+static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
+                         struct kins_check *out)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], jac[HEXAPOD_LEGS * KINS_POSE_DIM];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (!out || hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    out->reachable = 1;
+    out->worst_leg = 0;
+    out->leg_margin_mm = INFINITY;
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        double m = fmin(lg.len_mm[i] - k->joint_min[i], k->joint_max[i] - lg.len_mm[i]);
+        if (m < 0.0)
+            out->reachable = 0;
+        if (m < out->leg_margin_mm) {
+            out->leg_margin_mm = m;
+            out->worst_leg = i;
+        }
+        hexapod_jac_row(&o, &lg, i, h->inv_char_len, &jac[i * KINS_POSE_DIM]);
+    }
+    if (kins_svd_condition(jac, HEXAPOD_LEGS, KINS_POSE_DIM, &out->condition) != 0)
+        out->condition = INFINITY;
+    out->near_singular = !(out->condition <= h->singular_condition);
+    return KINS_OK;
+}
+
+/* Tool tip in both frames: one is fixed by configuration, the other follows the pose. */
+static int hexapod_tool_point(struct kins *k, const double pose[KINS_POSE_DIM],
+                              double tip_base_mm[3], double tip_platform_mm[3])
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], fixed[3], moving[3];
+    struct hexapod_rot o;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    memcpy(fixed, h->tool_tip_mm, sizeof fixed);
+    if (h->carries == HEXAPOD_CARRIES_WORKPIECE) {
+        /* tip in platform frame = R^T (tip_base - t) */
+        for (int j = 0; j < 3; j++)
+            moving[j] = o.r[0][j] * (fixed[0] - t[0]) + o.r[1][j] * (fixed[1] - t[1]) +
+                        o.r[2][j] * (fixed[2] - t[2]);
+        if (tip_base_mm)
+            memcpy(tip_base_mm, fixed, sizeof fixed);
+        if (tip_platform_mm)
+            memcpy(tip_platform_mm, moving, sizeof moving);
+    } else {
+        /* tip in base frame = t + R tip_platform */
+        for (int j = 0; j < 3; j++)
+            moving[j] = t[j] + o.r[j][0] * fixed[0] + o.r[j][1] * fixed[1] +
+                        o.r[j][2] * fixed[2];
+        if (tip_base_mm)
+            memcpy(tip_base_mm, moving, sizeof moving);
+        if (tip_platform_mm)
+            memcpy(tip_platform_mm, fixed, sizeof fixed);
+    }
+    return KINS_OK;
+}
+
+/* Frees an instance made by hexapod_create. */
+static void hexapod_destroy(struct kins *k)
+{
+    free(k);
+}
+
+/* Builds a hexapod from configuration and checks that its home pose is reachable. */
+static int hexapod_create(const struct kins_config *cfg, struct kins **out, char *err,
+                          size_t errlen)
+{
+    if (!cfg || !cfg->get || !out) {
+        if (err && errlen)
+            snprintf(err, errlen, "hexapod: no configuration given");
+        return KINS_ERR_ARG;
+    }
+    struct hexapod *h = calloc(1, sizeof *h);
+    if (!h)
+        return KINS_ERR_NOMEM;
+    h->base.ops = &kins_hexapod_ops;
+    h->base.njoints = HEXAPOD_LEGS;
+    int st = hexapod_configure(h, cfg, err, errlen);
+    if (st != KINS_OK)
+        goto fail;
+    double legs[HEXAPOD_LEGS];
+    if (hexapod_inverse(&h->base, h->base.home, legs) != KINS_OK) {
+        st = KINS_ERR_CONFIG;
+        for (int i = 0; i < HEXAPOD_LEGS && err && errlen; i++)
+            if (!(legs[i] >= h->base.joint_min[i] && legs[i] <= h->base.joint_max[i])) {
+                snprintf(err, errlen, "[KINS] HOME: the home pose is outside the leg limits "
+                         "(leg %d would be %.3f mm, limits [JOINT_%d] %.3f..%.3f mm)", i,
+                         legs[i], i, h->base.joint_min[i], h->base.joint_max[i]);
+                break;
+            }
+        goto fail;
+    }
+    *out = &h->base;
+    return KINS_OK;
+fail:
+    free(h);
+    return st;
+}
+
+const struct kins_ops kins_hexapod_ops = {
+    .name = "hexapod",
+    .create = hexapod_create,
+    .destroy = hexapod_destroy,
+    .inverse = hexapod_inverse,
+    .forward = hexapod_forward,
+    .leg_rates = hexapod_leg_rates,
+    .check = hexapod_check,
+    .tool_point = hexapod_tool_point,
+};

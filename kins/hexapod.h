@@ -1,0 +1,43 @@
+/* hexapod.h: the 6-UPS Stewart platform model's instance and its internal helpers. */
+#ifndef HEXCNC_HEXAPOD_H
+#define HEXCNC_HEXAPOD_H
+
+#include <stddef.h>
+
+#include "kins/kins.h"
+
+#define HEXAPOD_LEGS 6
+
+/* Which body the moving platform carries; the other (tool or work) is fixed on the frame. */
+enum hexapod_carries {
+    HEXAPOD_CARRIES_WORKPIECE = 0, /* tool fixed on the frame, table moves (the TMU machine) */
+    HEXAPOD_CARRIES_SPINDLE,       /* spindle on the platform, workpiece on the frame */
+};
+
+/* One hexapod: geometry, limits and solver settings, all read once from configuration. */
+struct hexapod {
+    struct kins base;                  /* generic part; must stay first */
+    double b_mm[HEXAPOD_LEGS][3];      /* base joint centres in the base frame, mm */
+    double p_mm[HEXAPOD_LEGS][3];      /* platform joint centres in the platform frame, mm */
+    double pdist_mm[HEXAPOD_LEGS][HEXAPOD_LEGS]; /* platform joint spacing, mm */
+    double bdist_mm[HEXAPOD_LEGS][HEXAPOD_LEGS]; /* base joint spacing, mm */
+    double char_len_mm;                /* turns angular Jacobian columns (mm/rad) into mm/mm */
+    double inv_char_len;               /* 1 / char_len_mm, 1/mm */
+    double fwd_tol_mm;                 /* forward solve: largest final Newton step, mm */
+    int fwd_max_iter;                  /* forward solve: Newton iteration limit */
+    double singular_condition;         /* condition number above which a pose is near-singular */
+    enum hexapod_carries carries;      /* what the platform carries */
+    double tool_tip_mm[3];             /* tool tip (gauge point + length along the tool axis):
+                                        * base frame if the tool is fixed, else platform frame */
+};
+
+/* Reads geometry, leg limits, solver settings and tool data from cfg into h (hexapod_geom.c).
+ * On failure err names the section and key. */
+int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *err,
+                      size_t errlen);
+
+/* Forward kinematics by Newton-Raphson (hexapod_fwd.c); the kins_ops forward entry. */
+int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                    struct kins_fwd_info *info);
+
+#endif

@@ -1,0 +1,191 @@
+/* kins.c: status texts and the plugin loader (dlopen by name, or a linked-in ops table). */
+#include <dlfcn.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "kins/kins.h"
+
+#ifndef HEXCNC_PREFIX
+#define HEXCNC_PREFIX "/usr/local"
+#endif
+
+/* Longest model name accepted: keeps every path and symbol in fixed buffers. */
+#define KINS_NAME_MAX 64
+
+static const struct {
+    int status;
+    const char *text;
+} kins_status_texts[] = {
+    { KINS_OK, "ok" },
+    { KINS_ERR_CONFIG, "kinematics configuration key missing or wrong" },
+    { KINS_ERR_NOMEM, "out of memory" },
+    { KINS_ERR_PLUGIN, "kinematics plugin not found or not loadable" },
+    { KINS_ERR_UNREACHABLE, "pose unreachable: a leg would be outside its length limits" },
+    { KINS_ERR_LEG_RANGE, "leg length outside its limits" },
+    { KINS_ERR_IMPOSSIBLE, "leg lengths no platform pose can have" },
+    { KINS_ERR_SINGULAR, "singular configuration: the legs cannot hold or move the platform" },
+    { KINS_ERR_NO_CONVERGE, "forward kinematics did not converge within its iteration limit" },
+    { KINS_ERR_ARG, "bad argument (not a number, or wrong count)" },
+};
+
+/* Text of a kinematics status, for messages. */
+const char *kins_strerror(int status)
+{
+    for (size_t i = 0; i < sizeof kins_status_texts / sizeof kins_status_texts[0]; i++)
+        if (kins_status_texts[i].status == status)
+            return kins_status_texts[i].text;
+    return "unknown kinematics status";
+}
+
+/* Creates an instance from an ops table, checking that the model filled in the base. */
+int kins_create(const struct kins_ops *ops, const struct kins_config *cfg, struct kins **out,
+                char *err, size_t errlen)
+{
+    if (err && errlen)
+        err[0] = '\0';
+    if (!ops || !ops->create || !out) {
+        if (err && errlen)
+            snprintf(err, errlen, "kinematics: no ops table given");
+        return KINS_ERR_ARG;
+    }
+    *out = NULL;
+    struct kins *k = NULL;
+    int st = ops->create(cfg, &k, err, errlen);
+    if (st != KINS_OK)
+        return st;
+    k->ops = ops;
+    k->plugin_handle = NULL;
+    *out = k;
+    return KINS_OK;
+}
+
+/* Writes <dir of /proc/self/exe>/../lib/kins into buf; 0 on success. */
+static int kins_exe_plugin_dir(char *buf, size_t len)
+{
+    char exe[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return -1;
+    exe[n] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (!slash)
+        return -1;
+    *slash = '\0';
+    int w = snprintf(buf, len, "%s/../lib/kins", exe);
+    return w < 0 || (size_t)w >= len ? -1 : 0;
+}
+
+/* Appends text to the list of tried paths kept for the error message. */
+static void kins_note_tried(char *tried, size_t len, const char *path, const char *why)
+{
+    size_t used = strlen(tried);
+    if (used + 1 >= len)
+        return;
+    /* A list too long for the buffer is cut; the message stays readable. */
+    if (snprintf(tried + used, len - used, "%s%s (%s)", used ? ", " : "", path, why) < 0)
+        tried[used] = '\0';
+}
+
+/* Tries one directory: dlopen <dir>/<name>.so and look up its ops symbol. */
+static const struct kins_ops *kins_try_dir(const char *dir, const char *name, const char *sym,
+                                           void **handle, char *tried, size_t triedlen)
+{
+    char path[PATH_MAX + KINS_NAME_MAX];
+    int w = snprintf(path, sizeof path, "%s/%s.so", dir, name);
+    if (w < 0 || (size_t)w >= sizeof path) {
+        kins_note_tried(tried, triedlen, dir, "path too long");
+        return NULL;
+    }
+    if (access(path, F_OK) != 0) {
+        kins_note_tried(tried, triedlen, path, "no such file");
+        return NULL;
+    }
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *why = dlerror();
+        kins_note_tried(tried, triedlen, path, why ? why : "dlopen failed");
+        return NULL;
+    }
+    dlerror();
+    const struct kins_ops *ops = (const struct kins_ops *)dlsym(h, sym);
+    if (!ops || !ops->create) {
+        char why[KINS_NAME_MAX + 32];
+        snprintf(why, sizeof why, "no symbol %s", sym);
+        kins_note_tried(tried, triedlen, path, why);
+        dlclose(h);
+        return NULL;
+    }
+    *handle = h;
+    return ops;
+}
+
+/* Finds kinematics `name` as a shared object along the search path (see kins.h). */
+const struct kins_ops *kins_find(const char *name, void **handle, char *err, size_t errlen)
+{
+    if (err && errlen)
+        err[0] = '\0';
+    size_t nlen = name ? strlen(name) : 0;
+    if (!handle || nlen == 0 || nlen >= KINS_NAME_MAX || strchr(name, '/') || name[0] == '.') {
+        if (err && errlen)
+            snprintf(err, errlen, "kinematics '%s': not a valid plugin name", name ? name : "");
+        return NULL;
+    }
+    *handle = NULL;
+    char sym[KINS_NAME_MAX + 16];
+    snprintf(sym, sizeof sym, "kins_%s_ops", name);
+    for (char *c = sym; *c; c++)
+        if (*c == '-')
+            *c = '_';
+
+    char dirs[3][PATH_MAX];
+    int ndirs = 0;
+    const char *env = getenv("HEXCNC_PLUGIN_DIR");
+    if (env && *env)
+        snprintf(dirs[ndirs++], PATH_MAX, "%s/kins", env);
+    if (kins_exe_plugin_dir(dirs[ndirs], PATH_MAX) == 0)
+        ndirs++;
+    snprintf(dirs[ndirs++], PATH_MAX, "%s/lib/hexcnc/kins", HEXCNC_PREFIX);
+
+    char tried[2048] = "";
+    for (int i = 0; i < ndirs; i++) {
+        const struct kins_ops *ops = kins_try_dir(dirs[i], name, sym, handle, tried, sizeof tried);
+        if (ops)
+            return ops;
+    }
+    if (err && errlen)
+        snprintf(err, errlen, "kinematics plugin '%s' not found; tried: %s", name, tried);
+    return NULL;
+}
+
+/* Loads a plugin by name and creates an instance that owns the plugin handle. */
+int kins_load(const char *name, const struct kins_config *cfg, struct kins **out,
+              char *err, size_t errlen)
+{
+    if (out)
+        *out = NULL;
+    void *handle = NULL;
+    const struct kins_ops *ops = kins_find(name, &handle, err, errlen);
+    if (!ops)
+        return KINS_ERR_PLUGIN;
+    int st = kins_create(ops, cfg, out, err, errlen);
+    if (st != KINS_OK) {
+        dlclose(handle);
+        return st;
+    }
+    (*out)->plugin_handle = handle;
+    return KINS_OK;
+}
+
+/* Destroys an instance, then closes the plugin its code lives in. */
+void kins_free(struct kins *k)
+{
+    if (!k)
+        return;
+    void *handle = k->plugin_handle;
+    k->ops->destroy(k);
+    if (handle)
+        dlclose(handle);
+}

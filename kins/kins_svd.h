@@ -1,0 +1,18 @@
+/* kins_svd.h: C API to the singular values of a small matrix (Eigen, in kins_svd.cpp). */
+#ifndef HEXCNC_KINS_SVD_H
+#define HEXCNC_KINS_SVD_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Condition number (largest / smallest singular value) of the rows x cols matrix m, stored
+ * row by row; rows, cols in 1..9. Writes +inf when the smallest singular value is zero.
+ * Returns 0, or -1 on a bad size or a non-finite entry. Not for the servo hot path. */
+int kins_svd_condition(const double *m, int rows, int cols, double *cond);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

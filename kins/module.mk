@@ -1,0 +1,23 @@
+# kins/: kinematics models behind struct kins_ops, linked into the library for tests and
+# tools, and built as lib/kins/<name>.so for loading by name ([KINS] KINEMATICS).
+KINS_HEXAPOD_SRCS := kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c kins/kins_cfg.c
+KINS_TRIVIAL_SRCS := kins/trivial.c kins/kins_cfg.c
+
+LIB_SRCS += kins/kins.c kins/kins_cfg.c kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c \
+            kins/trivial.c
+LIB_CXXSRCS += kins/kins_svd.cpp
+PLUGINS += $(LIBDIR)/kins/hexapod.so $(LIBDIR)/kins/trivial.so
+
+# The loader's last search place is the install prefix.
+$(BUILD)/kins/kins.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
+
+# Each plugin binds its own symbols first (-Bsymbolic), so a program that also links the
+# same model statically never mixes the two copies; --no-undefined keeps the .so complete.
+KINS_SO_LDFLAGS := -shared -Wl,-Bsymbolic -Wl,--no-undefined
+$(LIBDIR)/kins/hexapod.so: $(KINS_HEXAPOD_SRCS:%.c=$(BUILD)/%.o) $(BUILD)/kins/kins_svd.o
+	@mkdir -p $(@D)
+	$(CXX) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
+$(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
+
