@@ -14,7 +14,31 @@
  * approach when skew; outside: an arc of radius W about the programmed corner). The first
  * block that does not carry G141/G142 (or the end of the program) ends the run: the
  * interpreter calls comp5_flush() before it handles that block.
+ *
+ * What comp5 emits (docs/compensation.md has the details and the reasons):
+ *  - The second block of a run emits the positioning move: a CANON_FEED (not a rapid: it
+ *    belongs to a G141/G142 block that carries F) from the tool's pose to the compensated
+ *    start, with the FIRST block's line, file and feed.
+ *  - Each segment P(k-1) -> P(k) is cut as a CANON_FEED with block k's line, file and feed,
+ *    ending at the join it makes with the next segment (or, at comp5_flush(), at its own
+ *    compensated end). Each point P(k) is offset with its own block's radius and with the
+ *    normal N of its own A B C, as in the paper's per-block formula.
+ *  - An outside corner at P(k) adds a CANON_ARC (plane 0, center P(k), radius W(k), normal
+ *    unit(u_a x u_b) of the two offset directions, rotation +1), with block k's line. Both
+ *    ends of the arc use P(k)'s orientation, so A B C stay constant along the arc.
+ *  - Every emitted move has compensated = 141 or 142 and starts where the last one ended.
+ *
+ * Between comp5_block() calls the emitted path lags one block behind the program: the
+ * interpreter takes comp5_tool_pos() as the tool's pose after comp5_flush(). After an error
+ * the run is dropped (c->active = 0); c->err_line and comp5_errmsg() say what was wrong.
  */
+
+/* Tolerances, with their units. */
+#define COMP5_EPS_MM 1e-6          /* mm: shorter moves are zero-length; points closer coincide */
+#define COMP5_EPS_DEG 1e-9         /* deg: orientations closer than this are equal */
+#define COMP5_MIN_SIN_AXIS 1e-3    /* |T x N| below this (motion within ~0.06 deg of the tool
+                                    * axis) leaves the compensation direction undefined */
+#define COMP5_EPS_SIN_PARALLEL 1e-9 /* sine below which two offset lines count as parallel */
 
 enum comp5_status {
     COMP5_OK = 0,
@@ -25,6 +49,7 @@ enum comp5_status {
     COMP5_ERR_RADIUS,         /* radius missing, zero or negative */
     COMP5_ERR_GOUGE,          /* an inside corner the tool cannot reach without gouging */
     COMP5_ERR_SINK,           /* the canon sink refused a command */
+    COMP5_ERR_SIDE,           /* side is neither 141 nor 142 (a caller's mistake) */
     COMP5_STATUS_COUNT
 };
 const char *comp5_strerror(int status);
@@ -33,10 +58,20 @@ const char *comp5_strerror(int status);
 struct comp5_block {
     int side;                 /* 141 (right) or 142 (left) */
     double point[6];          /* programmed contour point and orientation, machine frame */
-    double radius_mm;         /* effective tool radius (W, or tool table diameter/2 + wear) */
+    double radius_mm;         /* effective tool radius (W, or tool table diameter/2 + wear);
+                               * 0 or NaN when the block has none: an error (COMP5_ERR_RADIUS) */
     double feed_mm_min;       /* feed in force */
     int line;                 /* source line, for the emitted moves and for errors */
     const char *file;
+};
+
+/* The offset line of one programmed segment: its two compensated ends. */
+struct comp5_seg {
+    double a0[6];             /* compensated start (P(k-1) + s W(k-1) V), its orientation */
+    double a1[6];             /* compensated end (P(k) + s W(k) V), its orientation */
+    double dir[3];            /* unit direction of travel T of the programmed segment */
+    double t_start;           /* where the cut of this segment begins, as a fraction of
+                               * a0 -> a1 (0 unless an inside join moved it) */
 };
 
 /* State of one run. Embedded in the interpreter's state; no allocation. */
@@ -49,6 +84,8 @@ struct comp5 {
     struct comp5_block prev2; /* the block before it (corner joins need both segments) */
     double tool_pos[6];       /* where the emitted moves have left the tool */
     int err_line;             /* line the last error refers to */
+    struct comp5_seg seg;     /* the segment prev2 -> prev, not yet cut (nblocks >= 2) */
+    char err_msg[240];        /* the last error in a machinist's words (no file:line prefix) */
 };
 
 void comp5_init(struct comp5 *c);
@@ -60,11 +97,13 @@ int comp5_block(struct comp5 *c, const struct comp5_block *b, const double start
 int comp5_flush(struct comp5 *c, canon_sink_fn sink, void *ctx);
 /* Where the tool is after the emitted moves (valid after comp5_flush or while active). */
 const double *comp5_tool_pos(const struct comp5 *c);
+/* The last error, in words, e.g. "G141 inside corner at line 12: ..." (never NULL). */
+const char *comp5_errmsg(const struct comp5 *c);
 
 /* The table normal N = R [0 0 1] for orientation A, B, C in degrees (paper's step 2). */
 void comp5_normal(double a_deg, double b_deg, double c_deg, double n[3]);
 /* The compensated point of one segment (paper's steps 1..4): p + s W unit(T x N), with
- * s = +1 for G141 and -1 for G142, T from `from` to `to`. */
+ * s = +1 for G141 and -1 for G142, T from `from` to `to`, N from p's A B C. */
 int comp5_offset_point(const double from[6], const double to[6], int side, double radius_mm,
                        const double p[6], double out[6]);
 

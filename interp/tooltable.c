@@ -1,0 +1,477 @@
+/* tooltable.c: LinuxCNC-format tool table: parse, look up, wear, G10 L1, atomic save. */
+#include "interp/tooltable.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define TOOLTABLE_MAX_FILE_BYTES (4L << 20) /* a table file larger than 4 MiB is refused */
+
+static const char *const tooltable_msgs[TOOLTABLE_STATUS_COUNT] = {
+    [TOOLTABLE_OK] = "ok",
+    [TOOLTABLE_ERR_IO] = "tool table file cannot be read or written",
+    [TOOLTABLE_ERR_SYNTAX] = "tool table line does not parse",
+    [TOOLTABLE_ERR_DUPLICATE] = "the same tool number appears twice in the tool table",
+    [TOOLTABLE_ERR_FULL] = "the tool table is full",
+    [TOOLTABLE_ERR_NO_TOOL] = "no such tool in the tool table",
+    [TOOLTABLE_ERR_VALUE] = "tool diameter (with wear) is missing, zero or negative",
+};
+
+/* The text of a status. */
+const char *tooltable_strerror(int status)
+{
+    if (status < 0 || status >= TOOLTABLE_STATUS_COUNT)
+        return "unknown tool table status";
+    return tooltable_msgs[status];
+}
+
+/* Formats an error message into err (when the caller gave one) and returns status. */
+__attribute__((format(printf, 4, 5)))
+static int tooltable_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+/* An empty table. */
+void tooltable_init(struct tooltable *t)
+{
+    memset(t, 0, sizeof *t);
+}
+
+/* Index of tool `tool` in t, or -1 (const-friendly core of tooltable_find). */
+static int tooltable_index(const struct tooltable *t, int tool)
+{
+    for (int i = 0; i < t->count; i++)
+        if (t->tools[i].tool == tool)
+            return i;
+    return -1;
+}
+
+/* The entry of tool `tool`, or NULL. */
+struct tool_entry *tooltable_find(struct tooltable *t, int tool)
+{
+    int i = tooltable_index(t, tool);
+    return i < 0 ? NULL : &t->tools[i];
+}
+
+/* Adds or replaces an entry (tool numbers 1 .. TOOLTABLE_WEAR_BASE - 1). */
+int tooltable_set(struct tooltable *t, const struct tool_entry *e)
+{
+    if (e->tool <= 0 || e->tool >= TOOLTABLE_WEAR_BASE)
+        return TOOLTABLE_ERR_NO_TOOL;
+    if (!(e->diameter_mm >= 0.0))
+        return TOOLTABLE_ERR_VALUE;
+    int i = tooltable_index(t, e->tool);
+    if (i < 0) {
+        if (t->count >= TOOLTABLE_MAX)
+            return TOOLTABLE_ERR_FULL;
+        i = t->count++;
+    }
+    t->tools[i] = *e;
+    return TOOLTABLE_OK;
+}
+
+/* Sets the diameter wear delta of an existing tool. */
+int tooltable_set_wear(struct tooltable *t, int tool, double wear_mm)
+{
+    struct tool_entry *e = tooltable_find(t, tool);
+    if (!e)
+        return TOOLTABLE_ERR_NO_TOOL;
+    if (!isfinite(wear_mm))
+        return TOOLTABLE_ERR_VALUE;
+    e->wear_mm = wear_mm;
+    return TOOLTABLE_OK;
+}
+
+/* G10 L1: nominal radius / length of tool p, or the wear of tool p - WEAR_BASE. */
+int tooltable_g10_l1(struct tooltable *t, int p, int has_r, double r_mm, int has_z,
+                     double z_mm)
+{
+    if (p > TOOLTABLE_WEAR_BASE) {
+        if (has_z)
+            return TOOLTABLE_ERR_VALUE; /* only diameter wear is kept */
+        return has_r ? tooltable_set_wear(t, p - TOOLTABLE_WEAR_BASE, 2.0 * r_mm)
+                     : TOOLTABLE_OK;
+    }
+    if (p <= 0 || p >= TOOLTABLE_WEAR_BASE)
+        return TOOLTABLE_ERR_NO_TOOL;
+    struct tool_entry e;
+    struct tool_entry *old = tooltable_find(t, p);
+    if (old) {
+        e = *old;
+    } else {
+        memset(&e, 0, sizeof e);
+        e.tool = p;
+        e.pocket = p;
+    }
+    if (has_r) {
+        if (!(r_mm >= 0.0))
+            return TOOLTABLE_ERR_VALUE;
+        e.diameter_mm = 2.0 * r_mm;
+    }
+    if (has_z) {
+        e.z_offset_mm = z_mm;
+        e.present |= TOOLTABLE_F_Z;
+    }
+    return tooltable_set(t, &e);
+}
+
+/* Effective radius for compensation: (diameter + wear) / 2, which must be > 0. */
+int tooltable_radius(const struct tooltable *t, int tool, double *radius_mm)
+{
+    int i = tooltable_index(t, tool);
+    if (i < 0)
+        return TOOLTABLE_ERR_NO_TOOL;
+    double d_mm = t->tools[i].diameter_mm + t->tools[i].wear_mm;
+    if (!(d_mm > 0.0))
+        return TOOLTABLE_ERR_VALUE;
+    *radius_mm = 0.5 * d_mm;
+    return TOOLTABLE_OK;
+}
+
+/* ---- parsing ---- */
+
+/* The letters LinuxCNC's tool table knows, in the order a save writes the optional ones. */
+static const char tooltable_offset_letters[] = "XYZABCUVW";
+
+/* One parsed line: a tool or a wear entry, with the line it came from. */
+struct tooltable_line {
+    struct tool_entry e;
+    int lineno;
+};
+
+/* Copies the comment after ';' without the leading blanks and the line end. */
+static void tooltable_copy_comment(char *dst, size_t dstlen, const char *src)
+{
+    while (*src == ' ' || *src == '\t')
+        src++;
+    size_t n = strcspn(src, "\r\n");
+    if (n >= dstlen)
+        n = dstlen - 1;
+    memcpy(dst, src, n);
+    dst[n] = '\0';
+}
+
+/* Reads one word's number; integers for T P Q. Returns 0 on success. */
+static int tooltable_number(const char **s, int want_int, double *v)
+{
+    char *end;
+    errno = 0;
+    *v = strtod(*s, &end);
+    if (end == *s || errno || !isfinite(*v))
+        return -1;
+    if (want_int && (*v != floor(*v) || fabs(*v) > 1e9))
+        return -1;
+    *s = end;
+    return 0;
+}
+
+/* Stores a field value; `bit` marks it present. Returns 0, or -1 if the letter repeats. */
+static int tooltable_store(struct tool_entry *e, unsigned *seen, char letter, double v)
+{
+    const char *all = "TPXYZABCUVWDIJQ";
+    unsigned bit = 1u << (strchr(all, letter) - all);
+    if (*seen & bit)
+        return -1;
+    *seen |= bit;
+    const char *off = strchr(tooltable_offset_letters, letter);
+    if (letter == 'T')
+        e->tool = (int)v;
+    else if (letter == 'P')
+        e->pocket = (int)v;
+    else if (letter == 'D')
+        e->diameter_mm = v;
+    else if (letter == 'I')
+        e->front_angle_deg = v, e->present |= TOOLTABLE_F_I;
+    else if (letter == 'J')
+        e->back_angle_deg = v, e->present |= TOOLTABLE_F_J;
+    else if (letter == 'Q')
+        e->orientation = (int)v, e->present |= TOOLTABLE_F_Q;
+    else if (letter == 'Z')
+        e->z_offset_mm = v, e->present |= TOOLTABLE_F_Z;
+    else if (off) {
+        e->offset[off - tooltable_offset_letters] = v;
+        e->present |= 1u << (off - tooltable_offset_letters);
+    }
+    return 0;
+}
+
+/* Parses one line into l->e; *is_tool says whether it held a tool (else blank/comment). */
+static int tooltable_parse_line(const char *s, struct tooltable_line *l, int *is_tool,
+                                const char *name, char *err, size_t errlen)
+{
+    unsigned seen = 0;
+    memset(&l->e, 0, sizeof l->e);
+    *is_tool = 0;
+    for (;;) {
+        while (*s == ' ' || *s == '\t' || *s == '\r')
+            s++;
+        if (*s == '\0' || *s == '\n')
+            break;
+        if (*s == ';') {
+            tooltable_copy_comment(l->e.comment, sizeof l->e.comment, s + 1);
+            break;
+        }
+        char letter = (char)toupper((unsigned char)*s);
+        if (!isalpha((unsigned char)*s) || !strchr("TPXYZABCUVWDIJQ", letter))
+            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                                  "%s:%d: unknown field '%c' (a tool table knows T P X Y Z A "
+                                  "B C U V W D I J Q)", name, l->lineno, *s);
+        s++;
+        double v;
+        if (tooltable_number(&s, letter == 'T' || letter == 'P' || letter == 'Q', &v))
+            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                                  "%s:%d: field %c needs a %snumber", name, l->lineno,
+                                  letter, strchr("TPQ", letter) ? "whole " : "");
+        if (*s && !strchr(" \t\r\n;", *s))
+            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                                  "%s:%d: field %c is followed by '%c' (put a space between "
+                                  "fields)", name, l->lineno, letter, *s);
+        if (tooltable_store(&l->e, &seen, letter, v))
+            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                                  "%s:%d: field %c appears twice", name, l->lineno, letter);
+    }
+    if (!seen)
+        return TOOLTABLE_OK;
+    if (!(seen & 1u))
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                              "%s:%d: the line has no tool number (T)", name, l->lineno);
+    if (l->e.tool <= 0 || l->e.tool == TOOLTABLE_WEAR_BASE)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                              "%s:%d: tool number T%d is not allowed (use 1..%d, or %d+n for "
+                              "the wear of tool n)", name, l->lineno, l->e.tool,
+                              TOOLTABLE_WEAR_BASE - 1, TOOLTABLE_WEAR_BASE);
+    if (!(seen & 2u))
+        l->e.pocket = l->e.tool;
+    if (l->e.tool > TOOLTABLE_WEAR_BASE && (seen & ~(1u | 2u | (1u << 11))))
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+                              "%s:%d: wear entry T%d may only carry P and D (diameter wear)",
+                              name, l->lineno, l->e.tool);
+    if (l->e.tool < TOOLTABLE_WEAR_BASE && l->e.diameter_mm < 0.0)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_VALUE,
+                              "%s:%d: tool T%d has a negative diameter D%g", name,
+                              l->lineno, l->e.tool, l->e.diameter_mm);
+    *is_tool = 1;
+    return TOOLTABLE_OK;
+}
+
+/* A wear entry read from the file, applied once every tool is known. */
+struct tooltable_wear {
+    int tool;                 /* the worn tool's number (entry number - WEAR_BASE) */
+    double wear_mm;           /* diameter wear delta */
+    int lineno;               /* line of the wear entry */
+};
+
+/* Folds a wear entry (T WEAR_BASE + n) into tool n, which must be in the table. */
+static int tooltable_apply_wear(struct tooltable *t, const struct tooltable_wear *l,
+                                int *wear_line, const char *name, char *err, size_t errlen)
+{
+    int tool = l->tool;
+    int i = tooltable_index(t, tool);
+    if (i < 0)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_NO_TOOL,
+                              "%s:%d: wear entry T%d is for tool T%d, which is not in the "
+                              "table", name, l->lineno, tool + TOOLTABLE_WEAR_BASE, tool);
+    if (wear_line[i])
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_DUPLICATE,
+                              "%s:%d: a second wear entry for tool T%d (the first is on line "
+                              "%d)", name, l->lineno, tool, wear_line[i]);
+    t->tools[i].wear_mm = l->wear_mm;
+    wear_line[i] = l->lineno;
+    return TOOLTABLE_OK;
+}
+
+/* Adds one tool line to t, refusing duplicates. line_of[i] remembers where tool i was. */
+static int tooltable_add_line(struct tooltable *t, const struct tooltable_line *l,
+                              int *line_of, const char *name, char *err, size_t errlen)
+{
+    int i = tooltable_index(t, l->e.tool);
+    if (i >= 0)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_DUPLICATE,
+                              "%s:%d: tool T%d appears twice (first on line %d)", name,
+                              l->lineno, l->e.tool, line_of[i]);
+    if (t->count >= TOOLTABLE_MAX)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_FULL,
+                              "%s:%d: more than %d tools", name, l->lineno, TOOLTABLE_MAX);
+    line_of[t->count] = l->lineno;
+    t->tools[t->count++] = l->e;
+    return TOOLTABLE_OK;
+}
+
+/* Parses a whole table from text: tools first, then the wear entries folded into them. */
+int tooltable_parse(struct tooltable *t, const char *text, const char *name, char *err,
+                    size_t errlen)
+{
+    int line_of[TOOLTABLE_MAX] = {0}, wear_line[TOOLTABLE_MAX] = {0};
+    struct tooltable_wear wear[TOOLTABLE_MAX];
+    int nwear = 0, rc = TOOLTABLE_OK;
+    struct tooltable_line l;
+    tooltable_init(t);
+    l.lineno = 0;
+    for (const char *s = text; s && *s && rc == TOOLTABLE_OK;) {
+        const char *eol = strchr(s, '\n');
+        l.lineno++;
+        int is_tool;
+        rc = tooltable_parse_line(s, &l, &is_tool, name, err, errlen);
+        if (rc == TOOLTABLE_OK && is_tool && l.e.tool > TOOLTABLE_WEAR_BASE) {
+            if (nwear >= TOOLTABLE_MAX)
+                rc = tooltable_fail(err, errlen, TOOLTABLE_ERR_FULL,
+                                    "%s:%d: more than %d wear entries", name, l.lineno,
+                                    TOOLTABLE_MAX);
+            else
+                wear[nwear++] = (struct tooltable_wear){
+                    l.e.tool - TOOLTABLE_WEAR_BASE, l.e.diameter_mm, l.lineno};
+        } else if (rc == TOOLTABLE_OK && is_tool) {
+            rc = tooltable_add_line(t, &l, line_of, name, err, errlen);
+        }
+        s = eol ? eol + 1 : NULL;
+    }
+    for (int k = 0; k < nwear && rc == TOOLTABLE_OK; k++)
+        rc = tooltable_apply_wear(t, &wear[k], wear_line, name, err, errlen);
+    if (rc != TOOLTABLE_OK)
+        tooltable_init(t);
+    return rc;
+}
+
+/* Reads the whole file into a NUL-terminated buffer the caller frees. */
+static char *tooltable_slurp(const char *path, char *err, size_t errlen, int *rc)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    long n;
+    *rc = TOOLTABLE_ERR_IO;
+    if (!f) {
+        tooltable_fail(err, errlen, *rc, "%s: cannot open the tool table: %s", path,
+                       strerror(errno));
+        return NULL;
+    }
+    if (fseek(f, 0, SEEK_END) || (n = ftell(f)) < 0 || n > TOOLTABLE_MAX_FILE_BYTES ||
+        fseek(f, 0, SEEK_SET)) {
+        tooltable_fail(err, errlen, *rc, "%s: cannot read the tool table (too large?)", path);
+        goto out;
+    }
+    buf = malloc((size_t)n + 1);
+    if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        tooltable_fail(err, errlen, *rc, "%s: cannot read the tool table", path);
+        free(buf);
+        buf = NULL;
+        goto out;
+    }
+    buf[n] = '\0';
+    *rc = TOOLTABLE_OK;
+out:
+    fclose(f);
+    return buf;
+}
+
+/* Reads a table file; err gets "file:line: what" on failure. */
+int tooltable_load(struct tooltable *t, const char *path, char *err, size_t errlen)
+{
+    int rc;
+    char *text = tooltable_slurp(path, err, errlen, &rc);
+    tooltable_init(t);
+    if (!text)
+        return rc;
+    rc = tooltable_parse(t, text, path, err, errlen);
+    free(text);
+    if (rc == TOOLTABLE_OK)
+        snprintf(t->path, sizeof t->path, "%s", path);
+    return rc;
+}
+
+/* ---- saving ---- */
+
+/* Writes one tool (and its wear entry, if any) in LinuxCNC's format. */
+static int tooltable_write_tool(FILE *f, const struct tool_entry *e)
+{
+    fprintf(f, "T%d P%d", e->tool, e->pocket);
+    for (int k = 0; k < 9; k++) {
+        if (!(e->present & (1u << k)))
+            continue;
+        double v = k == 2 ? e->z_offset_mm : e->offset[k];
+        fprintf(f, " %c%+.17g", tooltable_offset_letters[k], v);
+    }
+    fprintf(f, " D%.17g", e->diameter_mm);
+    if (e->present & TOOLTABLE_F_I)
+        fprintf(f, " I%.17g", e->front_angle_deg);
+    if (e->present & TOOLTABLE_F_J)
+        fprintf(f, " J%.17g", e->back_angle_deg);
+    if (e->present & TOOLTABLE_F_Q)
+        fprintf(f, " Q%d", e->orientation);
+    fprintf(f, " ;%s\n", e->comment);
+    if (e->wear_mm != 0.0)
+        fprintf(f, "T%d P0 D%.17g ;wear of T%d\n", e->tool + TOOLTABLE_WEAR_BASE,
+                e->wear_mm, e->tool);
+    return ferror(f) ? -1 : 0;
+}
+
+/* Makes "DIR/.NAME.tmpXXXXXX" next to path, so rename() stays on one file system. */
+static int tooltable_temp_name(const char *path, char *tmp, size_t tmplen)
+{
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path + 1) : 0;
+    int n = snprintf(tmp, tmplen, "%.*s.%s.tmpXXXXXX", dirlen, path, slash ? slash + 1 : path);
+    return n < 0 || (size_t)n >= tmplen ? -1 : 0;
+}
+
+/* Flushes the folder holding path, so the rename itself survives a power cut. */
+static void tooltable_sync_dir(const char *path)
+{
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path) ? (int)(slash - path) : 1, path);
+    int fd = open(dir, O_RDONLY | O_DIRECTORY);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        close(fd);
+    }
+}
+
+/* Writes the table atomically: temporary file in the same folder, fsync, rename. */
+int tooltable_save(const struct tooltable *t, const char *path, char *err, size_t errlen)
+{
+    char tmp[1100];
+    if (tooltable_temp_name(path, tmp, sizeof tmp))
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO, "%s: path too long", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0)
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO,
+                              "%s: cannot create a temporary file next to it: %s", path,
+                              strerror(errno));
+    (void)fchmod(fd, 0644);
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        close(fd);
+        unlink(tmp);
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO, "%s: %s", tmp, strerror(errno));
+    }
+    int bad = 0;
+    for (int i = 0; i < t->count && !bad; i++)
+        bad = tooltable_write_tool(f, &t->tools[i]);
+    bad = bad || fflush(f) != 0 || fsync(fileno(f)) != 0;
+    bad = fclose(f) != 0 || bad;
+    if (bad || rename(tmp, path) != 0) {
+        int e = errno;
+        unlink(tmp);
+        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO,
+                              "%s: cannot write the tool table: %s", path, strerror(e));
+    }
+    tooltable_sync_dir(path);
+    return TOOLTABLE_OK;
+}
