@@ -45,15 +45,16 @@ static inline int hexapod_lu(double a[N][N], int piv[N])
 /* Solves (LU) x = b in place on b, with the row swaps recorded by hexapod_lu. */
 static inline void hexapod_lu_solve(const double a[N][N], const int piv[N], double b[N])
 {
-    for (int c = 0; c < N; c++) {
+    /* hexapod_lu swaps whole rows (multipliers too), so all swaps come first. */
+    for (int c = 0; c < N; c++)
         if (piv[c] != c) {
             double tmp = b[c];
             b[c] = b[piv[c]];
             b[piv[c]] = tmp;
         }
+    for (int c = 0; c < N; c++)
         for (int r = c + 1; r < N; r++)
             b[r] -= a[r][c] * b[c];
-    }
     for (int c = N - 1; c >= 0; c--) {
         double s = b[c];
         for (int j = c + 1; j < N; j++)
