@@ -232,8 +232,8 @@ static int comp5_corner(struct comp5 *c, struct comp5_seg *b, canon_sink_fn sink
 static int comp5_check_block(struct comp5 *c, const struct comp5_block *b)
 {
     if (b->side != 141 && b->side != 142)
-        return comp5_fail(c, COMP5_ERR_SIDE, b->line, "compensation side %d is neither "
-                          "G141 nor G142", b->side);
+        return comp5_fail(c, COMP5_ERR_SIDE, b->line, "line %d: compensation side %d is "
+                          "neither G141 nor G142", b->line, b->side);
     if (!(b->radius_mm >= COMP5_EPS_MM) || !isfinite(b->radius_mm))
         return comp5_fail(c, COMP5_ERR_RADIUS, b->line,
                           "%s at line %d has no usable tool radius (%g mm): give W (the "
