@@ -1,0 +1,465 @@
+/* test_kins.c: hexapod kinematics: hand-worked home, round trips, rates, failures, frames. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kins/kins.h"
+#include "tests/test_kins_util.h"
+
+#define DEG (M_PI / 180.0)
+
+/* Creates a hexapod from a table, failing the test with the model's message. */
+static struct kins *make_kins(struct tk_cfg *c)
+{
+    struct kins_config cfg = tk_config(c);
+    struct kins *k = NULL;
+    char err[512] = "";
+    int st = kins_create(&kins_hexapod_ops, &cfg, &k, err, sizeof err);
+    ck_assert_msg(st == KINS_OK, "create failed: %s (%s)", err, kins_strerror(st));
+    return k;
+}
+
+/* The machine's own configuration file. */
+static struct kins *make_tmu(void)
+{
+    struct tk_cfg *c = tk_ini("configs/sim/tmu-hexapod.ini");
+    ck_assert_msg(c != NULL, "cannot read configs/sim/tmu-hexapod.ini (HEXCNC_ROOT?)");
+    struct kins *k = make_kins(c);
+    free(c);
+    return k;
+}
+
+/* At the level, centred pose every leg spans the same triangle: base joint at radius rb and
+ * angle hb, platform joint at radius rp and angle 60 - hp, height z. Law of cosines:
+ * L^2 = rb^2 + rp^2 - 2 rb rp cos(60 - hb - hp) + z^2. With rb 500, rp 300, hb = hp = 10,
+ * z 645: 250000 + 90000 - 300000 cos 40 deg + 416025. */
+START_TEST(test_home_by_hand)
+{
+    struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 520, 980);
+    struct kins *k = make_kins(c);
+    double expect = sqrt(250000.0 + 90000.0 - 300000.0 * cos(40.0 * DEG) + 645.0 * 645.0);
+    double pose[6] = { 0, 0, 645, 0, 0, 0 }, legs[6];
+    ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(legs[i], expect, 1e-9);
+    /* The same machine given by explicit joint coordinates gives the same legs. */
+    struct tk_cfg *e = tk_hexapod(500, 300, 10, 10, 520, 980);
+    const double bdeg[6] = { 10, 110, 130, 230, 250, 350 }, pdeg[6] = { 50, 70, 170, 190,
+                                                                        290, 310 };
+    for (int i = 0; i < 6; i++) {
+        char key[16], val[96];
+        snprintf(key, sizeof key, "BASE_%d", i);
+        snprintf(val, sizeof val, "%.17g %.17g 0", 500 * cos(bdeg[i] * DEG),
+                 500 * sin(bdeg[i] * DEG));
+        tk_set(e, "KINS", key, val);
+        snprintf(key, sizeof key, "PLATFORM_%d", i);
+        snprintf(val, sizeof val, "%.17g, %.17g, 0", 300 * cos(pdeg[i] * DEG),
+                 300 * sin(pdeg[i] * DEG));
+        tk_set(e, "KINS", key, val);
+    }
+    tk_set(e, "KINS", "BASE_RADIUS", NULL);
+    struct kins *k2 = make_kins(e);
+    double legs2[6];
+    ck_assert_int_eq(kins_inverse(k2, pose, legs2), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(legs2[i], expect, 1e-9);
+    /* A pure lift of 10 mm: every leg grows to sqrt(d^2 + 655^2). */
+    double d2 = expect * expect - 645.0 * 645.0;
+    pose[KINS_Z] = 655;
+    ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(legs[i], sqrt(d2 + 655.0 * 655.0), 1e-9);
+    kins_free(k);
+    kins_free(k2);
+    free(c);
+    free(e);
+}
+END_TEST
+
+/* Largest pose difference: mm for X Y Z, deg for A B C. */
+static void pose_err(const double *a, const double *b, double *pos_mm, double *ang_deg)
+{
+    *pos_mm = 0.0;
+    *ang_deg = 0.0;
+    for (int j = 0; j < 3; j++) {
+        *pos_mm = fmax(*pos_mm, fabs(a[j] - b[j]));
+        *ang_deg = fmax(*ang_deg, fabs(a[j + 3] - b[j + 3]));
+    }
+}
+
+/* 10,000 random poses over the working region: inverse then forward from home (cold) and
+ * from a start 0.05 mm / 0.01 deg away (warm) must give the pose back to 1e-9. */
+START_TEST(test_round_trip)
+{
+    struct kins *k = make_tmu();
+    uint64_t rng = 12345;
+    double worst_pos = 0, worst_ang = 0;
+    int max_cold = 0, max_warm = 0;
+    for (int n = 0; n < 10000; n++) {
+        double pose[6], legs[6], back[6], ep, ea;
+        struct kins_fwd_info info;
+        tk_rand_pose(&rng, pose);
+        ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+        memcpy(back, k->home, sizeof back);
+        ck_assert_int_eq(kins_forward(k, legs, back, &info), KINS_OK);
+        pose_err(pose, back, &ep, &ea);
+        worst_pos = fmax(worst_pos, ep);
+        worst_ang = fmax(worst_ang, ea);
+        max_cold = info.iterations > max_cold ? info.iterations : max_cold;
+        for (int j = 0; j < 6; j++)
+            back[j] = pose[j] + tk_rand(&rng, -1, 1) * (j < 3 ? 0.05 : 0.01);
+        ck_assert_int_eq(kins_forward(k, legs, back, &info), KINS_OK);
+        pose_err(pose, back, &ep, &ea);
+        worst_pos = fmax(worst_pos, ep);
+        worst_ang = fmax(worst_ang, ea);
+        max_warm = info.iterations > max_warm ? info.iterations : max_warm;
+    }
+    ck_assert_msg(worst_pos <= 1e-9, "position error %.3g mm", worst_pos);
+    ck_assert_msg(worst_ang <= 1e-9, "angle error %.3g deg", worst_ang);
+    ck_assert_int_le(max_cold, 20);
+    ck_assert_int_le(max_warm, 3);
+    kins_free(k);
+}
+END_TEST
+
+/* Leg rates through the Jacobian equal a central difference of the inverse. */
+START_TEST(test_leg_rates)
+{
+    struct kins *k = make_tmu();
+    uint64_t rng = 777;
+    for (int n = 0; n < 500; n++) {
+        double pose[6], vel[6], rates[6], lp[6], lm[6], pp[6], pm[6];
+        const double h = 1e-3; /* s */
+        tk_rand_pose(&rng, pose);
+        for (int j = 0; j < 6; j++)
+            vel[j] = tk_rand(&rng, -1, 1) * (j < 3 ? 50.0 : 5.0); /* mm/s, deg/s */
+        ck_assert_int_eq(kins_leg_rates(k, pose, vel, rates), KINS_OK);
+        for (int j = 0; j < 6; j++) {
+            pp[j] = pose[j] + h * vel[j];
+            pm[j] = pose[j] - h * vel[j];
+        }
+        kins_inverse(k, pp, lp);
+        kins_inverse(k, pm, lm);
+        for (int i = 0; i < 6; i++)
+            ck_assert_double_eq_tol(rates[i], (lp[i] - lm[i]) / (2 * h), 1e-5);
+    }
+    kins_free(k);
+}
+END_TEST
+
+/* All platform joints in one point: rotations move no leg, the Jacobian has rank 3. */
+START_TEST(test_singular_geometry)
+{
+    struct tk_cfg *c = tk_hexapod(500, 0, 10, 10, 100, 1500);
+    tk_set(c, "KINS", "HOME", "0 0 600 0 0 0");
+    struct kins *k = make_kins(c);
+    double pose[6] = { 5, 3, 600, 0, 0, 0 }, legs[6], out[6] = { 0, 0, 600, 0, 0, 0 };
+    ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+    struct kins_fwd_info info;
+    ck_assert_int_eq(kins_forward(k, legs, out, &info), KINS_ERR_SINGULAR);
+    ck_assert_double_eq(out[KINS_X], 0.0); /* untouched */
+    ck_assert_double_eq(out[KINS_Z], 600.0);
+    struct kins_check chk;
+    ck_assert_int_eq(kins_check_pose(k, pose, &chk), KINS_OK);
+    ck_assert_int_eq(chk.near_singular, 1);
+    ck_assert_msg(chk.condition > 1e12, "condition %g", chk.condition);
+    kins_free(k);
+    free(c);
+}
+END_TEST
+
+/* A regular platform turned so every leg lies in its plane: the legs cannot stop a twist. */
+START_TEST(test_singular_pose)
+{
+    /* Base and platform of equal size, joints at the same angles: at the level pose every
+     * leg is vertical and none resists a yaw (C) about Z. */
+    struct tk_cfg *c = tk_hexapod(400, 400, 10, 10, 100, 1500);
+    tk_set(c, "KINS", "PLATFORM_HALF_ANGLE", "50"); /* platform joint 60-50 = base joint */
+    tk_set(c, "KINS", "HOME", "0 0 600 0 0 0");
+    struct kins *k = make_kins(c);
+    double pose[6] = { 0, 0, 600, 0, 0, 0 }, legs[6];
+    ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(legs[i], 600.0, 1e-9);
+    struct kins_check chk;
+    ck_assert_int_eq(kins_check_pose(k, pose, &chk), KINS_OK);
+    ck_assert_int_eq(chk.near_singular, 1);
+    double out[6] = { 1, 1, 601, 0.5, 0.5, 0.5 };
+    int st = kins_forward(k, legs, out, NULL);
+    ck_assert_msg(st == KINS_ERR_SINGULAR || st == KINS_ERR_NO_CONVERGE,
+                  "singular pose solved as %s", kins_strerror(st));
+    /* The TMU machine is far from singular across its region. */
+    struct kins *t = make_tmu();
+    double home[6] = { 0, 0, 645, 0, 0, 0 };
+    ck_assert_int_eq(kins_check_pose(t, home, &chk), KINS_OK);
+    ck_assert_int_eq(chk.near_singular, 0);
+    ck_assert_msg(chk.condition < 5.0, "condition %g", chk.condition);
+    kins_free(k);
+    kins_free(t);
+    free(c);
+}
+END_TEST
+
+/* Failures are statuses, never numbers: range, impossibility, iteration limit, NaN. */
+START_TEST(test_failures)
+{
+    struct kins *k = make_tmu();
+    double far[6] = { 600, 0, 645, 0, 0, 0 }, legs[6];
+    ck_assert_int_eq(kins_inverse(k, far, legs), KINS_ERR_UNREACHABLE);
+    ck_assert_msg(legs[1] > k->joint_max[1], "joints still written for the report");
+    double pose[6] = { 1, 2, 3, 4, 5, 6 }, keep[6];
+    memcpy(keep, pose, sizeof keep);
+    double short_legs[6] = { 500, 700, 700, 700, 700, 700 };
+    ck_assert_int_eq(kins_forward(k, short_legs, pose, NULL), KINS_ERR_LEG_RANGE);
+    ck_assert_mem_eq(pose, keep, sizeof keep);
+    double nan_pose[6] = { 0, 0, NAN, 0, 0, 0 };
+    ck_assert_int_eq(kins_inverse(k, nan_pose, legs), KINS_ERR_ARG);
+    kins_free(k);
+
+    /* Legs of 100 mm on a machine whose platform joints are 383 mm apart across a base gap
+     * of 156 mm: two platform joints cannot be that far apart, so no pose exists. */
+    struct tk_cfg *c = tk_hexapod(450, 250, 10, 10, 50, 2000);
+    tk_set(c, "KINS", "HOME", "0 0 600 0 0 0");
+    k = make_kins(c);
+    double tiny[6] = { 100, 100, 100, 100, 100, 100 };
+    double start[6] = { 0, 0, 600, 0, 0, 0 };
+    memcpy(keep, start, sizeof keep);
+    ck_assert_int_eq(kins_forward(k, tiny, start, NULL), KINS_ERR_IMPOSSIBLE);
+    ck_assert_mem_eq(start, keep, sizeof keep);
+    kins_free(k);
+
+    /* One iteration cannot reach 1e-9 mm from 60 mm away: the iteration limit, pose kept. */
+    tk_set(c, "KINS", "FWD_MAX_ITERATIONS", "1");
+    k = make_kins(c);
+    double target[6] = { 40, -30, 640, 3, -2, 5 };
+    ck_assert_int_eq(kins_inverse(k, target, legs), KINS_OK);
+    struct kins_fwd_info info;
+    ck_assert_int_eq(kins_forward(k, legs, start, &info), KINS_ERR_NO_CONVERGE);
+    ck_assert_mem_eq(start, keep, sizeof keep);
+    ck_assert_int_eq(info.iterations, 1);
+    ck_assert_msg(info.residual_mm > 1e-9, "residual %g", info.residual_mm);
+    kins_free(k);
+    free(c);
+}
+END_TEST
+
+/* Creates from a table expecting failure, and returns the message. */
+static const char *create_err(struct tk_cfg *c, char *err, size_t len)
+{
+    struct kins_config cfg = tk_config(c);
+    struct kins *k = NULL;
+    ck_assert_int_eq(kins_create(&kins_hexapod_ops, &cfg, &k, err, len), KINS_ERR_CONFIG);
+    ck_assert_ptr_null(k);
+    return err;
+}
+
+/* Configuration errors name the section and the key. */
+START_TEST(test_config_errors)
+{
+    char err[512];
+    struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 520, 980);
+    tk_set(c, "KINS", "BASE_RADIUS", NULL);
+    ck_assert_str_eq(create_err(c, err, sizeof err), "[KINS] BASE_RADIUS: missing");
+    tk_set(c, "KINS", "BASE_RADIUS", "500");
+    tk_set(c, "JOINT_3", "MAX_LIMIT", "abc");
+    ck_assert_str_eq(create_err(c, err, sizeof err), "[JOINT_3] MAX_LIMIT: 'abc' is not a number");
+    tk_set(c, "JOINT_3", "MAX_LIMIT", "400");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[JOINT_3] MAX_LIMIT: 400 is not above MIN_LIMIT 520");
+    tk_set(c, "JOINT_3", "MAX_LIMIT", "980");
+    tk_set(c, "JOINT_5", "MIN_LIMIT", NULL);
+    ck_assert_str_eq(create_err(c, err, sizeof err), "[JOINT_5] MIN_LIMIT: missing");
+    tk_set(c, "JOINT_5", "MIN_LIMIT", "520");
+    tk_set(c, "KINS", "PLATFORM_HALF_ANGLE", "75");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[KINS] PLATFORM_HALF_ANGLE: 75 is outside 0..59");
+    tk_set(c, "KINS", "PLATFORM_HALF_ANGLE", "10");
+    tk_set(c, "KINS", "BASE_0", "1 2 3");
+    ck_assert_str_eq(create_err(c, err, sizeof err), "[KINS] PLATFORM_0: missing");
+    tk_set(c, "KINS", "BASE_0", "1 2");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] BASE_0: '1 2'"));
+    tk_set(c, "KINS", "BASE_0", NULL);
+    tk_set(c, "KINS", "PLATFORM_CARRIES", "TABLE");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[KINS] PLATFORM_CARRIES: 'TABLE': expected WORKPIECE or SPINDLE");
+    tk_set(c, "KINS", "PLATFORM_CARRIES", "spindle");
+    tk_set(c, "KINS", "FWD_TOLERANCE", "1e-9 mm");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[KINS] FWD_TOLERANCE: '1e-9 mm' is not a number");
+    tk_set(c, "KINS", "FWD_TOLERANCE", NULL);
+    tk_set(c, "KINS", "HOME", "0 0 2000 0 0 0");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] HOME: the home pose "
+                                 "is outside the leg limits"));
+    free(c);
+}
+END_TEST
+
+/* Two machines in one process keep their own geometry. */
+START_TEST(test_two_instances)
+{
+    struct tk_cfg *ca = tk_hexapod(500, 300, 10, 10, 400, 1200);
+    struct tk_cfg *cb = tk_hexapod(400, 200, 15, 5, 400, 1200);
+    struct kins *a = make_kins(ca), *b = make_kins(cb);
+    double pose[6] = { 20, -10, 640, 2, -3, 4 }, la[6], lb[6], la2[6], lb2[6];
+    ck_assert_int_eq(kins_inverse(a, pose, la), KINS_OK);
+    ck_assert_int_eq(kins_inverse(b, pose, lb), KINS_OK);
+    ck_assert_msg(fabs(la[0] - lb[0]) > 1.0, "different machines, different legs");
+    /* Interleaved calls give what each gives alone. */
+    ck_assert_int_eq(kins_inverse(a, pose, la2), KINS_OK);
+    ck_assert_mem_eq(la, la2, sizeof la);
+    double pa[6] = { 0, 0, 640, 0, 0, 0 }, pb[6] = { 0, 0, 640, 0, 0, 0 };
+    ck_assert_int_eq(kins_forward(a, la, pa, NULL), KINS_OK);
+    ck_assert_int_eq(kins_forward(b, lb, pb, NULL), KINS_OK);
+    for (int j = 0; j < 6; j++) {
+        ck_assert_double_eq_tol(pa[j], pose[j], 1e-9);
+        ck_assert_double_eq_tol(pb[j], pose[j], 1e-9);
+    }
+    ck_assert_int_eq(kins_inverse(b, pose, lb2), KINS_OK);
+    ck_assert_mem_eq(lb, lb2, sizeof lb);
+    kins_free(a);
+    kins_free(b);
+    free(ca);
+    free(cb);
+}
+END_TEST
+
+/* Fixed tool over a moving table: the tip stays put in the machine, and a +X move of the
+ * platform moves the cutter -X across the workpiece. */
+START_TEST(test_tool_frames)
+{
+    struct kins *k = make_tmu();
+    double pose[6] = { 0, 0, 630, 0, 0, 0 }, tb[3], tp[3];
+    ck_assert_int_eq(kins_tool_point(k, pose, tb, tp), KINS_OK);
+    /* TOOL_POINT 0 0 780, TOOL_AXIS 0 0 -1, TOOL_LENGTH 60: tip at Z 720. */
+    ck_assert_double_eq_tol(tb[2], 720.0, 1e-12);
+    ck_assert_double_eq_tol(tp[2], 90.0, 1e-12);
+    double tp2[3];
+    pose[KINS_X] = 10;
+    ck_assert_int_eq(kins_tool_point(k, pose, tb, tp2), KINS_OK);
+    ck_assert_double_eq_tol(tp2[0] - tp[0], -10.0, 1e-12);
+    ck_assert_double_eq_tol(tb[0], 0.0, 1e-12);
+    /* Table turned C = 90 deg: the platform's +Y axis points along machine -X... the tip,
+     * 10 mm in machine -X of the platform origin, is at platform +Y 10. */
+    pose[KINS_C] = 90;
+    ck_assert_int_eq(kins_tool_point(k, pose, NULL, tp2), KINS_OK);
+    ck_assert_double_eq_tol(tp2[0], 0.0, 1e-9);
+    ck_assert_double_eq_tol(tp2[1], 10.0, 1e-9);
+    kins_free(k);
+
+    /* Spindle on the platform: the tip rides along, 100 mm below the platform origin. */
+    struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 520, 980);
+    tk_set(c, "KINS", "PLATFORM_CARRIES", "SPINDLE");
+    tk_set(c, "KINS", "TOOL_POINT", "0 0 -40");
+    tk_set(c, "KINS", "TOOL_LENGTH", "60");
+    k = make_kins(c);
+    double p2[6] = { 5, 6, 650, 0, 90, 0 };
+    ck_assert_int_eq(kins_tool_point(k, p2, tb, tp), KINS_OK);
+    ck_assert_double_eq_tol(tp[2], -100.0, 1e-12);
+    /* B = 90: the platform's -Z axis points along machine -X. */
+    ck_assert_double_eq_tol(tb[0], 5.0 - 100.0, 1e-9);
+    ck_assert_double_eq_tol(tb[1], 6.0, 1e-9);
+    ck_assert_double_eq_tol(tb[2], 650.0, 1e-9);
+    kins_free(k);
+    free(c);
+}
+END_TEST
+
+/* Rotation order: R = Rz(C)·Ry(B)·Rx(A), checked on the legs of a one-leg-length change. */
+START_TEST(test_rotation_order)
+{
+    /* With explicit joints, one platform joint at (100, 0, 0) and its base joint straight
+     * below the pose's rotation of it, the leg length is the height exactly. */
+    struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 100, 2000);
+    struct kins *ref = make_kins(c);
+    for (int i = 0; i < 6; i++) {
+        char key[16], val[96];
+        snprintf(key, sizeof key, "BASE_%d", i);
+        snprintf(val, sizeof val, "%.17g %.17g 0", 500 * cos((i * 60 + 5) * DEG),
+                 500 * sin((i * 60 + 5) * DEG));
+        tk_set(c, "KINS", key, val);
+        snprintf(key, sizeof key, "PLATFORM_%d", i);
+        tk_set(c, "KINS", key, i == 0 ? "100 0 0" : "0 100 0");
+    }
+    tk_set(c, "KINS", "HOME", "0 0 700 0 0 0");
+    struct kins *k = make_kins(c);
+    /* A = 90 (about X first) keeps (100,0,0); then B = 90 about Y takes it to (0,0,-100);
+     * C then leaves it there. The other order would give a different point. */
+    double pose[6] = { 0, 0, 700, 90, 90, 30 }, legs[6];
+    ck_assert_int_ne(kins_inverse(k, pose, legs), KINS_ERR_ARG);
+    double b0x = 500 * cos(5 * DEG), b0y = 500 * sin(5 * DEG);
+    ck_assert_double_eq_tol(legs[0], sqrt(b0x * b0x + b0y * b0y + 600.0 * 600.0), 1e-9);
+    kins_free(k);
+    kins_free(ref);
+    free(c);
+}
+END_TEST
+
+/* The identity model, linked in. */
+START_TEST(test_trivial_static)
+{
+    struct tk_cfg *c = calloc(1, sizeof *c);
+    tk_set(c, "KINS", "JOINTS", "9");
+    tk_set(c, "JOINT_2", "MAX_LIMIT", "100");
+    struct kins_config cfg = tk_config(c);
+    struct kins *k = NULL;
+    char err[256];
+    ck_assert_int_eq(kins_create(&kins_trivial_ops, &cfg, &k, err, sizeof err), KINS_OK);
+    ck_assert_int_eq(k->njoints, 9);
+    double pose[6] = { 1, 2, 3, 4, 5, 6 }, j[9], back[6] = { 0 };
+    ck_assert_int_eq(kins_inverse(k, pose, j), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq(j[i], pose[i]);
+    ck_assert_double_eq(j[8], 0.0);
+    ck_assert_int_eq(kins_forward(k, j, back, NULL), KINS_OK);
+    ck_assert_mem_eq(back, pose, sizeof back);
+    pose[2] = 150;
+    ck_assert_int_eq(kins_inverse(k, pose, j), KINS_ERR_UNREACHABLE);
+    ck_assert_int_eq(kins_tool_point(k, pose, NULL, NULL), KINS_ERR_ARG);
+    tk_set(c, "KINS", "JOINTS", "12");
+    ck_assert_int_eq(kins_create(&kins_trivial_ops, &cfg, &k, err, sizeof err),
+                     KINS_ERR_CONFIG);
+    ck_assert_ptr_nonnull(strstr(err, "[KINS] JOINTS: 12"));
+    free(c);
+}
+END_TEST
+
+/* Status texts exist for every status. */
+START_TEST(test_strerror)
+{
+    for (int s = 0; s < KINS_STATUS_COUNT; s++)
+        ck_assert_str_ne(kins_strerror(s), "unknown kinematics status");
+    ck_assert_str_eq(kins_strerror(-5), "unknown kinematics status");
+}
+END_TEST
+
+/* The suite. */
+static Suite *kins_suite(void)
+{
+    Suite *s = suite_create("kins");
+    TCase *tc = tcase_create("hexapod");
+    tcase_add_test(tc, test_home_by_hand);
+    tcase_add_test(tc, test_round_trip);
+    tcase_add_test(tc, test_leg_rates);
+    tcase_add_test(tc, test_singular_geometry);
+    tcase_add_test(tc, test_singular_pose);
+    tcase_add_test(tc, test_failures);
+    tcase_add_test(tc, test_config_errors);
+    tcase_add_test(tc, test_two_instances);
+    tcase_add_test(tc, test_tool_frames);
+    tcase_add_test(tc, test_rotation_order);
+    tcase_add_test(tc, test_trivial_static);
+    tcase_add_test(tc, test_strerror);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(kins_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
