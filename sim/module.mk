@@ -2,3 +2,6 @@
 LIB_SRCS += sim/stepgen_core.c sim/stepgen.c
 HAL_COMPS += stepgen
 TESTS += test_stepgen
+# Simulated Modbus drives (libmodbus servers) and their tests.
+LIB_SRCS += sim/modbus_sim.c sim/modbus_sim_model.c
+TESTS += test_modbus test_modbus_faults
