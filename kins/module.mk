@@ -21,4 +21,4 @@ $(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
 	@mkdir -p $(@D)
 	$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
 
-TESTS += test_kins
+TESTS += test_kins test_kins_plugin
