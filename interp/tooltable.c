@@ -394,27 +394,38 @@ int tooltable_load(struct tooltable *t, const char *path, char *err, size_t errl
 
 /* ---- saving ---- */
 
+/* The shortest of %.15g / %.17g that reads back as exactly v (so a save loses nothing
+ * and -0.04 stays "-0.04"). */
+static const char *tooltable_num(char *buf, size_t len, double v, int plus)
+{
+    snprintf(buf, len, plus ? "%+.15g" : "%.15g", v);
+    if (strtod(buf, NULL) != v)
+        snprintf(buf, len, plus ? "%+.17g" : "%.17g", v);
+    return buf;
+}
+
 /* Writes one tool (and its wear entry, if any) in LinuxCNC's format. */
 static int tooltable_write_tool(FILE *f, const struct tool_entry *e)
 {
+    char n[40];
     fprintf(f, "T%d P%d", e->tool, e->pocket);
     for (int k = 0; k < 9; k++) {
         if (!(e->present & (1u << k)))
             continue;
         double v = k == 2 ? e->z_offset_mm : e->offset[k];
-        fprintf(f, " %c%+.17g", tooltable_offset_letters[k], v);
+        fprintf(f, " %c%s", tooltable_offset_letters[k], tooltable_num(n, sizeof n, v, 1));
     }
-    fprintf(f, " D%.17g", e->diameter_mm);
+    fprintf(f, " D%s", tooltable_num(n, sizeof n, e->diameter_mm, 0));
     if (e->present & TOOLTABLE_F_I)
-        fprintf(f, " I%.17g", e->front_angle_deg);
+        fprintf(f, " I%s", tooltable_num(n, sizeof n, e->front_angle_deg, 0));
     if (e->present & TOOLTABLE_F_J)
-        fprintf(f, " J%.17g", e->back_angle_deg);
+        fprintf(f, " J%s", tooltable_num(n, sizeof n, e->back_angle_deg, 0));
     if (e->present & TOOLTABLE_F_Q)
         fprintf(f, " Q%d", e->orientation);
     fprintf(f, " ;%s\n", e->comment);
     if (e->wear_mm != 0.0)
-        fprintf(f, "T%d P0 D%.17g ;wear of T%d\n", e->tool + TOOLTABLE_WEAR_BASE,
-                e->wear_mm, e->tool);
+        fprintf(f, "T%d P0 D%s ;wear of T%d\n", e->tool + TOOLTABLE_WEAR_BASE,
+                tooltable_num(n, sizeof n, e->wear_mm, 0), e->tool);
     return ferror(f) ? -1 : 0;
 }
 
