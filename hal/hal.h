@@ -161,6 +161,13 @@ int hal_getp(struct hal *h, const char *name, char *buf, size_t len);
 int hal_sets(struct hal *h, const char *signal, const char *value);
 /* `net SIGNAL pin pin ...` (creates the signal if new). */
 int hal_net(struct hal *h, const char *signal, int npins, char **pins);
+/* Additions (after the first contract):
+ * `gets SIGNAL`; `newsig NAME TYPE` (a signal with no pins yet); `unlinkp PIN` (the pin keeps
+ * the signal's last value); `delf FUNCT [THREAD]` (thread may be NULL). */
+int hal_gets(struct hal *h, const char *signal, char *buf, size_t len);
+int hal_newsig(struct hal *h, const char *name, enum hal_type type);
+int hal_unlinkp(struct hal *h, const char *pin);
+int hal_delf(struct hal *h, const char *funct, const char *thread);
 
 /* ---- the HAL command language ---------------------------------------------------------- */
 
@@ -171,5 +178,26 @@ int hal_cmd(struct hal *h, const char *line, const char *file, int lineno, FILE 
 /* Runs a HAL file: `#` comments, `\` continuation; stops at the first error, whose
  * message names the file and line. */
 int hal_source(struct hal *h, const char *path);
+/* Additions: hal_source with show/getp output to `out` (hal_source uses stdout). */
+int hal_source_to(struct hal *h, const char *path, FILE *out);
+/* A file name written in a HAL file (or a loadrt argument) is relative to that file's
+ * folder: resolves `name` against the innermost file being sourced, else leaves it as is. */
+int hal_path_resolve(const struct hal *h, const char *name, char *buf, size_t len);
+/* After each `start` command: on the simulated clock advance run_ns; in real time sleep
+ * run_ns (halcmd --run-ms). 0 (the default) returns at once. */
+void hal_set_start_run(struct hal *h, int64_t run_ns);
+
+/* ---- loadrt argument helpers for components (additions) ------------------------------ */
+
+#define HAL_INST_NAME_MAX 64
+/* VALUE of the KEY=VALUE argument, or NULL. */
+const char *hal_arg(int argc, char **argv, const char *key);
+/* Fails, naming the component and the argument, unless every argument is KEY=VALUE with KEY
+ * in the comma-separated list `known` (e.g. "count,names"). */
+int hal_args_check(struct hal *h, const char *comp, int argc, char **argv, const char *known);
+/* Instance names from count=N (comp.0 .. comp.N-1, default 1) or names=a,b (a, b), at most
+ * max of them. */
+int hal_arg_instances(struct hal *h, const char *comp, int argc, char **argv, int max,
+                      char (*names)[HAL_INST_NAME_MAX], int *count);
 
 #endif

@@ -1,0 +1,129 @@
+/* hal_rt.c: real-time threads: absolute deadlines, SCHED_FIFO and mlockall where allowed. */
+#include <errno.h>
+#include <sched.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include "hal/hal_priv.h"
+
+/* CLOCK_MONOTONIC in ns. */
+static int64_t hal_mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* Nanoseconds since hal_start (simulated or monotonic). */
+int64_t hal_now_ns(const struct hal *h)
+{
+    if (h->running && !h->sim_clock)
+        return hal_mono_ns() - h->start_mono_ns;
+    return h->sim_now_ns;
+}
+
+/* Warns once per runtime that real-time scheduling is not available. */
+static void hal_rt_warn(struct hal *h, const char *what, int err)
+{
+    if (h->rt_warned)
+        return;
+    h->rt_warned = true;
+    fprintf(stderr, "hal: warning: %s not permitted (%s); threads run with normal priority "
+            "and their timing may jitter\n", what, strerror(err));
+}
+
+/* One real-time thread: sleep to the absolute deadline, run, measure, count overruns. */
+static void *hal_rt_main(void *arg)
+{
+    struct hal_thread *t = arg;
+    struct hal *h = t->h;
+    int64_t next_ns = h->start_mono_ns + t->period_ns;
+    while (!__atomic_load_n(&h->stop_flag, __ATOMIC_ACQUIRE)) {
+        struct timespec ts = { .tv_sec = next_ns / 1000000000, .tv_nsec = next_ns % 1000000000 };
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR)
+            ;
+        if (__atomic_load_n(&h->stop_flag, __ATOMIC_ACQUIRE))
+            break;
+        pthread_mutex_lock(&t->lock);
+        int64_t t0 = hal_mono_ns();
+        hal_thread_run(t);
+        int64_t t1 = hal_mono_ns();
+        pthread_mutex_unlock(&t->lock);
+        int64_t run_ns = t1 - t0;
+        *t->time_ns = run_ns > INT32_MAX ? INT32_MAX : (int32_t)run_ns;
+        if (*t->time_ns > *t->tmax_ns)
+            *t->tmax_ns = *t->time_ns;
+        next_ns += t->period_ns;
+        if (t1 > next_ns) {              /* missed deadlines: count them, keep the phase */
+            int64_t missed = (t1 - next_ns) / t->period_ns + 1;
+            *t->overruns += (uint32_t)missed;
+            next_ns += missed * t->period_ns;
+        }
+    }
+    return NULL;
+}
+
+/* FIFO priority: the shorter the period, the higher. */
+static int hal_rt_priority(struct hal *h, struct hal_thread *t)
+{
+    int prio = sched_get_priority_max(SCHED_FIFO) - 1;
+    for (int i = 0; i < h->thread_list.n; i++) {
+        struct hal_thread *o = h->thread_list.v[i];
+        if (o->period_ns < t->period_ns)
+            prio--;
+    }
+    return prio < 1 ? 1 : prio;
+}
+
+/* Starts one thread, SCHED_FIFO if permitted, otherwise normal (with the warning). */
+static int hal_rt_spawn(struct hal *h, struct hal_thread *t)
+{
+    pthread_attr_t attr;
+    struct sched_param sp = { .sched_priority = hal_rt_priority(h, t) };
+    pthread_attr_init(&attr);
+    pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+    pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+    pthread_attr_setschedparam(&attr, &sp);
+    int err = pthread_create(&t->tid, &attr, hal_rt_main, t);
+    pthread_attr_destroy(&attr);
+    if (err == EPERM) {
+        hal_rt_warn(h, "SCHED_FIFO", err);
+        err = pthread_create(&t->tid, NULL, hal_rt_main, t);
+    }
+    if (err)
+        return hal_error(h, HAL_ERR_RT, "start: cannot create thread '%s': %s", t->name,
+                         strerror(err));
+    t->tid_valid = true;
+    return HAL_OK;
+}
+
+/* Starts every thread on a common time origin. */
+int hal_rt_start(struct hal *h)
+{
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+        hal_rt_warn(h, "mlockall", errno);
+    __atomic_store_n(&h->stop_flag, 0, __ATOMIC_RELEASE);
+    h->start_mono_ns = hal_mono_ns();
+    for (int i = 0; i < h->thread_list.n; i++) {
+        int st = hal_rt_spawn(h, h->thread_list.v[i]);
+        if (st != HAL_OK) {
+            hal_rt_stop(h);
+            return st;
+        }
+    }
+    return HAL_OK;
+}
+
+/* Asks every thread to finish its period and joins it. */
+void hal_rt_stop(struct hal *h)
+{
+    __atomic_store_n(&h->stop_flag, 1, __ATOMIC_RELEASE);
+    for (int i = 0; i < h->thread_list.n; i++) {
+        struct hal_thread *t = h->thread_list.v[i];
+        if (t->tid_valid)
+            pthread_join(t->tid, NULL);
+        t->tid_valid = false;
+    }
+    h->sim_now_ns = hal_mono_ns() - h->start_mono_ns;
+}
