@@ -1,7 +1,7 @@
 # sim/: simulated machine parts. The stepgen is a built-in HAL component.
 LIB_SRCS += sim/stepgen_core.c sim/stepgen.c
 HAL_COMPS += stepgen
-TESTS += test_stepgen
+TESTS += test_stepgen test_stepgen_hal
 # Simulated Modbus drives (libmodbus servers) and their tests.
 LIB_SRCS += sim/modbus_sim.c sim/modbus_sim_model.c
 TESTS += test_modbus test_modbus_faults
