@@ -5,3 +5,5 @@ TESTS += test_stepgen test_stepgen_hal
 # Simulated Modbus drives (libmodbus servers) and their tests.
 LIB_SRCS += sim/modbus_sim.c sim/modbus_sim_model.c
 TESTS += test_modbus test_modbus_faults
+# Simulated CiA 402 drives on CANopen.
+LIB_SRCS += sim/cia402_sim.c sim/cia402_sim_od.c
