@@ -22,3 +22,4 @@ $(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
 	$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
 
 TESTS += test_kins test_kins_plugin
+BENCHES += bench_kins
