@@ -169,9 +169,10 @@ static void tooltable_copy_comment(char *dst, size_t dstlen, const char *src)
 static int tooltable_number(const char **s, int want_int, double *v)
 {
     char *end;
+    size_t span = strspn(*s, "+-.0123456789eE"); /* plain decimals only: no hex, inf, nan */
     errno = 0;
     *v = strtod(*s, &end);
-    if (end == *s || errno || !isfinite(*v))
+    if (span == 0 || end != *s + span || errno || !isfinite(*v))
         return -1;
     if (want_int && (*v != floor(*v) || fabs(*v) > 1e9))
         return -1;

@@ -39,7 +39,7 @@ struct tool_entry {
     double z_offset_mm;       /* Z: tool length offset */
     double diameter_mm;       /* D: nominal diameter */
     double wear_mm;           /* diameter wear delta (negative as the tool wears down) */
-    char comment[80];         /* text after ';' */
+    char comment[256];        /* text after ';' (longer comments are cut here) */
     /* The other fields LinuxCNC knows, kept so a load/save round trip loses nothing. */
     double offset[9];         /* X Y Z A B C U V W offsets, mm / deg ([2] unused: Z above) */
     double front_angle_deg;   /* I */

@@ -173,6 +173,8 @@ START_TEST(test_syntax_errors)
     expect_parse_error("T1.5 P1 D10\n", TOOLTABLE_ERR_SYNTAX, 1, "whole");
     expect_parse_error("T1 P1 D10 D12\n", TOOLTABLE_ERR_SYNTAX, 1, "twice");
     expect_parse_error("T1 P1 D10Z0\n", TOOLTABLE_ERR_SYNTAX, 1, "space");
+    expect_parse_error("T1 P1 D0x10\n", TOOLTABLE_ERR_SYNTAX, 1, "field D");
+    expect_parse_error("T1 P1 Dinf\n", TOOLTABLE_ERR_SYNTAX, 1, "field D");
     expect_parse_error("T0 P1 D10\n", TOOLTABLE_ERR_SYNTAX, 1, "T0");
     expect_parse_error("T1 P1 D-10\n", TOOLTABLE_ERR_VALUE, 1, "negative diameter");
     expect_parse_error("T1 D10\nT10001 Z0.1 D-0.1\n", TOOLTABLE_ERR_SYNTAX, 2, "wear entry");
