@@ -1,0 +1,144 @@
+/* motion_config.c: motion configuration defaults, reading it from the INI, status texts. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "motion/motion_priv.h"
+
+/* One text per status, in enum order. */
+static const struct { int code; const char *text; } motion_errors[] = {
+    {MOTION_OK, "ok"},
+    {MOTION_ERR_NOMEM, "out of memory"},
+    {MOTION_ERR_CONFIG, "bad motion configuration"},
+    {MOTION_ERR_ARG, "bad argument"},
+    {MOTION_ERR_STATE, "not allowed in the current motion state"},
+    {MOTION_ERR_PROGRAM, "the program holds a move that cannot be planned"},
+    {MOTION_ERR_UNREACHABLE, "a move leaves the machine's reach"},
+    {MOTION_ERR_KINS, "the kinematics cannot follow a move"},
+    {MOTION_ERR_FERROR, "following error too large"},
+    {MOTION_ERR_ESTOP, "emergency stop"},
+};
+
+/* Text of a motion status. */
+const char *motion_strerror(int status)
+{
+    for (size_t i = 0; i < sizeof motion_errors / sizeof motion_errors[0]; i++)
+        if (motion_errors[i].code == status)
+            return motion_errors[i].text;
+    return "unknown motion status";
+}
+
+/* Name of a motion state, as status displays print it. */
+const char *motion_state_name(enum motion_state s)
+{
+    static const char *const names[MOTION_STATE_COUNT] = {
+        "idle", "running", "pausing", "paused", "stopping", "done", "fault"};
+    return (unsigned)s < MOTION_STATE_COUNT ? names[s] : "unknown";
+}
+
+/* Defaults for every field (see motion.h). */
+void motion_config_default(struct motion_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->servo_period_s = 0.001;
+    c->setpoint_period_s = 0;
+    c->max_lin_vel_mm_s = 100;
+    c->max_lin_acc_mm_s2 = 1000;
+    c->max_ang_vel_deg_s = 30;
+    c->max_ang_acc_deg_s2 = 300;
+    c->default_lin_vel_mm_s = 10;
+    c->kin_tol_mm = 0.001;
+    c->kin_tol_deg = 0.001;
+    c->blend_tol_mm = 0.01;
+    c->optional_stop = 1;
+    c->njoints = 6;
+    for (int i = 0; i < KINS_MAX_JOINTS; i++) {
+        c->joint[i].max_vel_mm_s = 100;
+        c->joint[i].max_acc_mm_s2 = 1000;
+        c->joint[i].ferror_mm = 1;
+        c->joint[i].min_ferror_mm = 0.1;
+    }
+}
+
+/* Reads one number [sec]key into *out (times scale); absent keeps *out. */
+static int read_num(const struct kins_config *cfg, const char *sec, const char *key,
+                    double scale, int allow_zero, double *out, char *err, size_t errlen)
+{
+    const char *v = cfg->get(cfg->ctx, sec, key);
+    if (!v)
+        return MOTION_OK;
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (end == v || *end || errno || !isfinite(d) || d < 0 || (d == 0 && !allow_zero)) {
+        snprintf(err, errlen, "[%s]%s = \"%s\": expected a %s number", sec, key, v,
+                 allow_zero ? "non-negative" : "positive");
+        return MOTION_ERR_CONFIG;
+    }
+    *out = d * scale;
+    return MOTION_OK;
+}
+
+/* Checks the fields a caller filled directly. */
+static int check_config(const struct motion_config *c, char *err, size_t errlen)
+{
+    if (!(c->servo_period_s > 0) || !(c->max_lin_vel_mm_s > 0) || !(c->max_lin_acc_mm_s2 > 0) ||
+        !(c->max_ang_vel_deg_s > 0) || !(c->max_ang_acc_deg_s2 > 0) ||
+        !(c->default_lin_vel_mm_s > 0) || c->setpoint_period_s < 0) {
+        snprintf(err, errlen, "motion configuration: periods, speeds and accelerations must be "
+                 "positive numbers");
+        return MOTION_ERR_CONFIG;
+    }
+    for (int i = 0; i < c->njoints; i++)
+        if (!(c->joint[i].max_vel_mm_s > 0) || !(c->joint[i].max_acc_mm_s2 > 0)) {
+            snprintf(err, errlen, "[JOINT_%d]: MAX_VELOCITY and MAX_ACCELERATION must be positive",
+                     i);
+            return MOTION_ERR_CONFIG;
+        }
+    return MOTION_OK;
+}
+
+/* Reads [EMCMOT], [TRAJ] and [JOINT_n] through cfg (see motion.h). */
+int motion_config_read(struct motion_config *c, const struct kins_config *cfg, int njoints,
+                       char *err, size_t errlen)
+{
+    if (!c || !cfg || !cfg->get || njoints < 1 || njoints > KINS_MAX_JOINTS) {
+        snprintf(err, errlen, "motion configuration: bad arguments");
+        return MOTION_ERR_ARG;
+    }
+    double opt = c->optional_stop;
+    int st = MOTION_OK;
+    c->njoints = njoints;
+    st = st ? st : read_num(cfg, "EMCMOT", "SERVO_PERIOD", 1e-9, 0, &c->servo_period_s, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "SETPOINT_PERIOD", 1e-9, 1, &c->setpoint_period_s, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "MAX_LINEAR_VELOCITY", 1, 0, &c->max_lin_vel_mm_s, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "MAX_LINEAR_ACCELERATION", 1, 0, &c->max_lin_acc_mm_s2, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, &c->max_ang_vel_deg_s, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, &c->max_ang_acc_deg_s2, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, &c->default_lin_vel_mm_s, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "KINEMATIC_TOLERANCE", 1, 1, &c->kin_tol_mm, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, &c->kin_tol_deg, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "BLEND_TOLERANCE", 1, 1, &c->blend_tol_mm, err, errlen);
+    st = st ? st : read_num(cfg, "TRAJ", "OPTIONAL_STOP", 1, 1, &opt, err, errlen);
+    for (int i = 0; i < njoints && !st; i++) {
+        char sec[16];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        struct motion_joint_config *j = &c->joint[i];
+        st = st ? st : read_num(cfg, sec, "MAX_VELOCITY", 1, 0, &j->max_vel_mm_s, err, errlen);
+        st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, &j->max_acc_mm_s2, err, errlen);
+        st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, &j->ferror_mm, err, errlen);
+        st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, &j->min_ferror_mm, err, errlen);
+    }
+    c->optional_stop = opt != 0;
+    return st ? st : check_config(c, err, errlen);
+}
+
+/* The same checks on a caller-filled configuration, for motion_create. */
+int motion_config_check(const struct motion_config *c, char *err, size_t errlen)
+{
+    return check_config(c, err, errlen);
+}

@@ -1,0 +1,341 @@
+/* motion_path.c: turns the canonical program into path segments and evaluates poses on them. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "motion/motion_priv.h"
+
+#define EPS_LEN 1e-9           /* mm or deg: shorter moves are skipped */
+#define SAMPLE_MM 1.0          /* largest knot spacing along the XYZ path, mm */
+#define SAMPLE_DEG 0.5         /* largest change of any of A B C between knots, deg */
+#define SAMPLE_RAD 0.05        /* largest arc angle between knots, rad */
+#define MAX_INTERVALS 4000     /* knots per segment are capped (very long moves) */
+
+
+/* Pose at s on a segment (s may lie slightly outside [0, len]: the geometry extends). */
+void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                     double pose[KINS_POSE_DIM])
+{
+    double u = sg->len > 0 ? s / sg->len : 0.0;
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        pose[i] = sg->start[i] + u * (sg->end[i] - sg->start[i]);
+    if (sg->kind != SEG_ARC)
+        return;
+    const struct motion_arc *a = &p->arcs[sg->arc];
+    double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, h = a->h0_mm + a->dh_mm * u;
+    double c = cos(ang), sn = sin(ang);
+    for (int i = 0; i < 3; i++)
+        pose[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
+}
+
+/* d pose / ds at s, analytic. */
+void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                        double dp[KINS_POSE_DIM])
+{
+    double il = sg->len > 0 ? 1.0 / sg->len : 0.0, u = s * il;
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        dp[i] = (sg->end[i] - sg->start[i]) * il;
+    if (sg->kind != SEG_ARC)
+        return;
+    const struct motion_arc *a = &p->arcs[sg->arc];
+    double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, c = cos(ang), sn = sin(ang);
+    for (int i = 0; i < 3; i++)
+        dp[i] = il * (a->dr_mm * (c * a->e1[i] + sn * a->e2[i])
+                      + r * a->sweep_rad * (-sn * a->e1[i] + c * a->e2[i]) + a->dh_mm * a->n[i]);
+}
+
+/* The file name, copied once per distinct name so the plan owns it. */
+static const char *intern_file(struct motion_plan *p, const char *name)
+{
+    if (!name)
+        return NULL;
+    for (size_t i = p->nfiles; i-- > 0;)
+        if (strcmp(p->files[i], name) == 0)
+            return p->files[i];
+    char **nf = realloc(p->files, (p->nfiles + 1) * sizeof *nf);
+    if (!nf)
+        return NULL;
+    p->files = nf;
+    if (!(nf[p->nfiles] = strdup(name)))
+        return NULL;
+    return nf[p->nfiles++];
+}
+
+/* Room for one more segment and n more knots. */
+static int grow(struct motion_plan *p, size_t nknots)
+{
+    if (p->nseg == p->capseg) {
+        size_t cap = p->capseg ? 2 * p->capseg : 256;
+        struct motion_seg *s = realloc(p->segs, cap * sizeof *s);
+        if (!s)
+            return -1;
+        p->segs = s, p->capseg = cap;
+    }
+    if (p->nknot + nknots > p->capknot) {
+        size_t cap = p->capknot ? 2 * p->capknot : 1024;
+        while (cap < p->nknot + nknots)
+            cap *= 2;
+        double *ks = realloc(p->ks, cap * sizeof *ks);
+        if (ks)
+            p->ks = ks;
+        double *kv = realloc(p->kv, cap * sizeof *kv);
+        if (kv)
+            p->kv = kv;
+        double *kt = realloc(p->kt, cap * sizeof *kt);
+        if (kt)
+            p->kt = kt;
+        double *kr = realloc(p->krho, cap * sizeof *kr);
+        if (kr)
+            p->krho = kr;
+        double *ia = realloc(p->iacc, cap * sizeof *ia);
+        if (ia)
+            p->iacc = ia;
+        double *ir = realloc(p->irho, cap * sizeof *ir);
+        if (ir)
+            p->irho = ir;
+        double *iv = realloc(p->ivp, cap * sizeof *iv);
+        if (iv)
+            p->ivp = iv;
+        if (!ks || !kv || !kt || !kr || !ia || !ir || !iv)
+            return -1;
+        p->capknot = cap;
+    }
+    return 0;
+}
+
+/* Appends a segment with n intervals of equal length (n + 1 knots). */
+static struct motion_seg *add_seg(struct motion_plan *p, const struct canon_cmd *c,
+                                  enum motion_seg_kind kind, size_t n)
+{
+    if (grow(p, n + 1) < 0)
+        return NULL;
+    struct motion_seg *sg = &p->segs[p->nseg++];
+    memset(sg, 0, sizeof *sg);
+    sg->kind = kind;
+    sg->line = c->line;
+    sg->file = intern_file(p, c->file);
+    sg->k0 = p->nknot;
+    sg->nk = n + 1;
+    sg->arc = -1;
+    p->nknot += n + 1;
+    return sg;
+}
+
+/* Intervals for a move: fine enough for the reachability and limit checks. */
+static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
+{
+    double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_rad / SAMPLE_RAD);
+    n = ceil(n);
+    return n < 2 ? 2 : n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
+}
+
+/* Spreads the knots of sg evenly over [0, len]. */
+static void place_knots(struct motion_plan *p, struct motion_seg *sg)
+{
+    size_t n = sg->nk - 1;
+    for (size_t i = 0; i <= n; i++)
+        p->ks[sg->k0 + i] = sg->len * (double)i / (double)n;
+}
+
+/* Largest |change| of A B C between two poses, deg. */
+static double abc_max(const double *a, const double *b)
+{
+    double d = 0;
+    for (int i = 3; i < 6; i++)
+        d = fmax(d, fabs(b[i] - a[i]));
+    return d;
+}
+
+/* A straight move (TRAVERSE or FEED) from `from` to c->end. */
+static int add_line(struct motion_plan *p, const struct canon_cmd *c, const double *from)
+{
+    double dx = c->end[0] - from[0], dy = c->end[1] - from[1], dz = c->end[2] - from[2];
+    double xyz = sqrt(dx * dx + dy * dy + dz * dz);
+    double da = c->end[3] - from[3], db = c->end[4] - from[4], dc = c->end[5] - from[5];
+    double abc = sqrt(da * da + db * db + dc * dc);
+    if (xyz < EPS_LEN && abc < EPS_LEN)
+        return 0;              /* no motion: nothing to plan */
+    struct motion_seg *sg = add_seg(p, c, SEG_LINE, intervals_for(xyz, abc_max(from, c->end), 0));
+    if (!sg)
+        return -1;
+    memcpy(sg->start, from, sizeof sg->start);
+    memcpy(sg->end, c->end, sizeof sg->end);
+    sg->rotary = xyz < EPS_LEN;
+    sg->len = sg->rotary ? abc : xyz;
+    sg->xyz_len_mm = sg->rotary ? 0 : xyz;
+    place_knots(p, sg);
+    return 0;
+}
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Fills arc geometry from the canonical arc; -1 with a message when it is degenerate. */
+static int arc_geometry(const struct canon_cmd *c, const double *from, struct motion_arc *a,
+                        char *err, size_t errlen)
+{
+    double nl = sqrt(dot3(c->arc.normal, c->arc.normal));
+    if (!(nl > 1e-12) || c->arc.rotation == 0) {
+        snprintf(err, errlen, "%s:%d: arc without a plane normal or turn direction",
+                 c->file ? c->file : "program", c->line);
+        return -1;
+    }
+    double rs[3], re[3], us[3], ue[3];
+    for (int i = 0; i < 3; i++) {
+        a->n[i] = c->arc.normal[i] / nl;
+        a->center[i] = c->arc.center[i];
+        rs[i] = from[i] - a->center[i];
+        re[i] = c->end[i] - a->center[i];
+    }
+    a->h0_mm = dot3(rs, a->n);
+    double he = dot3(re, a->n);
+    for (int i = 0; i < 3; i++) {
+        us[i] = rs[i] - a->h0_mm * a->n[i];
+        ue[i] = re[i] - he * a->n[i];
+    }
+    a->r0_mm = sqrt(dot3(us, us));
+    double r1 = sqrt(dot3(ue, ue));
+    if (a->r0_mm < 1e-6 || r1 < 1e-6) {
+        snprintf(err, errlen, "%s:%d: arc of zero radius (start or end on the centre)",
+                 c->file ? c->file : "program", c->line);
+        return -1;
+    }
+    a->dr_mm = r1 - a->r0_mm;
+    a->dh_mm = he - a->h0_mm;
+    for (int i = 0; i < 3; i++)
+        a->e1[i] = us[i] / a->r0_mm;
+    a->e2[0] = a->n[1] * a->e1[2] - a->n[2] * a->e1[1];
+    a->e2[1] = a->n[2] * a->e1[0] - a->n[0] * a->e1[2];
+    a->e2[2] = a->n[0] * a->e1[1] - a->n[1] * a->e1[0];
+    double phi = atan2(dot3(ue, a->e2), dot3(ue, a->e1)); /* (-pi, pi] */
+    int turns = abs(c->arc.rotation) - 1;
+    if (c->arc.rotation > 0)
+        a->sweep_rad = (phi > 1e-12 ? phi : phi + 2 * M_PI) + 2 * M_PI * turns;
+    else
+        a->sweep_rad = (phi < -1e-12 ? phi : phi - 2 * M_PI) - 2 * M_PI * turns;
+    return 0;
+}
+
+/* An arc or helix from `from` to c->end. */
+static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const double *from,
+                   char *err, size_t errlen)
+{
+    struct motion_arc a;
+    if (arc_geometry(c, from, &a, err, errlen) < 0)
+        return -2;
+    if (p->narc == p->caparc) {
+        size_t cap = p->caparc ? 2 * p->caparc : 64;
+        struct motion_arc *na = realloc(p->arcs, cap * sizeof *na);
+        if (!na)
+            return -1;
+        p->arcs = na, p->caparc = cap;
+    }
+    double rm = a.r0_mm + 0.5 * a.dr_mm;
+    double planar = fabs(a.sweep_rad) * rm;
+    double xyz = sqrt(planar * planar + a.dh_mm * a.dh_mm + a.dr_mm * a.dr_mm);
+    struct motion_seg *sg = add_seg(p, c, SEG_ARC,
+                                    intervals_for(xyz, abc_max(from, c->end), fabs(a.sweep_rad)));
+    if (!sg)
+        return -1;
+    p->arcs[p->narc] = a;
+    sg->arc = (int)p->narc++;
+    memcpy(sg->start, from, sizeof sg->start);
+    memcpy(sg->end, c->end, sizeof sg->end);
+    sg->len = xyz;
+    sg->xyz_len_mm = xyz;
+    place_knots(p, sg);
+    return 0;
+}
+
+/* A dwell or a pause: two knots at one point, speed 0. */
+static int add_stop(struct motion_plan *p, const struct canon_cmd *c, const double *at,
+                    enum motion_seg_kind kind, double dwell_s)
+{
+    struct motion_seg *sg = add_seg(p, c, kind, 1);
+    if (!sg)
+        return -1;
+    memcpy(sg->start, at, sizeof sg->start);
+    memcpy(sg->end, at, sizeof sg->end);
+    sg->dwell_s = dwell_s;
+    p->ks[sg->k0] = p->ks[sg->k0 + 1] = 0;
+    return 0;
+}
+
+/* The programmed speed of a move (feed, G93 inverse time, or rapid) and its path mode. */
+static void set_speed(const struct motion *m, struct motion_seg *sg, const struct canon_cmd *c,
+                      double blend_tol_mm)
+{
+    sg->blend_tol_mm = blend_tol_mm;
+    if (c->type == CANON_TRAVERSE || sg->kind == SEG_DWELL || sg->kind == SEG_PAUSE)
+        sg->feed = 0;
+    else if (c->inverse_time_min > 0)
+        sg->feed = sg->len / (c->inverse_time_min * 60.0);
+    else if (c->feed_mm_min > 0)
+        sg->feed = c->feed_mm_min / 60.0;
+    else
+        sg->feed = m->cfg.default_lin_vel_mm_s;
+}
+
+/* Builds the segment list from the program (geometry only; speeds come later). */
+int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err,
+                      size_t errlen)
+{
+    struct motion_plan *p = &m->plan;
+    double at[KINS_POSE_DIM];
+    double blend = 0;          /* G61 exact stop until the program says G64 */
+    memcpy(at, prog->start, sizeof at);
+    for (size_t i = 0; i < prog->count; i++) {
+        const struct canon_cmd *c = &prog->cmds[i];
+        size_t nseg0 = p->nseg;
+        int rc = 0;
+        switch (c->type) {
+        case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
+        case CANON_ARC: rc = add_arc(p, c, at, err, errlen); break;
+        case CANON_DWELL: rc = c->value > 0 ? add_stop(p, c, at, SEG_DWELL, c->value) : 0; break;
+        case CANON_PAUSE:
+            if (c->ivalue == 0 || m->cfg.optional_stop)
+                rc = add_stop(p, c, at, SEG_PAUSE, 0);
+            break;
+        default: break;        /* informational, or read again by the planner */
+        }
+        if (rc == -2)
+            return MOTION_ERR_PROGRAM;
+        if (rc < 0) {
+            snprintf(err, errlen, "out of memory planning the program");
+            return MOTION_ERR_NOMEM;
+        }
+        if (p->nseg > nseg0)
+            set_speed(m, &p->segs[p->nseg - 1], c, blend);
+        if (c->type == CANON_PATH_MODE)
+            blend = c->value > 0 ? c->value : c->value < 0 ? m->cfg.blend_tol_mm : 0;
+        if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
+            memcpy(at, c->end, sizeof at);
+        if (c->type == CANON_PROGRAM_END)
+            break;
+    }
+    double dist = 0;
+    for (size_t i = 0; i < p->nseg; i++) {
+        p->segs[i].dist0_mm = dist;
+        dist += p->segs[i].xyz_len_mm;
+    }
+    p->total_len_mm = dist;
+    return MOTION_OK;
+}
+
+/* Frees everything a plan holds and empties it. */
+void motion_plan_free(struct motion_plan *p)
+{
+    free(p->segs);
+    free(p->arcs);
+    free(p->ks);
+    free(p->kv);
+    free(p->kt);
+    free(p->krho);
+    free(p->iacc);
+    free(p->irho);
+    free(p->ivp);
+    for (size_t i = 0; i < p->nfiles; i++)
+        free(p->files[i]);
+    free(p->files);
+    memset(p, 0, sizeof *p);
+}

@@ -1,0 +1,132 @@
+/* motion_priv.h: the planned program (segments, knots) and the motion instance, inside motion/. */
+#ifndef HEXCNC_MOTION_PRIV_H
+#define HEXCNC_MOTION_PRIV_H
+
+#include <stddef.h>
+
+#include "motion/motion.h"
+
+/* What a segment does. */
+enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE };
+
+/* Arc geometry: position(u) = center + (r0 + dr u)(cos(th u) e1 + sin(th u) e2) + (h0 + dh u) n,
+ * u in [0, 1]: a planar arc, a helix, or (dr != 0) the small spiral of an arc whose end
+ * radius differs from its start radius. */
+struct motion_arc {
+    double center[3];        /* mm */
+    double e1[3], e2[3];     /* unit, in the arc plane; e2 = n x e1 */
+    double n[3];             /* unit normal */
+    double r0_mm, dr_mm;     /* start radius and its change to the end radius, mm */
+    double h0_mm, dh_mm;     /* height along n at the start and its change, mm */
+    double sweep_rad;        /* signed angle turned (> 0: counter-clockwise about n) */
+};
+
+/* One planned segment: a move, a dwell or a pause. The path parameter s runs over [0, len]
+ * (mm along the XYZ path, or deg along the ABC path for rotary-only moves). */
+struct motion_seg {
+    enum motion_seg_kind kind;
+    int rotary;              /* 1: rotary-only move, s and speeds in deg */
+    int line;                /* program line */
+    const char *file;        /* program file (interned by motion) */
+    double start[KINS_POSE_DIM], end[KINS_POSE_DIM]; /* mm, deg */
+    double len;              /* mm (deg when rotary) */
+    double xyz_len_mm;       /* XYZ length, mm (0 for rotary-only, dwell, pause) */
+    double dist0_mm;         /* XYZ distance of the program before this segment, mm */
+    double dwell_s;          /* DWELL: seconds */
+    double feed;             /* programmed speed, mm/s (deg/s when rotary); 0 = rapid */
+    double blend_tol_mm;     /* G64 tolerance in force (blend into the next move), 0 = stop */
+    size_t k0;               /* first knot */
+    size_t nk;               /* knots (>= 2) */
+    int arc;                 /* index into arcs for SEG_ARC, else -1 */
+};
+
+/* The planned program: segments and the velocity profile at knots along them. Interval i
+ * joins knot i and i+1; at segment joints the two knots share the velocity (length 0).
+ * Within an interval the speed goes from kv[i] at iacc[i] up to ivp[i], cruises, and comes
+ * down at iacc[i] to kv[i + 1] (a trapezoid; either ramp may be empty). */
+struct motion_plan {
+    struct motion_seg *segs;
+    size_t nseg, capseg;
+    struct motion_arc *arcs;
+    size_t narc, caparc;
+    double *ks;              /* knot: s within its segment */
+    double *kv;              /* knot: planned path speed at override 1 */
+    double *kt;              /* knot: planned time from program start, s */
+    double *krho;             /* knot: largest feed override allowed from here (>= 1) */
+    double *iacc;            /* interval: path acceleration limit */
+    double *ivp;             /* interval: cruise speed (accelerate, cruise, decelerate) */
+    double *irho;             /* interval: override ceiling from speed and acceleration caps */
+    size_t nknot, capknot;
+    char **files;            /* interned file names */
+    size_t nfiles;
+    double total_time_s;
+    double total_len_mm;
+    struct motion_plan_info info;
+};
+
+/* The motion instance. */
+struct motion {
+    struct motion_config cfg;
+    struct kins *kins;       /* borrowed */
+    int nj;                  /* joints */
+    struct motion_plan plan;
+    int loaded;              /* a program is planned */
+    enum motion_state state;
+    int fault_status;
+    char msg[320];           /* last error / fault text */
+    double start_pose[KINS_POSE_DIM];
+    /* run state */
+    double tau_s;            /* position on the plan's time axis, s */
+    double rate;             /* current time-scaling rate (feed override in effect) */
+    double override_cmd;     /* requested feed override */
+    double elapsed_s;
+    size_t ci;               /* current interval */
+    size_t cs;               /* segment holding knot ci */
+    size_t paused_at_seg;    /* pause segment already honoured (+1), 0 = none */
+    int have_cmd;            /* joint_cmd holds a command */
+    double pose[KINS_POSE_DIM];
+    double pose_vel[KINS_POSE_DIM];
+    double joint_cmd[KINS_MAX_JOINTS];
+    double joint_vel[KINS_MAX_JOINTS];
+    double ferror[KINS_MAX_JOINTS];
+    double path_vel;
+    double dist_mm;          /* XYZ path length covered, mm */
+    int line;
+    const char *file;
+};
+
+/* Durations of the three phases of an interval of length ds: accelerate from v0 to vp,
+ * cruise at vp, decelerate to v1, at acceleration a. */
+static inline void motion_phases(double v0, double v1, double vp, double a, double ds,
+                                 double *ta, double *tc, double *td)
+{
+    double sa = (vp * vp - v0 * v0) / (2 * a), sd = (vp * vp - v1 * v1) / (2 * a);
+    double sc = ds - sa - sd;
+    *ta = (vp - v0) / a;
+    *td = (vp - v1) / a;
+    *tc = sc > 0 && vp > 0 ? sc / vp : 0;
+}
+
+/* Formats the instance's message (motion.c). */
+void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Checks a caller-filled configuration (motion_config.c). */
+int motion_config_check(const struct motion_config *c, char *err, size_t errlen);
+
+/* Path geometry (motion_path.c). */
+void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                     double pose[KINS_POSE_DIM]);
+/* d pose / ds at s (mm or deg per unit of s). */
+void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                        double dp[KINS_POSE_DIM]);
+int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err,
+                      size_t errlen);
+void motion_plan_free(struct motion_plan *p);
+
+/* Planning (motion_plan.c). */
+int motion_plan_profile(struct motion *m, char *err, size_t errlen);
+
+/* 6x6 solve with partial pivoting (motion_plan.c); 0 on success, -1 when singular. */
+int motion_solve6(double a[6][6], double b[6]);
+
+#endif

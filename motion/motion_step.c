@@ -1,0 +1,212 @@
+/* motion_step.c: the servo-period interpolator: follows the planned profile on a scaled clock. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "motion/motion_priv.h"
+
+/*
+ * The plan gives the path position s(tau) for the plan's own clock tau (override 1). Each
+ * period tau advances by rate * dt: rate is the feed override in effect. Pausing or aborting
+ * ramps rate to 0, so the machine slows down ON the planned path. The path acceleration is
+ *     d2s/dt2 = rate^2 * a_plan(tau) + v_plan(tau) * d(rate)/dt,
+ * so the rate may change only as fast as keeps that within the interval's acceleration
+ * limit; above 1 it is also held under the plan's ceiling (speed caps of legs and machine).
+ */
+
+/* Plan position, speed and acceleration at tau within interval ci. */
+static void plan_at(const struct motion_plan *p, size_t ci, double tau, double *s, double *v,
+                    double *a)
+{
+    double d = tau - p->kt[ci], ds = p->ks[ci + 1] - p->ks[ci];
+    double v0 = p->kv[ci], v1 = p->kv[ci + 1], vp = p->ivp[ci], acc = p->iacc[ci];
+    if (!(ds > 0) || !(p->kt[ci + 1] > p->kt[ci])) {
+        *s = p->ks[ci];
+        *v = v0;
+        *a = 0;
+        return;
+    }
+    double ta, tc, td;
+    motion_phases(v0, v1, vp, acc, ds, &ta, &tc, &td);
+    d = d < 0 ? 0 : d > ta + tc + td ? ta + tc + td : d;
+    if (d < ta) {
+        *v = v0 + acc * d, *a = acc;
+        *s = v0 * d + 0.5 * acc * d * d;
+    } else if (d < ta + tc) {
+        *v = vp, *a = 0;
+        *s = (vp * vp - v0 * v0) / (2 * acc) + vp * (d - ta);
+    } else {
+        double e = d - ta - tc;
+        *v = vp - acc * e, *a = -acc;
+        *s = (vp * vp - v0 * v0) / (2 * acc) + vp * tc + vp * e - 0.5 * acc * e * e;
+    }
+    *s = p->ks[ci] + (*s > ds ? ds : *s);
+}
+
+/* The override ceiling at tau in interval ci (>= 1). */
+static double ceiling_at(const struct motion_plan *p, size_t ci, double tau)
+{
+    double dt = p->kt[ci + 1] - p->kt[ci];
+    double f = dt > 0 ? (p->kt[ci + 1] - tau) / dt : 0;
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    double r = p->krho[ci + 1] + (p->krho[ci] - p->krho[ci + 1]) * f;
+    return fmin(r, p->irho[ci]);
+}
+
+/* New rate after dt: toward the target, within the acceleration budget and the ceiling. */
+static double next_rate(const struct motion *m, double target, double vp, double ap,
+                        double ceiling, double dt)
+{
+    double r = m->rate, acc = m->plan.iacc[m->ci];
+    if (target > ceiling)
+        target = ceiling;
+    double lo = 0, hi = 2;
+    if (vp > 1e-9) {
+        lo = r + dt * (-acc - r * r * ap) / vp;
+        hi = r + dt * (acc - r * r * ap) / vp;
+    }
+    double rn = target < lo ? lo : target > hi ? hi : target;
+    if (rn > ceiling)
+        rn = ceiling;
+    if (rn < 0)
+        rn = 0;
+    if (fabs(rn - target) < 1e-9)
+        rn = target;
+    return rn;
+}
+
+/* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
+static int pause_here(struct motion *m)
+{
+    const struct motion_seg *sg = &m->plan.segs[m->cs];
+    if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
+        return 0;
+    m->paused_at_seg = m->cs + 1;
+    m->tau_s = m->plan.kt[m->ci];
+    m->rate = 0;
+    if (m->state == MOTION_RUNNING || m->state == MOTION_PAUSING)
+        m->state = MOTION_PAUSED;
+    return 1;
+}
+
+/* Moves ci and cs forward to the interval holding tau; stops at an unhonoured pause. */
+static void follow_knots(struct motion *m)
+{
+    const struct motion_plan *p = &m->plan;
+    if (pause_here(m))
+        return;
+    while (m->ci + 2 < p->nknot && m->tau_s >= p->kt[m->ci + 1]) {
+        m->ci++;
+        while (m->ci >= p->segs[m->cs].k0 + p->segs[m->cs].nk)
+            m->cs++;
+        if (pause_here(m))
+            return;
+    }
+}
+
+/* Advances the plan clock by one period. */
+static void advance(struct motion *m, double dt)
+{
+    const struct motion_plan *p = &m->plan;
+    const struct motion_seg *sg = &p->segs[m->cs];
+    double s, vp, ap;
+    m->elapsed_s += dt;
+    if (sg->kind == SEG_DWELL && m->ci == sg->k0) {
+        if (m->state == MOTION_RUNNING)
+            m->tau_s += dt;             /* a dwell lasts its time whatever the override */
+        else
+            m->rate = 0;
+    } else {
+        double target = m->state == MOTION_RUNNING ? m->override_cmd : 0;
+        plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+        double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
+        m->tau_s += 0.5 * (m->rate + rn) * dt;
+        m->rate = rn;
+    }
+    follow_knots(m);
+    if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED) {
+        m->tau_s = p->total_time_s;
+        m->state = MOTION_DONE;
+        m->rate = 0;
+    }
+    if (m->rate == 0 && m->state == MOTION_PAUSING)
+        m->state = MOTION_PAUSED;
+    if (m->rate == 0 && m->state == MOTION_STOPPING) {
+        m->state = MOTION_IDLE;
+        m->loaded = 0;
+    }
+}
+
+/* Pose, rates and legs at the current plan time. */
+static int evaluate(struct motion *m)
+{
+    const struct motion_plan *p = &m->plan;
+    const struct motion_seg *sg = &p->segs[m->cs];
+    double s, vp, ap, dp[KINS_POSE_DIM];
+    plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+    if (m->state == MOTION_DONE) {
+        s = sg->len;
+        vp = 0;
+    }
+    double v = vp * m->rate;
+    if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
+        v = 0;
+    motion_seg_pose(p, sg, s, m->pose);
+    motion_seg_tangent(p, sg, s, dp);
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        m->pose_vel[i] = dp[i] * v;
+    m->path_vel = v;
+    m->line = sg->line;
+    m->file = sg->file;
+    m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
+    int st = kins_inverse(m->kins, m->pose, m->joint_cmd);
+    if (st == KINS_OK && v != 0)
+        st = kins_leg_rates(m->kins, m->pose, m->pose_vel, m->joint_vel);
+    else
+        memset(m->joint_vel, 0, sizeof m->joint_vel);
+    return st;
+}
+
+/* One servo period (see motion.h). */
+int motion_step(struct motion *m, double period_s, struct motion_out *out)
+{
+    if (!m || !out || !(period_s > 0))
+        return MOTION_ERR_ARG;
+    int ret = MOTION_OK;
+    int moving = m->state == MOTION_RUNNING || m->state == MOTION_PAUSING ||
+                 m->state == MOTION_STOPPING;
+    if (m->state == MOTION_PAUSED)
+        m->elapsed_s += period_s;
+    if (moving && m->loaded && m->plan.nseg) {
+        advance(m, period_s);
+        int st = evaluate(m);
+        if (st != KINS_OK) {
+            motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
+                     "(%s); machine stopped", m->file ? m->file : "program", m->line,
+                     kins_strerror(st));
+            m->state = MOTION_FAULT;
+            m->fault_status = ret = MOTION_ERR_KINS;
+        }
+    } else {
+        m->path_vel = 0;
+        memset(m->pose_vel, 0, sizeof m->pose_vel);
+        memset(m->joint_vel, 0, sizeof m->joint_vel);
+    }
+    memcpy(out->pose, m->pose, sizeof out->pose);
+    memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
+    memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
+    memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
+    memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
+    out->njoints = m->nj;
+    out->line = m->line;
+    out->file = m->file;
+    out->state = m->state;
+    out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
+    out->path_vel = m->path_vel;
+    out->time_elapsed_s = m->elapsed_s;
+    out->time_remaining_s = m->loaded ? m->plan.total_time_s - m->tau_s : 0;
+    out->distance_done_mm = m->dist_mm;
+    out->distance_total_mm = m->plan.total_len_mm;
+    out->feed_override = m->rate;
+    return ret;
+}

@@ -1,0 +1,344 @@
+/* test_motion.c: planner and interpolator: trapezoids, arcs, dwell, rejection at load, config. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+
+/* Opens the trivial machine or fails the test. */
+static void open_trivial(struct tm_machine *mc)
+{
+    ck_assert_int_eq(tm_open(mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+}
+
+/* Opens the TMU hexapod or fails the test. */
+static void open_hexapod(struct tm_machine *mc)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_msg(c != NULL, "cannot read configs/sim/tmu-hexapod.ini (HEXCNC_ROOT?)");
+    ck_assert_int_eq(tm_open(mc, c, &kins_hexapod_ops), 0);
+}
+
+/* Loads and starts a program, failing the test with motion's message. */
+static void load_start(struct motion *m, struct canon_prog *p)
+{
+    char err[512] = "";
+    int st = motion_load(m, p, err, sizeof err);
+    ck_assert_msg(st == MOTION_OK, "load: %s", err);
+    ck_assert_int_eq(motion_start(m), MOTION_OK);
+}
+
+/* One 100 mm feed move at 50 mm/s, 1000 mm/s^2 on the trivial machine: a trapezoid with
+ * 0.05 s ramps: 2.05 s. The run ends exactly on the end point, in the planned time, and
+ * never exceeds the feed or the acceleration. */
+START_TEST(test_trapezoid_trivial)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double end[6] = {100, 0, 0, 0, 0, 0};
+    tm_add(&p, CANON_FEED, 3, end, 3000, 0);
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    ck_assert_int_eq(motion_plan_info(mc.m, &info), MOTION_OK);
+    ck_assert_msg(fabs(info.time_s - 2.05) < 0.01, "planned %.4f s, ideal 2.05 s", info.time_s);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 10000, &s, NULL, NULL);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[0], 100, 1e-9);
+    ck_assert_double_eq_tol(s.last.joint_pos[0], 100, 1e-9);
+    ck_assert_msg(fabs(s.t_s - info.time_s) <= DT + 1e-9, "ran %.4f s, planned %.4f s", s.t_s,
+                  info.time_s);
+    ck_assert_msg(s.max_v_mm_s <= 50 * (1 + 1e-9), "speed %.6f > 50", s.max_v_mm_s);
+    ck_assert_msg(s.max_v_mm_s > 49.99, "never reached the feed: %.4f", s.max_v_mm_s);
+    ck_assert_msg(s.max_a_mm_s2 <= 1000 * (1 + 1e-6), "acceleration %.3f > 1000", s.max_a_mm_s2);
+    ck_assert_int_eq(s.last.line, 3);
+    ck_assert_double_eq_tol(s.last.distance_done_mm, 100, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* A short move never reaches the feed: a triangle, 2 sqrt(d / a) long. Rapids use the
+ * machine's MAX_LINEAR_VELOCITY. */
+START_TEST(test_triangle_and_rapid)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double a[6] = {0, 2, 0, 0, 0, 0}, b[6] = {0, 2, 300, 0, 0, 0};
+    tm_add(&p, CANON_FEED, 1, a, 6000, 0);           /* 2 mm at up to 100 mm/s */
+    tm_add(&p, CANON_TRAVERSE, 2, b, 0, 0);          /* 300 mm rapid at 100 mm/s */
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    double tri = 2 * sqrt(2 / 1000.0), rapid = 300 / 100.0 + 100 / 1000.0;
+    ck_assert_msg(fabs(info.time_s - (tri + rapid)) < 0.01 * (tri + rapid),
+                  "planned %.4f s, ideal %.4f s", info.time_s, tri + rapid);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 10000, &s, NULL, NULL);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[2], 300, 1e-9);
+    ck_assert(s.max_v_mm_s <= 100 * (1 + 1e-9) && s.max_v_mm_s > 99.9);
+    ck_assert(s.max_a_mm_s2 <= 1000 * (1 + 1e-6));
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* A five-axis move on the TMU hexapod: ends exactly, in the planned time, within the path
+ * feed and acceleration, the leg speeds within [JOINT_n] MAX_VELOCITY. */
+START_TEST(test_trapezoid_hexapod)
+{
+    struct tm_machine mc;
+    open_hexapod(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e[6] = {60, -40, 660, 5, -4, 10};
+    memcpy(p.start, s0, sizeof s0);
+    tm_add(&p, CANON_FEED, 7, e, 1200, 0);
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, NULL, NULL);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(s.last.pose[i], e[i], 1e-9);
+    double legs[6];
+    kins_inverse(mc.kins, e, legs);
+    for (int i = 0; i < 6; i++) {
+        ck_assert_double_eq_tol(s.last.joint_pos[i], legs[i], 1e-9);
+        ck_assert(s.max_leg_v[i] <= mc.mc.joint[i].max_vel_mm_s);
+        ck_assert(s.max_leg_a[i] <= mc.mc.joint[i].max_acc_mm_s2 * (1 + 1e-6));
+    }
+    ck_assert(fabs(s.t_s - info.time_s) <= DT + 1e-9);
+    ck_assert(s.max_v_mm_s <= 20 * (1 + 1e-9));
+    ck_assert(s.max_a_mm_s2 <= mc.mc.max_lin_acc_mm_s2 * (1 + 1e-6));
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Largest distance of the run's XYZ from a circle of radius r about c in the plane normal n,
+ * and largest distance from that plane (for a planar arc). */
+struct arc_check { double c[3], n[3], r, max_rad_err, max_plane_err; };
+static int arc_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct arc_check *a = ctx;
+    double d[3], h = 0, q = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = o->pose[i] - a->c[i], h += d[i] * a->n[i];
+    for (int i = 0; i < 3; i++)
+        q += (d[i] - h * a->n[i]) * (d[i] - h * a->n[i]);
+    a->max_rad_err = fmax(a->max_rad_err, fabs(sqrt(q) - a->r));
+    a->max_plane_err = fmax(a->max_plane_err, fabs(h));
+    return 0;
+}
+
+/* G17 arc: a half circle of radius 20 stays on its radius and ends at its end point, in
+ * about pi r / v; a 3-D arc about a tilted normal (as G141/G142 corners) does too. */
+START_TEST(test_arcs)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double e1[6] = {40, 0, 0, 0, 0, 0}, c1[3] = {20, 0, 0}, n1[3] = {0, 0, 1};
+    tm_arc(&p, 5, e1, c1, n1, -1, 1200);     /* G2 from (0,0) over the top to (40,0) */
+    load_start(mc.m, &p);
+    struct arc_check ac = {{20, 0, 0}, {0, 0, 1}, 20, 0, 0};
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, arc_hook, &ac);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[0], 40, 1e-9);
+    ck_assert_double_eq_tol(s.last.pose[1], 0, 1e-9);
+    ck_assert_msg(ac.max_rad_err < 1e-9 && ac.max_plane_err < 1e-9, "off the arc by %g",
+                  ac.max_rad_err);
+    ck_assert_msg(fabs(s.t_s - M_PI * 20 / 20.0) < 0.1, "half circle took %.3f s", s.t_s);
+    canon_prog_free(&p);
+    /* clockwise about +Z from (0,0): passes y > 0 */
+    canon_prog_init(&p);
+    double nt[3] = {0, sin(0.3), cos(0.3)}, ct[3] = {10, 0, 0}, et[6] = {20, 0, 0, 0, 0, 0};
+    tm_arc(&p, 6, et, ct, nt, 1, 600);       /* a plane-0 arc with a tilted normal */
+    load_start(mc.m, &p);
+    struct arc_check at = {{10, 0, 0}, {0, sin(0.3), cos(0.3)}, 10, 0, 0};
+    tm_run(mc.m, DT, 100000, &s, arc_hook, &at);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[0], 20, 1e-9);
+    ck_assert(at.max_rad_err < 1e-9 && at.max_plane_err < 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Helix: two full turns of radius 5 rising 4 mm: ends on its end point, the height rises in
+ * proportion to the angle, the radius holds. */
+static int helix_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    double *worst = ctx, x = o->pose[0], y = o->pose[1];
+    worst[0] = fmax(worst[0], fabs(sqrt(x * x + y * y) - 5));
+    if (o->pose[2] < worst[1] - 1e-12)
+        worst[2] = 1;                          /* Z went down: not a rising helix */
+    worst[1] = o->pose[2];
+    return 0;
+}
+START_TEST(test_helix)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    p.start[0] = 5;
+    double e[6] = {5, 0, 4, 0, 0, 0}, c[3] = {0, 0, 0}, n[3] = {0, 0, 1};
+    tm_arc(&p, 9, e, c, n, 2, 600);           /* G3 with P2: two turns */
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    double len = sqrt(pow(4 * M_PI * 5, 2) + 16);
+    ck_assert_double_eq_tol(info.length_mm, len, 1e-6);
+    double worst[3] = {0, 0, 0};
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, helix_hook, worst);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[0], 5, 1e-9);
+    ck_assert_double_eq_tol(s.last.pose[2], 4, 1e-9);
+    ck_assert(worst[0] < 1e-9);
+    ck_assert(worst[2] == 0);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* G4 P1.5 between two moves: the machine holds still for 1.5 s, and the plan counts it. */
+static int dwell_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    double *still = ctx;
+    if (o->line == 2 && o->path_vel == 0)
+        *still += DT;
+    return 0;
+}
+START_TEST(test_dwell)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double a[6] = {10, 0, 0, 0, 0, 0}, b[6] = {20, 0, 0, 0, 0, 0};
+    tm_add(&p, CANON_FEED, 1, a, 600, 0);
+    tm_add(&p, CANON_DWELL, 2, NULL, 0, 1.5);
+    tm_add(&p, CANON_FEED, 3, b, 600, 0);
+    tm_add(&p, CANON_PROGRAM_END, 4, NULL, 0, 0);
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    double move = 10 / 10.0 + 10 / 1000.0;   /* each: 1 s cruise + one ramp's worth */
+    ck_assert_double_eq_tol(info.time_s, 2 * move + 1.5, 0.01);
+    double still = 0;
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, dwell_hook, &still);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_msg(fabs(still - 1.5) <= 2 * DT, "held %.4f s at the dwell", still);
+    ck_assert_double_eq_tol(s.last.pose[0], 20, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* A move that leaves the workspace in its middle (both ends reachable) is refused at load,
+ * naming the line, before any motion; so is a line to an unreachable end. At Z 645 the legs
+ * are 725 mm; a full circle in the XZ plane about (10, 0, 795) rises to Z 945, where they
+ * would be over 1000 mm, beyond the 980 mm limit. */
+START_TEST(test_unreachable_mid_move)
+{
+    struct tm_machine mc;
+    open_hexapod(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, a[6] = {10, 0, 645, 0, 0, 0}, L[6];
+    memcpy(p.start, s0, sizeof s0);
+    tm_add(&p, CANON_FEED, 11, a, 600, 0);
+    double c[3] = {10, 0, 795}, n[3] = {0, 1, 0};
+    tm_arc(&p, 12, a, c, n, 1, 600);          /* G18 full circle back to its start */
+    ck_assert_int_eq(kins_inverse(mc.kins, a, L), KINS_OK);
+    char err[512] = "";
+    int st = motion_load(mc.m, &p, err, sizeof err);
+    ck_assert_int_eq(st, MOTION_ERR_UNREACHABLE);
+    ck_assert_msg(strstr(err, "test.ngc:12:") && strstr(err, "beyond its maximum of 980"),
+                  "message: %s", err);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_ERR_STATE);
+    struct motion_out o;
+    motion_step(mc.m, DT, &o);
+    ck_assert_int_eq(o.state, MOTION_IDLE);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(o.pose[i], mc.kins->home[i], 1e-12);   /* never moved */
+    canon_prog_free(&p);
+    canon_prog_init(&p);
+    memcpy(p.start, s0, sizeof s0);
+    double up[6] = {0, 0, 1000, 0, 0, 0};
+    tm_add(&p, CANON_TRAVERSE, 20, a, 0, 0);
+    tm_add(&p, CANON_FEED, 21, up, 600, 0);
+    st = motion_load(mc.m, &p, err, sizeof err);
+    ck_assert_int_eq(st, MOTION_ERR_UNREACHABLE);
+    ck_assert_msg(strstr(err, "test.ngc:21:"), "message: %s", err);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Configuration: keys read, a bad value named with its section and key. */
+START_TEST(test_config)
+{
+    struct tk_cfg *c = tm_trivial_cfg();
+    struct kins_config kc = tk_config(c);
+    struct motion_config mcfg;
+    char err[256] = "";
+    motion_config_default(&mcfg);
+    tk_set(c, "EMCMOT", "SERVO_PERIOD", "250000");
+    tk_set(c, "TRAJ", "SETPOINT_PERIOD", "10000000");
+    tk_set(c, "JOINT_3", "FERROR", "0.5");
+    ck_assert_int_eq(motion_config_read(&mcfg, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(mcfg.servo_period_s, 0.00025, 1e-15);
+    ck_assert_double_eq_tol(mcfg.setpoint_period_s, 0.01, 1e-15);
+    ck_assert_double_eq_tol(mcfg.joint[3].ferror_mm, 0.5, 1e-15);
+    ck_assert_double_eq_tol(mcfg.max_lin_vel_mm_s, 100, 1e-15);
+    ck_assert_double_eq_tol(mcfg.kin_tol_mm, 0.001, 1e-15);
+    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "fast");
+    ck_assert_int_eq(motion_config_read(&mcfg, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_msg(strstr(err, "[TRAJ]MAX_LINEAR_ACCELERATION"), "message: %s", err);
+    ck_assert_str_eq(motion_strerror(MOTION_ERR_FERROR), "following error too large");
+    ck_assert_str_eq(motion_state_name(MOTION_PAUSED), "paused");
+    free(c);
+}
+END_TEST
+
+static Suite *motion_suite(void)
+{
+    Suite *s = suite_create("motion");
+    TCase *tc = tcase_create("plan");
+    tcase_add_test(tc, test_trapezoid_trivial);
+    tcase_add_test(tc, test_triangle_and_rapid);
+    tcase_add_test(tc, test_trapezoid_hexapod);
+    tcase_add_test(tc, test_arcs);
+    tcase_add_test(tc, test_helix);
+    tcase_add_test(tc, test_dwell);
+    tcase_add_test(tc, test_unreachable_mid_move);
+    tcase_add_test(tc, test_config);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(motion_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
