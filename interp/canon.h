@@ -58,6 +58,8 @@ struct canon_cmd {
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */
+    int has_n;             /* the source block had an N word (for printers) */
+    int n_number;          /* its value */
 };
 
 /* Where the interpreter sends commands. Return 0 to continue, non-zero to stop the

@@ -1,4 +1,7 @@
 # interp/: the RS274/NGC interpreter and the canonical command stream.
 LIB_SRCS += interp/canon.c
+LIB_SRCS += interp/interp.c interp/lexer.c interp/number.c interp/expr.c interp/block.c \
+            interp/exec.c interp/arc.c interp/cycles.c interp/offsets.c interp/params.c \
+            interp/printer.c
 LIB_SRCS += interp/comp5.c interp/comp5_join.c interp/tooltable.c
 TESTS += test_comp5 test_comp5_join test_tooltable

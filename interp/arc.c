@@ -1,0 +1,137 @@
+/* arc.c: G2/G3 in G17/G18/G19: centre (I J K) and radius (R) forms, full circles, helices. */
+#include <math.h>
+#include <string.h>
+
+#include "interp/interp_int.h"
+
+#define W(c) (in->blk.col[(c) - 'a'])
+#define V(c) (in->blk.val[(c) - 'a'])
+
+/* LinuxCNC's check that both ends are on one circle: an error when the radii differ by more
+ * than 0.02 mm (0.002 in) and 0.1 %, or by more than 100 times that absolute tolerance. */
+#define ARC_TOL_MM 0.02
+#define ARC_TOL_IN 0.002
+#define ARC_REL_TOL 0.001
+
+/* The two in-plane axes (first, second, as LinuxCNC orders them), the normal axis and the
+ * centre words of a plane. G18's first axis is Z, so that (Z, X, Y) is right-handed. */
+struct plane_axes {
+    int a1, a2, n;
+    char w1, w2, wn;
+};
+
+static struct plane_axes plane_of(int plane)
+{
+    if (plane == 18)
+        return (struct plane_axes){AX_Z, AX_X, AX_Y, 'k', 'i', 'j'};
+    if (plane == 19)
+        return (struct plane_axes){AX_Y, AX_Z, AX_X, 'j', 'k', 'i'};
+    return (struct plane_axes){AX_X, AX_Y, AX_Z, 'i', 'j', 'k'};
+}
+
+/* R form: the centre on the side that gives the short arc (R > 0) or the long one (R < 0). */
+static int centre_from_r(struct interp *in, int ccw, const double s[2], const double e[2],
+                         double c[2])
+{
+    double r = interp_len_mm(in, V('r')), ar = fabs(r);
+    double dx = e[0] - s[0], dy = e[1] - s[1], half = 0.5 * hypot(dx, dy);
+    if (half < 1e-9)
+        return interp_fail(in, INTERP_ERR_ARC, W('r'), "an arc in R form cannot end where it "
+                           "starts: program a full circle with I J K");
+    if (ar < 1e-12 || half / ar > 1.0 + 1e-12)
+        return interp_fail(in, INTERP_ERR_ARC, W('r'), "arc radius R%g is too small to reach "
+                           "the end point (half the distance is %.4f)", V('r'),
+                           in->inch ? half / MM_PER_INCH : half);
+    if (half > ar)
+        half = ar;
+    double off = sqrt(ar * ar - half * half);
+    double th = atan2(dy, dx) + (((ccw && r > 0) || (!ccw && r < 0)) ? M_PI_2 : -M_PI_2);
+    c[0] = 0.5 * (s[0] + e[0]) + off * cos(th);
+    c[1] = 0.5 * (s[1] + e[1]) + off * sin(th);
+    return 0;
+}
+
+/* I J K form: the centre as an offset from the start (G91.1) or absolute (G90.1). */
+static int centre_from_ijk(struct interp *in, const struct plane_axes *p, const double s[2],
+                           double c[2])
+{
+    if (W(p->wn))
+        return interp_fail(in, INTERP_ERR_WORD, W(p->wn), "%c word in a G%d arc: the centre "
+                           "words of this plane are %c and %c", p->wn - 32, in->plane,
+                           p->w1 - 32, p->w2 - 32);
+    if (!W(p->w1) && !W(p->w2))
+        return interp_fail(in, INTERP_ERR_WORD, 0, "arc with neither R nor a centre word (%c, "
+                           "%c) for G%d", p->w1 - 32, p->w2 - 32, in->plane);
+    double o1 = W(p->w1) ? interp_len_mm(in, V(p->w1)) : 0.0;
+    double o2 = W(p->w2) ? interp_len_mm(in, V(p->w2)) : 0.0;
+    if (in->arc_absolute) {
+        double off1 = in->g5x[p->a1] + in->g92[p->a1] + in->tool[p->a1];
+        double off2 = in->g5x[p->a2] + in->g92[p->a2] + in->tool[p->a2];
+        c[0] = o1 + off1;
+        c[1] = o2 + off2;
+    } else {
+        c[0] = s[0] + o1;
+        c[1] = s[1] + o2;
+    }
+    return 0;
+}
+
+/* Both ends must lie on one circle about the centre (LinuxCNC's tolerances). */
+static int check_radii(struct interp *in, const double s[2], const double e[2], const double c[2])
+{
+    double r1 = hypot(s[0] - c[0], s[1] - c[1]), r2 = hypot(e[0] - c[0], e[1] - c[1]);
+    double k = in->inch ? 1.0 / MM_PER_INCH : 1.0, tol = in->inch ? ARC_TOL_IN : ARC_TOL_MM;
+    const char *u = in->inch ? "in" : "mm";
+    if (r1 * k < 1e-9 || r2 * k < 1e-9)
+        return interp_fail(in, INTERP_ERR_ARC, 0, "zero-radius arc: the centre is on the %s "
+                           "point (start radius %.4f %s, end radius %.4f %s)",
+                           r1 * k < 1e-9 ? "start" : "end", r1 * k, u, r2 * k, u);
+    double err = fabs(r1 - r2) * k, rel = err / fmax(r1 * k, r2 * k);
+    if (err > tol * 100.0 || (rel > ARC_REL_TOL && err > tol))
+        return interp_fail(in, INTERP_ERR_ARC, 0, "the end of the arc is not on its circle: "
+                           "radius %.4f %s at the start, %.4f %s at the end (difference %.4f %s; "
+                           "check the centre words and the end point)", r1 * k, u, r2 * k, u,
+                           err, u);
+    return 0;
+}
+
+int interp_arc(struct interp *in, int g)
+{
+    struct plane_axes p = plane_of(in->plane);
+    int ccw = g == 30, turns = 1;
+    double end[6], s[2], e[2], c[2] = {0, 0};
+    interp_target(in, 0, end);
+    s[0] = in->pos[p.a1];
+    s[1] = in->pos[p.a2];
+    e[0] = end[p.a1];
+    e[1] = end[p.a2];
+    if (W('r') && (W('i') || W('j') || W('k')))
+        return interp_fail(in, INTERP_ERR_WORD, W('r'), "arc with both R and I/J/K: use one form "
+                           "or the other");
+    if (W('p')) {
+        CHP(interp_to_int(in, V('p'), W('p'), "P (number of turns)", &turns));
+        if (turns < 1)
+            return interp_fail(in, INTERP_ERR_WORD, W('p'), "P (number of turns) must be 1 or "
+                               "more, not %d", turns);
+    }
+    if (W('r'))
+        CHP(centre_from_r(in, ccw, s, e, c));
+    else
+        CHP(centre_from_ijk(in, &p, s, c));
+    CHP(check_radii(in, s, e, c));
+
+    struct canon_cmd cmd;
+    interp_cmd_init(in, &cmd, CANON_ARC);
+    memcpy(cmd.end, end, sizeof cmd.end);
+    cmd.arc.center[p.a1] = c[0];
+    cmd.arc.center[p.a2] = c[1];
+    cmd.arc.center[p.n] = in->pos[p.n];
+    cmd.arc.normal[p.n] = 1.0;
+    cmd.arc.rotation = ccw ? turns : -turns;
+    cmd.arc.plane = in->plane;
+    cmd.feed_mm_min = in->feed_mm_min;
+    if (in->inverse_time)
+        cmd.inverse_time_min = 1.0 / in->f_word;
+    memcpy(in->pos, end, sizeof in->pos);
+    return interp_emit(in, &cmd);
+}

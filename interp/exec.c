@@ -1,0 +1,337 @@
+/* exec.c: runs one checked block in LinuxCNC's order of execution, emitting canon commands. */
+#include <math.h>
+#include <string.h>
+
+#include "interp/interp_int.h"
+#include "interp/tooltable.h"
+
+#define W(c) (in->blk.col[(c) - 'a'])    /* column of word c, 0 if absent */
+#define V(c) (in->blk.val[(c) - 'a'])    /* value of word c */
+
+void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
+{
+    memset(c, 0, sizeof *c);
+    c->type = t;
+    c->line = in->line;
+    c->file = in->file;
+    c->has_n = in->blk.n_present;
+    c->n_number = in->blk.n_number;
+}
+
+int interp_emit(struct interp *in, struct canon_cmd *c)
+{
+    if (in->sink(in->sink_ctx, c))
+        return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the program");
+    return 0;
+}
+
+/* Emits a command that carries only a value / ivalue. */
+static int emit_simple(struct interp *in, enum canon_type t, double value, int ivalue)
+{
+    struct canon_cmd c;
+    interp_cmd_init(in, &c, t);
+    c.value = value;
+    c.ivalue = ivalue;
+    c.feed_mm_min = in->feed_mm_min;
+    return interp_emit(in, &c);
+}
+
+double interp_len_mm(const struct interp *in, double v)
+{
+    return in->inch ? v * MM_PER_INCH : v;
+}
+
+void interp_prog_pos(const struct interp *in, double prog[6])
+{
+    for (int i = 0; i < 6; i++) {
+        prog[i] = in->pos[i] - in->g5x[i] - in->g92[i] - in->tool[i];
+        if (i < 3 && in->inch)
+            prog[i] /= MM_PER_INCH;
+    }
+}
+
+void interp_target(struct interp *in, int machine, double t[6])
+{
+    static const char ax[6] = {'x', 'y', 'z', 'a', 'b', 'c'};
+    for (int i = 0; i < 6; i++) {
+        if (!W(ax[i])) {
+            t[i] = in->pos[i];
+            continue;
+        }
+        double v = i < 3 ? interp_len_mm(in, V(ax[i])) : V(ax[i]);
+        if (machine)
+            t[i] = v;
+        else if (in->incremental)
+            t[i] = in->pos[i] + v;
+        else
+            t[i] = v + in->g5x[i] + in->g92[i] + in->tool[i];
+    }
+}
+
+int interp_straight(struct interp *in, enum canon_type t, const double end[6])
+{
+    struct canon_cmd c;
+    interp_cmd_init(in, &c, t);
+    memcpy(c.end, end, sizeof c.end);
+    c.feed_mm_min = in->feed_mm_min;
+    if (t != CANON_TRAVERSE && in->inverse_time)
+        c.inverse_time_min = 1.0 / in->f_word;
+    memcpy(in->pos, end, sizeof in->pos);
+    return interp_emit(in, &c);
+}
+
+/* Feed moves need a feed: a non-zero F in force, or F in this very block under G93. */
+int interp_need_feed(struct interp *in, const char *what)
+{
+    if (in->inverse_time && !W('f'))
+        return interp_fail(in, INTERP_ERR_WORD, 0, "%s in inverse time mode (G93) needs an F "
+                           "word in the same block", what);
+    if (in->f_word <= 0.0)
+        return interp_fail(in, INTERP_ERR_WORD, 0, "%s with zero feed rate: give an F word "
+                           "first", what);
+    return 0;
+}
+
+/* F, S, T, M6, M3/M4/M5, M7/M8/M9 and G4: the first steps of LinuxCNC's order. */
+static int exec_machine_words(struct interp *in)
+{
+    struct interp_block *b = &in->blk;
+    if (b->g[5] >= 0) {
+        in->inverse_time = b->g[5] == 930;
+        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+    }
+    if (W('f')) {
+        if (V('f') < 0)
+            return interp_fail(in, INTERP_ERR_WORD, W('f'), "negative F word (feed) %g", V('f'));
+        in->f_word = V('f');
+        in->feed_mm_min = in->inch ? V('f') * MM_PER_INCH : V('f') * in->feed_factor;
+        if (!in->inverse_time)
+            CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+    }
+    if (W('s')) {
+        if (V('s') < 0)
+            return interp_fail(in, INTERP_ERR_WORD, W('s'), "negative S word (spindle speed) %g",
+                               V('s'));
+        in->spindle_rpm = V('s');
+        CHP(emit_simple(in, CANON_SPINDLE_SPEED, in->spindle_rpm, 0));
+    }
+    if (W('t')) {
+        int t;
+        CHP(interp_to_int(in, V('t'), W('t'), "T (tool number)", &t));
+        if (t < 0 || (t > 0 && in->tt && !tooltable_find(in->tt, t)))
+            return interp_fail(in, INTERP_ERR_TOOL, W('t'), "tool T%d is not in the tool table%s%s",
+                               t, in->tt && in->tt->path[0] ? " " : "",
+                               in->tt ? in->tt->path : "");
+        in->selected_tool = t;
+    }
+    if (b->m[6] == 6) {
+        in->current_tool = in->selected_tool;
+        CHP(emit_simple(in, CANON_TOOL_CHANGE, 0, in->current_tool));
+    }
+    if (b->m[7] == 3 || b->m[7] == 4) {
+        in->spindle_dir = b->m[7] == 3 ? 1 : -1;
+        CHP(emit_simple(in, CANON_SPINDLE_ON, in->spindle_dir, 0));
+    } else if (b->m[7] == 5) {
+        in->spindle_dir = 0;
+        CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
+    }
+    if (b->m[8] >= 0)
+        CHP(emit_simple(in, CANON_COOLANT, 0, b->m[8]));
+    if (b->g[0] == 40) {
+        if (!W('p') || V('p') < 0)
+            return interp_fail(in, INTERP_ERR_WORD, b->gcol[0], "G4 needs a P word: the dwell "
+                               "time in seconds (0 or more)");
+        CHP(emit_simple(in, CANON_DWELL, V('p'), 0));
+    }
+    return 0;
+}
+
+/* Plane, units, G40, tool length, coordinate system, path mode, distance, retract. */
+static int exec_modes(struct interp *in)
+{
+    struct interp_block *b = &in->blk;
+    if (b->g[2] >= 0)
+        in->plane = b->g[2] / 10;
+    if (b->g[6] >= 0)
+        in->inch = b->g[6] == 200;
+    if (b->g[8] >= 0)
+        CHP(interp_tool_length(in, b->g[8]));
+    if (b->g[12] >= 0) {
+        int c = b->g[12], sys = c < 591 ? (c - 540) / 10 + 1 : c - 591 + 7;
+        interp_select_coord(in, sys);
+        CHP(interp_emit_offsets(in));
+    }
+    if (b->g[13] >= 0) {
+        in->path_mode = b->g[13];
+        in->path_tol_mm = b->g[13] == 640 && W('p') ? interp_len_mm(in, V('p')) : 0.0;
+        if (in->path_tol_mm < 0)
+            return interp_fail(in, INTERP_ERR_WORD, W('p'), "G64 P (blend tolerance) must not "
+                               "be negative");
+        CHP(emit_simple(in, CANON_PATH_MODE, b->g[13] == 640 ? in->path_tol_mm : 0.0,
+                        b->g[13]));
+    }
+    if (b->g[3] >= 0)
+        in->incremental = b->g[3] == 910;
+    if (b->g[4] >= 0)
+        in->arc_absolute = b->g[4] == 901;
+    if (b->g[10] >= 0)
+        in->retract_old_z = b->g[10] == 980;
+    return 0;
+}
+
+/* G141/G142: the programmed point, resolved as for G1, handed to the compensation. */
+static int exec_comp5(struct interp *in, int g)
+{
+    struct comp5_block cb;
+    memset(&cb, 0, sizeof cb);
+    if (W('w') && W('d'))
+        return interp_fail(in, INTERP_ERR_WORD, W('d'), "G%d with both W and D: give the tool "
+                           "radius (W) or the tool whose radius to use (D), not both", g / 10);
+    if (W('w')) {
+        in->comp_radius_mm = interp_len_mm(in, V('w'));
+    } else if (W('d')) {
+        int t, rc;
+        CHP(interp_to_int(in, V('d'), W('d'), "D (tool number)", &t));
+        if (!in->tt)
+            return interp_fail(in, INTERP_ERR_TOOL, W('d'), "D%d needs a tool table (give one "
+                               "with -t or [EMCIO] TOOL_TABLE)", t);
+        rc = tooltable_radius(in->tt, t, &in->comp_radius_mm);
+        if (rc)
+            return interp_fail(in, INTERP_ERR_TOOL, W('d'), "D%d: %s", t, tooltable_strerror(rc));
+    }
+    CHP(interp_need_feed(in, g == 1410 ? "G141" : "G142"));
+    cb.side = g / 10;
+    interp_target(in, 0, cb.point);
+    cb.radius_mm = in->comp_radius_mm;
+    cb.feed_mm_min = in->feed_mm_min;
+    cb.line = in->line;
+    cb.file = in->file;
+    int rc = comp5_block(&in->comp, &cb, in->pos, in->sink, in->sink_ctx);
+    if (rc) {
+        int col = rc == COMP5_ERR_RADIUS ? (W('w') ? W('w') : W('d')) : 0;
+        interp_fail(in, INTERP_ERR_COMP5, col, "%s", comp5_errmsg(&in->comp));
+        in->err.line = in->comp.err_line ? in->comp.err_line : in->line;
+        return INTERP_ERR_COMP5;
+    }
+    memcpy(in->pos, cb.point, sizeof in->pos);
+    return 0;
+}
+
+/* Ends an open G141/G142 run; the tool is then where the compensation left it. */
+static int flush_comp5(struct interp *in)
+{
+    if (!in->comp.active)
+        return 0;
+    int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
+    in->comp_radius_mm = 0;
+    if (rc) {
+        interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_errmsg(&in->comp));
+        in->err.line = in->comp.err_line ? in->comp.err_line : in->line;
+        return INTERP_ERR_COMP5;
+    }
+    memcpy(in->pos, comp5_tool_pos(&in->comp), sizeof in->pos);
+    return 0;
+}
+
+/* The motion of the block: G0 G1 G2 G3, canned cycles, G53 moves. */
+static int exec_motion(struct interp *in)
+{
+    struct interp_block *b = &in->blk;
+    int g0 = b->g[0];
+    if (b->g[1] >= 0) {
+        in->motion = b->g[1] == 800 ? -1 : b->g[1];
+        if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
+            in->cycle_mode = 0;
+    }
+    if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || b->g[8] == 431)
+        return 0; /* those blocks' axis words are not motion */
+    int m = in->motion;
+    int axis = W('x') || W('y') || W('z') || W('a') || W('b') || W('c');
+    double t[6];
+    if (m == 0 || m == 10) {
+        if (!axis)
+            return 0;
+        if (m == 10)
+            CHP(interp_need_feed(in, "G1"));
+        interp_target(in, g0 == 530, t);
+        return interp_straight(in, m == 0 ? CANON_TRAVERSE : CANON_FEED, t);
+    }
+    if (m == 20 || m == 30) {
+        if (!axis && !W('i') && !W('j') && !W('k') && !W('r'))
+            return 0;
+        CHP(interp_need_feed(in, m == 20 ? "G2" : "G3"));
+        return interp_arc(in, m);
+    }
+    if (m >= 0 && axis)
+        return interp_cycle(in, m);
+    return 0;
+}
+
+/* M2/M30: LinuxCNC's end-of-program resets, then the end itself. M0/M1 pause. */
+static int exec_stop(struct interp *in)
+{
+    int m = in->blk.m[4];
+    if (m == 0 || m == 1)
+        return emit_simple(in, CANON_PAUSE, 0, m);
+    if (m != 2 && m != 30)
+        return 0;
+    if (in->coord_system != 1) {
+        interp_select_coord(in, 1);
+        CHP(interp_emit_offsets(in));
+    }
+    in->plane = 17;
+    in->incremental = 0;
+    in->inverse_time = 0;
+    in->motion = 10;
+    in->spindle_dir = 0;
+    CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
+    CHP(emit_simple(in, CANON_COOLANT, 0, 9));
+    in->ended = 1;
+    return emit_simple(in, CANON_PROGRAM_END, 0, m);
+}
+
+/* Whether the block holds anything but a comment (an empty block keeps a G141/G142 run open). */
+static int block_empty(const struct interp_block *b)
+{
+    for (int i = 0; i < 26; i++)
+        if (b->col[i])
+            return 0;
+    for (int i = 0; i < INTERP_GROUPS; i++)
+        if (b->g[i] >= 0)
+            return 0;
+    for (int i = 0; i < INTERP_MGROUPS; i++)
+        if (b->m[i] >= 0)
+            return 0;
+    return b->nassign == 0;
+}
+
+int interp_execute(struct interp *in)
+{
+    struct interp_block *b = &in->blk;
+    CHP(interp_check_block(in));
+    for (int i = 0; i < b->nassign; i++)
+        in->params[b->assign_idx[i]] = b->assign_val[i];
+    int g0 = b->g[0];
+    int comp = g0 == 1410 || g0 == 1420;
+    if (!comp && !block_empty(b))
+        CHP(flush_comp5(in));
+    if (b->has_comment) {
+        struct canon_cmd c;
+        interp_cmd_init(in, &c, CANON_COMMENT);
+        c.text = b->comment;
+        CHP(interp_emit(in, &c));
+    }
+    CHP(exec_machine_words(in));
+    CHP(exec_modes(in));
+    if (g0 == 100)
+        CHP(interp_g10(in));
+    else if (g0 == 280 || g0 == 281 || g0 == 300 || g0 == 301)
+        CHP(interp_home(in, g0));
+    else if (g0 >= 920 && g0 <= 923)
+        CHP(interp_g92(in, g0));
+    if (comp)
+        CHP(exec_comp5(in, g0));
+    else
+        CHP(exec_motion(in));
+    return exec_stop(in);
+}

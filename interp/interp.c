@@ -1,0 +1,264 @@
+/* interp.c: the interpreter's public face: lifecycle, configuration, the line loop, errors. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interp/interp_int.h"
+#include "interp/tooltable.h"
+
+static const char *const status_text[INTERP_STATUS_COUNT] = {
+    [INTERP_OK] = "no error",
+    [INTERP_ERR_IO] = "file cannot be read or written",
+    [INTERP_ERR_NOMEM] = "out of memory",
+    [INTERP_ERR_SYNTAX] = "syntax error",
+    [INTERP_ERR_EXPR] = "expression cannot be evaluated",
+    [INTERP_ERR_PARAM] = "bad parameter",
+    [INTERP_ERR_MODAL] = "modal group conflict",
+    [INTERP_ERR_WORD] = "word missing, repeated or out of range",
+    [INTERP_ERR_UNSUPPORTED] = "not supported",
+    [INTERP_ERR_ARC] = "impossible arc",
+    [INTERP_ERR_CYCLE] = "bad canned cycle",
+    [INTERP_ERR_TOOL] = "tool error",
+    [INTERP_ERR_COMP5] = "G141/G142 compensation error",
+    [INTERP_ERR_SINK] = "stopped by the command consumer",
+};
+
+const char *interp_strerror(int status)
+{
+    if (status < 0 || status >= INTERP_STATUS_COUNT)
+        return "unknown interpreter status";
+    return status_text[status];
+}
+
+int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
+{
+    if (in->err.status)
+        return in->err.status;
+    in->err.status = status;
+    snprintf(in->err.file, sizeof in->err.file, "%s", in->file);
+    in->err.line = in->line;
+    in->err.column = column;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(in->err.message, sizeof in->err.message, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+char *interp_error_format(const struct interp_error *e, char *buf, size_t len)
+{
+    if (e->line > 0 && e->column > 0)
+        snprintf(buf, len, "%s:%d:%d: error: %s", e->file, e->line, e->column, e->message);
+    else if (e->line > 0)
+        snprintf(buf, len, "%s:%d: error: %s", e->file, e->line, e->message);
+    else
+        snprintf(buf, len, "%s: error: %s", e->file[0] ? e->file : "interp", e->message);
+    return buf;
+}
+
+/* The modal state a fresh interpreter (and LinuxCNC at start-up) has. */
+static void modal_defaults(struct interp *in)
+{
+    in->motion = 0;
+    in->plane = 17;
+    in->inch = 0;
+    in->incremental = 0;
+    in->arc_absolute = 0;
+    in->inverse_time = 0;
+    in->retract_old_z = 0;
+    in->path_mode = 640;
+    in->path_tol_mm = 0;
+    interp_select_coord(in, 1);
+}
+
+struct interp *interp_create(void)
+{
+    struct interp *in = calloc(1, sizeof *in);
+    if (!in)
+        return NULL;
+    in->feed_factor = 1.0;
+    modal_defaults(in);
+    comp5_init(&in->comp);
+    return in;
+}
+
+void interp_destroy(struct interp *in)
+{
+    if (!in)
+        return;
+    free(in->param_path);
+    free(in);
+}
+
+void interp_set_start(struct interp *in, const double pose[6])
+{
+    memcpy(in->start, pose, sizeof in->start);
+    memcpy(in->pos, pose, sizeof in->pos);
+}
+
+int interp_set_param_file(struct interp *in, const char *path)
+{
+    free(in->param_path);
+    in->param_path = NULL;
+    memset(&in->err, 0, sizeof in->err);
+    if (!path)
+        return 0;
+    in->param_path = strdup(path);
+    if (!in->param_path)
+        return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory");
+    snprintf(in->file, sizeof in->file, "%s", path);
+    in->line = 0;
+    CHP(interp_params_load(in, path));
+    /* The offsets come back as LinuxCNC restores them: the saved system, G92 if it was on. */
+    int sys = (int)in->params[PARAM_COORD];
+    interp_select_coord(in, sys >= 1 && sys <= 9 ? sys : 1);
+    for (int i = 0; i < 6; i++)
+        in->g92[i] = in->params[PARAM_G92_ON] != 0.0 ? in->params[PARAM_G92 + i] : 0.0;
+    return 0;
+}
+
+void interp_set_tooltable(struct interp *in, struct tooltable *tt)
+{
+    in->tt = tt;
+}
+
+void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit)
+{
+    in->feed_factor = mm_min_per_f_unit;
+}
+
+void interp_set_block_delete(struct interp *in, int on)
+{
+    in->block_delete = on != 0;
+}
+
+int interp_feed_units_parse(const char *name, double *factor)
+{
+    if (strcmp(name, "mm/min") == 0)
+        *factor = 1.0;
+    else if (strcmp(name, "m/min") == 0)
+        *factor = 1000.0;
+    else
+        return -1;
+    return 0;
+}
+
+const struct interp_error *interp_last_error(const struct interp *in)
+{
+    return &in->err;
+}
+
+void interp_get_view(const struct interp *in, struct interp_view *v)
+{
+    v->inch = in->inch;
+    v->plane = in->plane;
+    v->coord_system = in->coord_system;
+    memcpy(v->g5x_mm, in->g5x, sizeof v->g5x_mm);
+    memcpy(v->g92_mm, in->g92, sizeof v->g92_mm);
+    memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
+    v->feed_factor = in->feed_factor;
+    v->current_tool = in->current_tool;
+}
+
+double interp_param(const struct interp *in, int n)
+{
+    return n >= 1 && n < INTERP_NPARAMS ? in->params[n] : 0.0;
+}
+
+/* Handles a lone '%': the first one opens the program, the next one ends it. */
+static int percent_line(struct interp *in, int first)
+{
+    if (first) {
+        in->pct_open = 1;
+        return 0;
+    }
+    in->ended = 1;
+    int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
+    if (rc)
+        return interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_strerror(rc));
+    return 0;
+}
+
+/* Reads and runs every line until the end of the text or of the program. */
+static int run_lines(struct interp *in, const char *text, size_t len)
+{
+    const char *p = text, *end = text + len;
+    int first = 1;
+    while (p < end && !in->ended) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        size_t l = nl ? (size_t)(nl - p) : (size_t)(end - p);
+        in->line++;
+        in->depth = 0;
+        int kind;
+        CHP(interp_read_line(in, p, l, &kind));
+        if (kind == 2)
+            CHP(percent_line(in, first));
+        else if (kind == 1)
+            CHP(interp_execute(in));
+        if (kind == 2 || in->norm[0] || in->blk.has_comment)
+            first = 0;
+        p = nl ? nl + 1 : end;
+    }
+    if (!in->ended && !in->pct_open)
+        return interp_fail(in, INTERP_ERR_SYNTAX, 0, "the program ends without M2, M30 or a "
+                           "closing %% line");
+    if (!in->ended) { /* opened with % and never closed: LinuxCNC accepts it */
+        int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
+        if (rc)
+            return interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_strerror(rc));
+    }
+    return 0;
+}
+
+int interp_run_text(struct interp *in, const char *file_name, const char *text, size_t len,
+                    canon_sink_fn sink, void *ctx)
+{
+    memset(&in->err, 0, sizeof in->err);
+    snprintf(in->file, sizeof in->file, "%s", file_name);
+    in->line = 0;
+    in->ended = 0;
+    in->pct_open = 0;
+    in->sink = sink;
+    in->sink_ctx = ctx;
+    comp5_init(&in->comp);
+    int rc = run_lines(in, text, len);
+    int save = interp_params_save(in);
+    return rc ? rc : save;
+}
+
+int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, void *ctx)
+{
+    memset(&in->err, 0, sizeof in->err);
+    snprintf(in->file, sizeof in->file, "%s", path);
+    in->line = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return interp_fail(in, INTERP_ERR_IO, 0, "cannot open the program: %s", strerror(errno));
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    int rc = 0;
+    while (buf) {
+        size_t n = fread(buf + len, 1, cap - len, f);
+        len += n;
+        if (len < cap)
+            break;
+        char *nb = realloc(buf, cap * 2);
+        if (!nb) {
+            free(buf);
+            buf = NULL;
+            break;
+        }
+        buf = nb;
+        cap *= 2;
+    }
+    if (!buf)
+        rc = interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory reading the program");
+    else if (ferror(f))
+        rc = interp_fail(in, INTERP_ERR_IO, 0, "cannot read the program: %s", strerror(errno));
+    fclose(f);
+    if (!rc)
+        rc = interp_run_text(in, path, buf, len, sink, ctx);
+    free(buf);
+    return rc;
+}

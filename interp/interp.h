@@ -1,0 +1,92 @@
+/* interp.h: the RS274/NGC interpreter (LinuxCNC dialect): G-code text in, canonical commands out. */
+#ifndef HEXCNC_INTERP_H
+#define HEXCNC_INTERP_H
+
+#include <stddef.h>
+
+#include "interp/canon.h"
+
+struct tooltable;
+struct interp;
+
+/* What went wrong. 0 = OK; every other value comes with a message in struct interp_error. */
+enum interp_status {
+    INTERP_OK = 0,
+    INTERP_ERR_IO,            /* the program, parameter or tool file cannot be read/written */
+    INTERP_ERR_NOMEM,         /* out of memory */
+    INTERP_ERR_SYNTAX,        /* a word, number or expression that does not parse */
+    INTERP_ERR_EXPR,          /* an expression that cannot be evaluated (domain, /0) */
+    INTERP_ERR_PARAM,         /* a bad parameter number or parameter file */
+    INTERP_ERR_MODAL,         /* two codes of one modal group, or a code that needs another */
+    INTERP_ERR_WORD,          /* a word missing, repeated, out of range or not allowed here */
+    INTERP_ERR_UNSUPPORTED,   /* a valid RS274/NGC construct this interpreter does not run */
+    INTERP_ERR_ARC,           /* an arc that cannot be made (radius mismatch, zero radius) */
+    INTERP_ERR_CYCLE,         /* a canned cycle with inconsistent R/Z/Q/P */
+    INTERP_ERR_TOOL,          /* a tool number not in the tool table, or a tool table error */
+    INTERP_ERR_COMP5,         /* G141/G142 compensation refused the path */
+    INTERP_ERR_SINK,          /* the canon sink asked to stop */
+    INTERP_STATUS_COUNT
+};
+const char *interp_strerror(int status);
+
+/* The first error of a run: where and what. column is 1-based, 0 when not known. */
+struct interp_error {
+    int status;               /* enum interp_status */
+    char file[256];           /* program file name as given to the interpreter */
+    int line;                 /* 1-based source line, 0 when the error is not in the program */
+    int column;               /* 1-based column of the offending word, 0 if unknown */
+    char message[256];        /* what is wrong, in a machinist's words */
+};
+/* Formats "file:line:col: error: message" (col left out when 0) into buf; returns buf. */
+char *interp_error_format(const struct interp_error *e, char *buf, size_t len);
+
+/* Lifecycle. interp_create returns NULL when out of memory. */
+struct interp *interp_create(void);
+void interp_destroy(struct interp *in);
+
+/* Configuration (before a run). The initial pose is in machine coordinates (mm, deg). */
+void interp_set_start(struct interp *in, const double pose[6]);
+/* Parameter file (LinuxCNC's format, "number value" per line). Loads it now if it exists;
+ * the persistent parameters (5161..5390) are written back, atomically, when a run ends.
+ * NULL: no file. Returns INTERP_OK or an error (details in interp_last_error). */
+int interp_set_param_file(struct interp *in, const char *path);
+/* Tool table for T/M6, G43 H and the D word of G141/G142; not owned. NULL: no table. */
+void interp_set_tooltable(struct interp *in, struct tooltable *tt);
+/* F multiplier for metric programs: 1 for FEED_UNITS = mm/min, 1000 for m/min. */
+void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit);
+/* Block delete switch: 1 skips lines that start with '/'; 0 (the default, as rs274) runs
+ * them. */
+void interp_set_block_delete(struct interp *in, int on);
+/* Parses an [RS274NGC] FEED_UNITS value ("mm/min" or "m/min"); -1 if unknown, else 0. */
+int interp_feed_units_parse(const char *name, double *factor);
+
+/* Runs a whole program, sending canonical commands to sink. The state (modes, position,
+ * offsets, parameters) persists from run to run on one interpreter. Returns INTERP_OK or
+ * the status of the first error, after which nothing more is emitted. */
+int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, void *ctx);
+/* The same for a program held in memory; file_name is used in commands and errors. */
+int interp_run_text(struct interp *in, const char *file_name, const char *text, size_t len,
+                    canon_sink_fn sink, void *ctx);
+const struct interp_error *interp_last_error(const struct interp *in);
+
+/* A read-only view of the modal state, for tools that print program coordinates. */
+struct interp_view {
+    int inch;                 /* 1 under G20 */
+    int plane;                /* 17, 18 or 19 */
+    int coord_system;         /* 1..9 for G54..G59.3 */
+    double g5x_mm[6];         /* offset of the active coordinate system (mm, deg) */
+    double g92_mm[6];         /* G92 offset (mm, deg) */
+    double tool_mm[6];        /* tool length offset (Z only for G43 H) */
+    double feed_factor;       /* see interp_set_feed_factor */
+    int current_tool;         /* tool in the spindle */
+};
+void interp_get_view(const struct interp *in, struct interp_view *v);
+/* Numbered parameter #n (1..5602), or 0 when out of range. */
+double interp_param(const struct interp *in, int n);
+
+/* Number conversion used by the lexer: reads a decimal such as "-12.345" starting at s
+ * (no exponent, as in G-code), correctly rounded (the same double strtod gives). Returns
+ * the number of characters read, 0 if none. Exposed for tests and the benchmark. */
+size_t interp_parse_decimal(const char *s, size_t len, double *out);
+
+#endif

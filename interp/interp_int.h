@@ -1,0 +1,147 @@
+/* interp_int.h: the interpreter's internal state and the functions its files share. */
+#ifndef HEXCNC_INTERP_INT_H
+#define HEXCNC_INTERP_INT_H
+
+#include <stdarg.h>
+
+#include "interp/comp5.h"
+#include "interp/interp.h"
+
+#define INTERP_NPARAMS 5603      /* #1 .. #5602, as LinuxCNC */
+#define INTERP_LINE_MAX 4096     /* characters in one program line */
+#define INTERP_MAX_ASSIGN 64     /* #n= settings in one block */
+#define INTERP_GROUPS 15         /* G modal groups 0..14 (LinuxCNC numbering) */
+#define INTERP_MGROUPS 10        /* M modal groups 0..9 */
+#define MM_PER_INCH 25.4
+
+enum { AX_X, AX_Y, AX_Z, AX_A, AX_B, AX_C };
+
+/* Parameters with a fixed meaning (LinuxCNC's numbers). */
+enum {
+    PARAM_G28 = 5161,            /* 5161..5166: G28 home X..C, machine mm/deg */
+    PARAM_G30 = 5181,            /* 5181..5186: G30 home */
+    PARAM_G92_ON = 5210,         /* 1 while G92 offsets are applied */
+    PARAM_G92 = 5211,            /* 5211..5216: G92 offsets */
+    PARAM_COORD = 5220,          /* active coordinate system 1..9 */
+    PARAM_G54 = 5221,            /* 5221..5226 G54, then every 20 up to 5381 (G59.3) */
+    PARAM_PERSIST_LO = 5161,
+    PARAM_PERSIST_HI = 5390,
+};
+
+/* One block as read: words by letter, G and M codes by modal group, #n= settings. */
+struct interp_block {
+    double val[26];              /* value of each letter word ('a' = 0) */
+    int col[26];                 /* 1-based column of each word, 0 = absent */
+    int g[INTERP_GROUPS];        /* G code x10 per group (G92.1 = 921), -1 = none */
+    int gcol[INTERP_GROUPS];
+    int m[INTERP_MGROUPS];       /* M code per group, -1 = none */
+    int mcol[INTERP_MGROUPS];
+    int nassign;
+    int assign_idx[INTERP_MAX_ASSIGN];
+    double assign_val[INTERP_MAX_ASSIGN];
+    int n_present;               /* the block has an N word */
+    int n_number;
+    int has_comment;
+    char comment[256];           /* last ( ) comment of the line, as written */
+};
+
+struct interp {
+    /* configuration */
+    double start[6];             /* initial machine pose, mm/deg */
+    char *param_path;            /* parameter file or NULL */
+    struct tooltable *tt;        /* tool table or NULL (not owned) */
+    double feed_factor;          /* mm/min per F unit in G21 */
+    int block_delete;            /* 1: skip lines starting with '/' */
+    int started;                 /* a run has happened (pos is valid) */
+
+    /* where we are in the program */
+    char file[256];
+    int line;                    /* 1-based */
+    int depth;                   /* nesting of [ ] and # while reading a value */
+    int pct_open;                /* the program began with a % line */
+    int ended;                   /* M2/M30 or closing % seen */
+    canon_sink_fn sink;
+    void *sink_ctx;
+    struct interp_error err;
+
+    /* numbered parameters, mm and deg for lengths and angles */
+    double params[INTERP_NPARAMS];
+
+    /* modal state */
+    double pos[6];               /* current machine pose, mm/deg */
+    int motion;                  /* G code x10 of group 1, -1 = G80 */
+    int plane;                   /* 17, 18, 19 */
+    int inch;                    /* G20 */
+    int incremental;             /* G91 */
+    int arc_absolute;            /* G90.1 (IJK absolute) */
+    int inverse_time;            /* G93 */
+    int coord_system;            /* 1..9 */
+    int retract_old_z;           /* G98 */
+    int path_mode;               /* 610, 611 or 640 */
+    double path_tol_mm;          /* G64 P */
+    double g5x[6];               /* active work offset, mm/deg */
+    double g92[6];               /* active G92 offset */
+    double tool[6];              /* active tool length offset */
+    double feed_mm_min;          /* F in force, converted */
+    double f_word;               /* F as programmed (for printers) */
+    double cycle_r, cycle_q, cycle_p, cycle_z; /* sticky canned cycle words, program units */
+    int cycle_mode;              /* the cycle (x10) whose words are sticky, 0 = none */
+    int current_tool, selected_tool;
+    int spindle_dir;             /* 1, -1, 0 */
+    double spindle_rpm;
+    double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
+
+    struct comp5 comp;           /* G141/G142 run in progress */
+    struct interp_block blk;     /* the block being worked on */
+    char norm[INTERP_LINE_MAX];  /* the line lowercased without spaces and comments */
+    int normcol[INTERP_LINE_MAX];/* original column of each norm char */
+};
+
+/* Records the first error (printf-style message) and returns status. */
+int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* lexer.c: reads one raw line into in->blk (evaluating expressions). *kind: 1 = a block
+ * to run, 0 = nothing (deleted line), 2 = a lone '%'. Returns a status. */
+int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind);
+/* expr.c: reads a real value at norm[*pos] ([expr], #n, function, number). */
+int interp_read_value(struct interp *in, int *pos, double *out);
+/* Reads an integer-valued parameter index or code (within 1e-4 of an integer). */
+int interp_to_int(struct interp *in, double v, int column, const char *what, int *out);
+
+/* block.c: files a G or M code into its group; checks the block as a whole. */
+int interp_add_g(struct interp *in, double v, int column);
+int interp_add_m(struct interp *in, double v, int column);
+int interp_check_block(struct interp *in);
+
+/* params.c */
+int interp_params_load(struct interp *in, const char *path);
+int interp_params_save(struct interp *in);
+void interp_select_coord(struct interp *in, int system);
+int interp_emit_offsets(struct interp *in);
+
+/* exec.c: runs the block in in->blk in LinuxCNC's order of execution. */
+int interp_execute(struct interp *in);
+int interp_emit(struct interp *in, struct canon_cmd *c);
+void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t);
+double interp_len_mm(const struct interp *in, double v); /* program length -> mm */
+void interp_prog_pos(const struct interp *in, double prog[6]); /* current pos, program units */
+/* Resolves axis words to a machine target (G90/G91, offsets, units; G53 when machine). */
+void interp_target(struct interp *in, int machine, double target[6]);
+int interp_straight(struct interp *in, enum canon_type t, const double end[6]);
+/* Checks a feed move has a feed (F in force, or F in the block under G93). */
+int interp_need_feed(struct interp *in, const char *what);
+
+/* arc.c */
+int interp_arc(struct interp *in, int g);
+/* cycles.c */
+int interp_cycle(struct interp *in, int g);
+/* offsets.c: G10, G28/G30, G92 family, G43/G49. */
+int interp_g10(struct interp *in);
+int interp_home(struct interp *in, int g);
+int interp_g92(struct interp *in, int g);
+int interp_tool_length(struct interp *in, int g);
+
+#define CHP(call) do { int rc_ = (call); if (rc_) return rc_; } while (0)
+
+#endif

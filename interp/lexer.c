@@ -1,0 +1,175 @@
+/* lexer.c: one program line to a block: spaces and case removed, comments, words, #n= settings. */
+#include <string.h>
+
+#include "interp/interp_int.h"
+
+/* Empties the block before a line is read. */
+static void block_reset(struct interp_block *b)
+{
+    memset(b->col, 0, sizeof b->col);
+    for (int i = 0; i < INTERP_GROUPS; i++)
+        b->g[i] = -1;
+    for (int i = 0; i < INTERP_MGROUPS; i++)
+        b->m[i] = -1;
+    b->nassign = 0;
+    b->n_present = 0;
+    b->has_comment = 0;
+}
+
+/* Copies a ( ) comment starting at raw[*i] == '(' into the block; LinuxCNC keeps the last. */
+static int read_comment(struct interp *in, const char *raw, size_t len, size_t *i)
+{
+    size_t start = *i + 1, j = start;
+    for (; j < len && raw[j] != ')'; j++)
+        if (raw[j] == '(')
+            return interp_fail(in, INTERP_ERR_SYNTAX, (int)j + 1,
+                               "a comment inside a comment: '(' before the ')' that closes the "
+                               "comment opened at column %d", (int)*i + 1);
+    if (j >= len)
+        return interp_fail(in, INTERP_ERR_SYNTAX, (int)*i + 1,
+                           "comment not closed: '(' without a matching ')' on this line");
+    size_t n = j - start;
+    if (n >= sizeof in->blk.comment)
+        n = sizeof in->blk.comment - 1;
+    memcpy(in->blk.comment, raw + start, n);
+    in->blk.comment[n] = 0;
+    in->blk.has_comment = 1;
+    *i = j;
+    return 0;
+}
+
+/* Builds in->norm: the line without blanks and comments, lowercased, columns remembered. */
+static int normalise(struct interp *in, const char *raw, size_t len, size_t i, int *count)
+{
+    int n = 0;
+    for (; i < len; i++) {
+        char c = raw[i];
+        if (c == ' ' || c == '\t' || c == '\r')
+            continue;
+        if (c == '(') {
+            CHP(read_comment(in, raw, len, &i));
+            continue;
+        }
+        if (c == ';')
+            break;
+        if (n >= INTERP_LINE_MAX - 1)
+            return interp_fail(in, INTERP_ERR_SYNTAX, (int)i + 1,
+                               "line too long (more than %d characters)", INTERP_LINE_MAX - 1);
+        if (c >= 'A' && c <= 'Z')
+            c = (char)(c + ('a' - 'A'));
+        in->norm[n] = c;
+        in->normcol[n] = (int)i + 1;
+        n++;
+    }
+    in->norm[n] = 0;
+    in->normcol[n] = (int)len + 1;
+    *count = n;
+    return 0;
+}
+
+/* Reads "#n=value" at norm[*pos] == '#'. The setting takes effect after the whole line. */
+static int read_assignment(struct interp *in, int *pos)
+{
+    struct interp_block *b = &in->blk;
+    int col = in->normcol[*pos];
+    (*pos)++;
+    if (in->norm[*pos] == '<')
+        return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
+                           "named parameters (#<name>) are not supported yet");
+    double iv, v;
+    int idx;
+    CHP(interp_read_value(in, pos, &iv));
+    CHP(interp_to_int(in, iv, col, "parameter number", &idx));
+    if (idx < 1 || idx >= INTERP_NPARAMS)
+        return interp_fail(in, INTERP_ERR_PARAM, col,
+                           "parameter number #%d out of range (1 to %d)", idx, INTERP_NPARAMS - 1);
+    if (in->norm[*pos] != '=')
+        return interp_fail(in, INTERP_ERR_SYNTAX, in->normcol[*pos],
+                           "'=' expected after #%d (a parameter setting is #n=value)", idx);
+    (*pos)++;
+    CHP(interp_read_value(in, pos, &v));
+    if (b->nassign >= INTERP_MAX_ASSIGN)
+        return interp_fail(in, INTERP_ERR_PARAM, col, "more than %d parameter settings in one block",
+                           INTERP_MAX_ASSIGN);
+    b->assign_idx[b->nassign] = idx;
+    b->assign_val[b->nassign] = v;
+    b->nassign++;
+    return 0;
+}
+
+/* Reads one letter word at norm[*pos]. */
+static int read_word(struct interp *in, int *pos)
+{
+    struct interp_block *b = &in->blk;
+    char c = in->norm[*pos];
+    int col = in->normcol[*pos];
+    if (c == 'o')
+        return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
+                           "O-words (subroutines, loops, conditions) are not supported yet");
+    if (c == 'u' || c == 'v')
+        return interp_fail(in, INTERP_ERR_WORD, col,
+                           "this machine has no %c axis (axes are X Y Z A B C)", c - 32);
+    if (c == 'e' || (c < 'a' || c > 'z'))
+        return interp_fail(in, INTERP_ERR_SYNTAX, col,
+                           c >= '0' && c <= '9' ? "a number without a word letter before it"
+                                                : "'%c' is not a G-code word", c);
+    (*pos)++;
+    if (in->norm[*pos] == 0)
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value", c - 32);
+    double v;
+    CHP(interp_read_value(in, pos, &v));
+    if (c == 'g')
+        return interp_add_g(in, v, col);
+    if (c == 'm')
+        return interp_add_m(in, v, col);
+    if (c == 'n') {
+        if (b->n_present)
+            return interp_fail(in, INTERP_ERR_WORD, col, "two N words in one block");
+        CHP(interp_to_int(in, v, col, "N line number", &b->n_number));
+        if (b->n_number < 0 || b->n_number > 99999)
+            return interp_fail(in, INTERP_ERR_WORD, col, "N line number out of range (0 to 99999)");
+        b->n_present = 1;
+        return 0;
+    }
+    int k = c - 'a';
+    if (b->col[k])
+        return interp_fail(in, INTERP_ERR_WORD, col,
+                           "two %c words in one block (the first is at column %d)", c - 32,
+                           b->col[k]);
+    b->col[k] = col;
+    b->val[k] = v;
+    return 0;
+}
+
+int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind)
+{
+    block_reset(&in->blk);
+    *kind = 0;
+    size_t i = 0;
+    while (i < len && (raw[i] == ' ' || raw[i] == '\t'))
+        i++;
+    if (i < len && raw[i] == '/') {
+        if (in->block_delete)
+            return INTERP_OK;
+        i++;
+    }
+    int n = 0;
+    CHP(normalise(in, raw, len, i, &n));
+    if (n == 1 && in->norm[0] == '%') {
+        *kind = 2;
+        return INTERP_OK;
+    }
+    for (int pos = 0; pos < n;) {
+        char c = in->norm[pos];
+        if (c == '%')
+            return interp_fail(in, INTERP_ERR_SYNTAX, in->normcol[pos],
+                               "'%%' must stand alone on its line (it marks the program's start "
+                               "and end)");
+        if (c == '#')
+            CHP(read_assignment(in, &pos));
+        else
+            CHP(read_word(in, &pos));
+    }
+    *kind = 1;
+    return INTERP_OK;
+}

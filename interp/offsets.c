@@ -1,0 +1,166 @@
+/* offsets.c: G10 (tool table, work offsets), G28/G30 homes, G92 family, G43/G49 tool length. */
+#include <math.h>
+#include <string.h>
+
+#include "interp/interp_int.h"
+#include "interp/tooltable.h"
+
+#define W(c) (in->blk.col[(c) - 'a'])
+#define V(c) (in->blk.val[(c) - 'a'])
+
+static const char axis_letter[6] = {'x', 'y', 'z', 'a', 'b', 'c'};
+
+/* The value of axis word i in mm (X Y Z) or deg (A B C). */
+static double axis_mm(const struct interp *in, int i)
+{
+    return i < 3 ? interp_len_mm(in, V(axis_letter[i])) : V(axis_letter[i]);
+}
+
+static int any_axis(const struct interp *in)
+{
+    for (int i = 0; i < 6; i++)
+        if (W(axis_letter[i]))
+            return 1;
+    return 0;
+}
+
+/* G10 L1 P R Z: a tool's radius and length into the tool table, then the table's file. */
+static int g10_l1(struct interp *in, int p)
+{
+    if (!in->tt)
+        return interp_fail(in, INTERP_ERR_TOOL, in->blk.gcol[0], "G10 L1 needs a tool table "
+                           "(give one with -t or [EMCIO] TOOL_TABLE)");
+    int rc = tooltable_g10_l1(in->tt, p, W('r') != 0, interp_len_mm(in, V('r')), W('z') != 0,
+                              interp_len_mm(in, V('z')));
+    if (rc)
+        return interp_fail(in, INTERP_ERR_TOOL, W('p'), "G10 L1 P%d: %s", p, tooltable_strerror(rc));
+    if (in->tt->path[0]) {
+        char err[256];
+        rc = tooltable_save(in->tt, in->tt->path, err, sizeof err);
+        if (rc)
+            return interp_fail(in, INTERP_ERR_IO, 0, "%s", err);
+    }
+    return 0;
+}
+
+/* G10 L2 / L20 P: a work offset set directly, or so that the current point reads as given. */
+static int g10_coord(struct interp *in, int l, int p)
+{
+    if (p < 0 || p > 9)
+        return interp_fail(in, INTERP_ERR_WORD, W('p'), "G10 L%d P%d: P selects the coordinate "
+                           "system, 1 (G54) to 9 (G59.3), or 0 for the active one", l, p);
+    if (W('r'))
+        return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('r'), "G10 L%d R (rotation of the "
+                           "coordinate system) is not supported yet", l);
+    int sys = p == 0 ? in->coord_system : p, base = PARAM_G54 + 20 * (sys - 1);
+    for (int i = 0; i < 6; i++) {
+        if (!W(axis_letter[i]))
+            continue;
+        double v = axis_mm(in, i);
+        in->params[base + i] = l == 2 ? v : in->pos[i] - in->g92[i] - in->tool[i] - v;
+    }
+    if (sys == in->coord_system) {
+        interp_select_coord(in, sys);
+        return interp_emit_offsets(in);
+    }
+    return 0;
+}
+
+int interp_g10(struct interp *in)
+{
+    int l, p;
+    if (!W('l'))
+        return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[0], "G10 needs an L word: L1 (tool "
+                           "table), L2 or L20 (work offsets)");
+    if (!W('p'))
+        return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[0], "G10 needs a P word (the tool "
+                           "or the coordinate system)");
+    CHP(interp_to_int(in, V('l'), W('l'), "G10 L", &l));
+    CHP(interp_to_int(in, V('p'), W('p'), "G10 P", &p));
+    if (l == 1)
+        return g10_l1(in, p);
+    if (l == 2 || l == 20)
+        return g10_coord(in, l, p);
+    return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('l'), "G10 L%d is not supported (L1, L2 "
+                       "and L20 are)", l);
+}
+
+/* G28/G30: rapid through the point given (if any) to the stored home; .1 stores the home. */
+int interp_home(struct interp *in, int g)
+{
+    int base = g < 300 ? PARAM_G28 : PARAM_G30;
+    if (g == 281 || g == 301) {
+        if (any_axis(in))
+            return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[0], "G%d.1 takes no axis words: "
+                               "it stores the current position", g / 10);
+        for (int i = 0; i < 6; i++)
+            in->params[base + i] = in->pos[i];
+        return 0;
+    }
+    double t[6];
+    int all = !any_axis(in);
+    if (!all) {
+        interp_target(in, 0, t);
+        CHP(interp_straight(in, CANON_TRAVERSE, t));
+    }
+    for (int i = 0; i < 6; i++)
+        t[i] = all || W(axis_letter[i]) ? in->params[base + i] : in->pos[i];
+    return interp_straight(in, CANON_TRAVERSE, t);
+}
+
+/* G92 sets the offset so the current point reads as given; .1 clears it and its parameters,
+ * .2 clears it keeping the parameters, .3 brings it back from them. */
+int interp_g92(struct interp *in, int g)
+{
+    if (g == 920) {
+        if (!any_axis(in))
+            return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[0], "G92 needs at least one "
+                               "axis word (the value the current point should have)");
+        for (int i = 0; i < 6; i++) {
+            if (!W(axis_letter[i]))
+                continue;
+            in->g92[i] = in->pos[i] - in->g5x[i] - in->tool[i] - axis_mm(in, i);
+        }
+        for (int i = 0; i < 6; i++)
+            in->params[PARAM_G92 + i] = in->g92[i];
+        in->params[PARAM_G92_ON] = 1;
+    } else if (g == 921 || g == 922) {
+        memset(in->g92, 0, sizeof in->g92);
+        if (g == 921)
+            for (int i = 0; i < 6; i++)
+                in->params[PARAM_G92 + i] = 0;
+        in->params[PARAM_G92_ON] = 0;
+    } else {
+        for (int i = 0; i < 6; i++)
+            in->g92[i] = in->params[PARAM_G92 + i];
+        in->params[PARAM_G92_ON] = 1;
+    }
+    return interp_emit_offsets(in);
+}
+
+/* G43 H (tool table Z), G43.1 (offsets given in the block), G49 (none). */
+int interp_tool_length(struct interp *in, int g)
+{
+    if (g == 490) {
+        memset(in->tool, 0, sizeof in->tool);
+    } else if (g == 431) {
+        for (int i = 0; i < 6; i++)
+            if (W(axis_letter[i]))
+                in->tool[i] = axis_mm(in, i);
+    } else {
+        int h = in->current_tool;
+        if (W('h'))
+            CHP(interp_to_int(in, V('h'), W('h'), "H (tool number)", &h));
+        memset(in->tool, 0, sizeof in->tool);
+        if (h < 0)
+            return interp_fail(in, INTERP_ERR_WORD, W('h'), "negative H word H%d", h);
+        if (h > 0) {
+            struct tool_entry *e = in->tt ? tooltable_find(in->tt, h) : NULL;
+            if (!e)
+                return interp_fail(in, INTERP_ERR_TOOL, W('h') ? W('h') : in->blk.gcol[8],
+                                   "G43 H%d: tool %d is not in the tool table", h, h);
+            in->tool[AX_Z] = e->z_offset_mm;
+        }
+    }
+    return interp_emit_offsets(in);
+}

@@ -1,0 +1,247 @@
+/* printer.c: canonical commands as text, line for line in the format of LinuxCNC's `rs274 -g`. */
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+#include "interp/interp.h"
+#include "interp/printer.h"
+
+#define MM_PER_INCH 25.4
+
+/* Appends raw bytes, writing the buffer out when it fills. */
+static void put(struct interp_printer *p, const char *s, size_t n)
+{
+    if (p->len + n > sizeof p->buf) {
+        interp_printer_flush(p);
+        if (n > sizeof p->buf) {
+            if (p->write(p->write_ctx, s, n))
+                p->failed = 1;
+            return;
+        }
+    }
+    memcpy(p->buf + p->len, s, n);
+    p->len += n;
+}
+
+static void puts_(struct interp_printer *p, const char *s)
+{
+    put(p, s, strlen(s));
+}
+
+/* A coordinate with the printer's digits, exactly as printf's %.Nf would print it. */
+static void put_num(struct interp_printer *p, double v, int digits)
+{
+    char tmp[400];
+    put(p, tmp, interp_format_fixed(v, digits, tmp));
+}
+
+/* The first columns: rs274's output counter (%5d) and the N number or "N.....". */
+static void line_start(struct interp_printer *p, const struct canon_cmd *c)
+{
+    char tmp[40];
+    int n;
+    p->seq++;
+    if (c && c->has_n)
+        n = snprintf(tmp, sizeof tmp, "%5ld N%-5d ", p->seq, c->n_number);
+    else
+        n = snprintf(tmp, sizeof tmp, "%5ld N..... ", p->seq);
+    put(p, tmp, (size_t)n);
+}
+
+/* NAME(v1, v2, ...) with the given values and digits, then a newline. */
+static void put_call(struct interp_printer *p, const char *name, const double *v, int n,
+                     int digits)
+{
+    puts_(p, name);
+    put(p, "(", 1);
+    for (int i = 0; i < n; i++) {
+        if (i)
+            put(p, ", ", 2);
+        put_num(p, v[i], digits);
+    }
+    put(p, ")\n", 2);
+}
+
+/* Machine pose to program coordinates: what rs274 prints (offsets removed, inch units). */
+static void to_program(const struct interp_view *v, const double m[6], double out[6])
+{
+    for (int i = 0; i < 6; i++) {
+        out[i] = m[i] - v->g5x_mm[i] - v->g92_mm[i] - v->tool_mm[i];
+        if (i < 3 && v->inch)
+            out[i] /= MM_PER_INCH;
+    }
+}
+
+/* ARC_FEED(first end, second end, first centre, second centre, turns, axis end, A, B, C). */
+static void put_arc(struct interp_printer *p, const struct interp_view *v,
+                    const struct canon_cmd *c)
+{
+    double e[6], ctr6[6] = {0}, ctr[6];
+    to_program(v, c->end, e);
+    memcpy(ctr6, c->arc.center, sizeof c->arc.center);
+    to_program(v, ctr6, ctr);
+    int a1 = 0, a2 = 1, n = 2;
+    if (c->arc.plane == 18) {
+        a1 = 2; a2 = 0; n = 1;
+    } else if (c->arc.plane == 19) {
+        a1 = 1; a2 = 2; n = 0;
+    } else if (c->arc.plane == 0) { /* 3-D arc of the compensation: no rs274 equivalent */
+        double vals[12] = {e[0], e[1], e[2], ctr[0], ctr[1], ctr[2], c->arc.normal[0],
+                           c->arc.normal[1], c->arc.normal[2], e[3], e[4], e[5]};
+        put_call(p, "ARC_FEED_3D", vals, 12, p->digits);
+        return;
+    }
+    char tmp[32];
+    puts_(p, "ARC_FEED(");
+    double first[4] = {e[a1], e[a2], ctr[a1], ctr[a2]};
+    for (int i = 0; i < 4; i++) {
+        put_num(p, first[i], p->digits);
+        put(p, ", ", 2);
+    }
+    put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "%d, ", c->arc.rotation));
+    double rest[4] = {e[n], e[3], e[4], e[5]};
+    for (int i = 0; i < 4; i++) {
+        if (i)
+            put(p, ", ", 2);
+        put_num(p, rest[i], p->digits);
+    }
+    put(p, ")\n", 2);
+}
+
+/* The offsets in force, in program units, as rs274's SET_*_OFFSET lines. */
+static void put_offsets(struct interp_printer *p, const struct interp_view *v)
+{
+    double k = v->inch ? 1.0 / MM_PER_INCH : 1.0, g5x[7], g92[6];
+    g5x[0] = v->coord_system;
+    for (int i = 0; i < 6; i++) {
+        g5x[i + 1] = v->g5x_mm[i] * (i < 3 ? k : 1.0);
+        g92[i] = v->g92_mm[i] * (i < 3 ? k : 1.0);
+    }
+    char tmp[32];
+    line_start(p, NULL);
+    put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_G5X_OFFSET(%d, ", v->coord_system));
+    for (int i = 1; i < 7; i++) {
+        if (i > 1)
+            put(p, ", ", 2);
+        put_num(p, g5x[i], 4);
+    }
+    put(p, ")\n", 2);
+    line_start(p, NULL);
+    put_call(p, "SET_G92_OFFSET", g92, 6, 4);
+}
+
+/* Everything but the moves. */
+static void put_other(struct interp_printer *p, const struct interp_view *v,
+                      const struct canon_cmd *c)
+{
+    char tmp[300];
+    double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
+    switch (c->type) {
+    case CANON_DWELL: put_call(p, "DWELL", &c->value, 1, 4); return;
+    case CANON_FEED_RATE: {
+        double f = c->feed_mm_min * (v->inch ? k : 1.0 / v->feed_factor);
+        put_call(p, "SET_FEED_RATE", &f, 1, 4);
+        return;
+    }
+    case CANON_FEED_MODE:
+        snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", (int)c->value);
+        break;
+    case CANON_PATH_MODE:
+        if (c->ivalue == 640)
+            snprintf(tmp, sizeof tmp, "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, %f)\n",
+                     c->value * k);
+        else
+            snprintf(tmp, sizeof tmp, "SET_MOTION_CONTROL_MODE(%s)\n",
+                     c->ivalue == 611 ? "CANON_EXACT_STOP" : "CANON_EXACT_PATH");
+        break;
+    case CANON_SPINDLE_SPEED:
+        snprintf(tmp, sizeof tmp, "SET_SPINDLE_SPEED(0, %.4f)\n", c->value);
+        break;
+    case CANON_SPINDLE_ON:
+        snprintf(tmp, sizeof tmp, "START_SPINDLE_%sCLOCKWISE(0)\n", c->value < 0 ? "COUNTER" : "");
+        break;
+    case CANON_SPINDLE_STOP: snprintf(tmp, sizeof tmp, "STOP_SPINDLE_TURNING(0)\n"); break;
+    case CANON_TOOL_CHANGE: snprintf(tmp, sizeof tmp, "CHANGE_TOOL(%d)\n", c->ivalue); break;
+    case CANON_COOLANT:
+        snprintf(tmp, sizeof tmp, "%s\n", c->ivalue == 7 ? "MIST_ON()" : c->ivalue == 8 ?
+                 "FLOOD_ON()" : "FLOOD_OFF()");
+        break;
+    case CANON_COMMENT:
+        if (c->text && strncasecmp(c->text, "msg,", 4) == 0)
+            snprintf(tmp, sizeof tmp, "MESSAGE(\"%s\")\n", c->text + 4);
+        else
+            snprintf(tmp, sizeof tmp, "COMMENT(\"%s\")\n", c->text ? c->text : "");
+        break;
+    case CANON_PAUSE:
+        snprintf(tmp, sizeof tmp, "%s\n", c->ivalue ? "OPTIONAL_PROGRAM_STOP()" : "PROGRAM_STOP()");
+        break;
+    case CANON_PROGRAM_END: snprintf(tmp, sizeof tmp, "PROGRAM_END()\n"); break;
+    default: snprintf(tmp, sizeof tmp, "%s()\n", canon_type_name(c->type)); break;
+    }
+    puts_(p, tmp);
+}
+
+int interp_printer_sink(void *ctx, const struct canon_cmd *c)
+{
+    struct interp_printer *p = ctx;
+    struct interp_view v;
+    interp_get_view(p->in, &v);
+    if (v.inch != p->inch) {
+        p->inch = v.inch;
+        line_start(p, NULL);
+        puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
+    }
+    if (c->type == CANON_OFFSETS) {
+        put_offsets(p, &v);
+        return p->failed ? -1 : 0;
+    }
+    line_start(p, c);
+    if (c->type == CANON_TRAVERSE || c->type == CANON_FEED) {
+        double e[6];
+        to_program(&v, c->end, e);
+        put_call(p, c->type == CANON_TRAVERSE ? "STRAIGHT_TRAVERSE" : "STRAIGHT_FEED", e, 6,
+                 p->digits);
+    } else if (c->type == CANON_ARC) {
+        put_arc(p, &v, c);
+    } else {
+        put_other(p, &v, c);
+    }
+    return p->failed ? -1 : 0;
+}
+
+void interp_printer_init(struct interp_printer *p, const struct interp *in, int digits,
+                         interp_write_fn write, void *write_ctx)
+{
+    p->in = in;
+    p->write = write;
+    p->write_ctx = write_ctx;
+    p->digits = digits;
+    p->seq = 0;
+    p->failed = 0;
+    p->len = 0;
+    struct interp_view v;
+    interp_get_view(in, &v);
+    p->inch = v.inch;
+}
+
+int interp_printer_preamble(struct interp_printer *p)
+{
+    struct interp_view v;
+    interp_get_view(p->in, &v);
+    line_start(p, NULL);
+    puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
+    put_offsets(p, &v);
+    line_start(p, NULL);
+    puts_(p, "SET_XY_ROTATION(0.0000)\n");
+    line_start(p, NULL);
+    puts_(p, "SET_FEED_REFERENCE(CANON_XYZ)\n");
+    return p->failed ? -1 : 0;
+}
+
+int interp_printer_flush(struct interp_printer *p)
+{
+    if (p->len && p->write(p->write_ctx, p->buf, p->len))
+        p->failed = 1;
+    p->len = 0;
+    return p->failed ? -1 : 0;
+}
