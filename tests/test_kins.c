@@ -340,7 +340,7 @@ START_TEST(test_tool_frames)
     ck_assert_int_eq(kins_tool_point(k, pose, tb, tp2), KINS_OK);
     ck_assert_double_eq_tol(tp2[0] - tp[0], -10.0, 1e-12);
     ck_assert_double_eq_tol(tb[0], 0.0, 1e-12);
-    /* Table turned C = 90 deg: the platform's +Y axis points along machine -X... the tip,
+    /* Table turned C = 90 deg: the platform's +Y axis points along machine -X, so the tip,
      * 10 mm in machine -X of the platform origin, is at platform +Y 10. */
     pose[KINS_C] = 90;
     ck_assert_int_eq(kins_tool_point(k, pose, NULL, tp2), KINS_OK);

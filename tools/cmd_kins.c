@@ -11,8 +11,7 @@
 #include "tools/cmd.h"
 
 const char cmd_kins_usage[] =
-    "kins CONFIG.ini inverse X Y Z A B C | forward L1 .. L6\n"
-    "                                  pose (mm, deg) <-> leg lengths (mm) by [KINS] KINEMATICS";
+    "kins CONFIG.ini inverse X Y Z A B C | forward L1..L6   pose (mm, deg) <-> legs (mm)";
 
 /* One INI entry, with the line it came from for messages. */
 struct kins_ini_entry {
