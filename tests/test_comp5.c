@@ -265,6 +265,40 @@ START_TEST(test_inside_fits)
 }
 END_TEST
 
+/* Runs are separate: after a flush the other side may start a new run; a tool already at
+ * the compensated start gets no positioning move. */
+START_TEST(test_runs_separate)
+{
+    struct comp5 c;
+    struct canon_prog p;
+    double start[6] = {0, -5, 0, 0, 0, 0}; /* exactly the G141 start below */
+    comp5_init(&c);
+    canon_prog_init(&p);
+    struct comp5_block b[4] = {tu_block(141, 0, 0, 0, 0, 0, 0, 5, 1),
+                               tu_block(141, 30, 0, 0, 0, 0, 0, 5, 2),
+                               tu_block(142, 30, 0, 0, 0, 0, 0, 5, 4),
+                               tu_block(142, 60, 0, 0, 0, 0, 0, 5, 5)};
+    ck_assert_int_eq(comp5_block(&c, &b[0], start, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_int_eq(comp5_block(&c, &b[1], start, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_uint_eq(p.count, 0); /* no positioning: the tool is there */
+    ck_assert_int_eq(comp5_flush(&c, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_uint_eq(p.count, 1);
+    ck_assert_int_eq(comp5_flush(&c, canon_prog_sink, &p), COMP5_OK); /* no run: no-op */
+    ck_assert_uint_eq(p.count, 1);
+    const double *pos = comp5_tool_pos(&c);
+    ck_assert_double_eq_tol(pos[0], 30.0, 1e-12);
+    ck_assert_double_eq_tol(pos[1], -5.0, 1e-12);
+    ck_assert_int_eq(comp5_block(&c, &b[2], pos, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_int_eq(comp5_block(&c, &b[3], pos, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_int_eq(comp5_flush(&c, canon_prog_sink, &p), COMP5_OK);
+    ck_assert_uint_eq(p.count, 3);
+    ck_assert_int_eq(p.cmds[1].line, 4); /* positioning from (30,-5) to (30,5) */
+    ck_assert_double_eq_tol(p.cmds[1].end[1], 5.0, 1e-12);
+    ck_assert_int_eq(p.cmds[2].compensated, 142);
+    canon_prog_free(&p);
+}
+END_TEST
+
 static Suite *comp5_suite(void)
 {
     Suite *s = suite_create("comp5");
@@ -277,6 +311,7 @@ static Suite *comp5_suite(void)
     tcase_add_test(tc, test_collinear);
     tcase_add_test(tc, test_errors);
     tcase_add_test(tc, test_inside_fits);
+    tcase_add_test(tc, test_runs_separate);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -219,6 +219,37 @@ START_TEST(test_skew_inside)
 }
 END_TEST
 
+/* An outside corner where A B C change from block to block: the arc keeps the corner's
+ * orientation at both ends, lies perpendicular to the corner's tool axis, radius W. */
+START_TEST(test_outside_orientation_change)
+{
+    double pts[3][3] = {{0, 0, 500}, {60, 0, 500}, {60, 40, 500}};
+    double abc[3][3] = {{-5, 3, 0}, {6, -9, 12}, {0, -15, 25}};
+    double n[3], rs[3], re[3];
+    struct canon_prog p;
+    const double w_mm = 5.0;
+    ck_assert_int_eq(run_path(141, pts, abc, 3, w_mm, &p), COMP5_OK);
+    ck_assert_uint_eq(p.count, 4);
+    const struct canon_cmd *arc = &p.cmds[2];
+    ck_assert_int_eq(arc->type, CANON_ARC);
+    tu_normal(abc[1][0], abc[1][1], abc[1][2], n);
+    for (int i = 0; i < 3; i++) {
+        rs[i] = p.cmds[1].end[i] - pts[1][i];
+        re[i] = arc->end[i] - pts[1][i];
+        ck_assert_double_eq_tol(p.cmds[1].end[3 + i], abc[1][i], 1e-12);
+        ck_assert_double_eq_tol(arc->end[3 + i], abc[1][i], 1e-12);
+        ck_assert_double_eq_tol(p.cmds[0].end[3 + i], abc[0][i], 1e-12);
+        ck_assert_double_eq_tol(p.cmds[3].end[3 + i], abc[2][i], 1e-12);
+    }
+    ck_assert_double_eq_tol(tu_norm(rs), w_mm, TOL);
+    ck_assert_double_eq_tol(tu_norm(re), w_mm, TOL);
+    ck_assert_double_eq_tol(tu_dot(rs, n), 0.0, TOL);
+    ck_assert_double_eq_tol(tu_dot(re, n), 0.0, TOL);
+    ck_assert_double_eq_tol(fabs(tu_dot(arc->arc.normal, n)), 1.0, TOL);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* Samples move k of a program (FEED: straight; ARC: about its normal) at fraction f. */
 static void sample(const struct canon_prog *p, size_t k, const double from[3], double f,
                    double out[3])
@@ -295,6 +326,7 @@ static Suite *comp5_join_suite(void)
     tcase_add_test(tc, test_outside_tilted);
     tcase_add_test(tc, test_u_turn);
     tcase_add_test(tc, test_skew_inside);
+    tcase_add_test(tc, test_outside_orientation_change);
     tcase_add_test(tc, test_path_distance);
     suite_add_tcase(s, tc);
     return s;
