@@ -49,10 +49,42 @@ static int hal_ini_handler(void *user, const char *section, const char *key, con
     return 1;
 }
 
+/* libinih (as Debian builds it) reads lines of at most INI_MAX_LINE - 1 characters and
+ * parses the rest of a longer line as a line of its own; say so instead. Returns the first
+ * too-long line's number, 0 if none, -1 if the file cannot be opened. */
+static int hal_ini_long_line(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t n;
+    int lineno = 0, bad = 0;
+    while (!bad && (n = getline(&line, &cap, f)) >= 0) {
+        lineno++;
+        while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
+            n--;
+        if (n >= INI_MAX_LINE - 1)
+            bad = lineno;
+    }
+    free(line);
+    fclose(f);
+    return bad;
+}
+
 /* Reads an INI file, replacing any read before. */
 int hal_load_ini(struct hal *h, const char *path)
 {
     hal_ini_free(h);
+    errno = 0;
+    int longl = hal_ini_long_line(path);
+    if (longl == -1)
+        return hal_error(h, HAL_ERR_IO, "cannot open INI file '%s': %s", path,
+                         strerror(errno ? errno : ENOENT));
+    if (longl > 0)
+        return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: line longer than %d characters (the INI "
+                         "reader's limit)", path, longl, INI_MAX_LINE - 2);
     errno = 0;
     int r = ini_parse(path, hal_ini_handler, h);
     if (r == -1)

@@ -91,11 +91,12 @@ static void hal_show_sigs(struct hal *h, FILE *out, const char *pattern)
             continue;
         hal_format_value(s->type, &s->data, val, sizeof val);
         fprintf(out, "  %-5s %14s  %s\n", hal_type_name(s->type), val, s->name);
+        if (s->writer)          /* the writer first, then readers and I/O pins by name */
+            fprintf(out, "%26s %s\n", "<==", s->writer->name);
         for (int k = 0; k < np; k++) {
             struct hal_pin *p = pins[k];
-            if (p->sig == s)    /* the arrow as seen from the signal */
-                fprintf(out, "%26s %s\n", p->dir == HAL_IN ? "==>" : p->dir == HAL_OUT ?
-                        "<==" : "<=>", p->name);
+            if (p->sig == s && p != s->writer)
+                fprintf(out, "%26s %s\n", p->dir == HAL_IN ? "==>" : "<=>", p->name);
         }
     }
     free(pins);
