@@ -261,21 +261,30 @@ static int modbus_sim_listen(struct modbus_sim_drive *d, const char *host, int p
     return MODBUS_SIM_OK;
 }
 
-/* Starts every drive's TCP server. */
+/* Starts drive i's TCP server on host:port (0 = ephemeral). */
+int modbus_sim_start_tcp_port(struct modbus_sim *s, int i, const char *host, int port)
+{
+    if (i < 0 || i >= s->n || port < 0 || port > 65535 || s->d[i].ctx)
+        return MODBUS_SIM_ERR_ARG;
+    struct modbus_sim_drive *d = &s->d[i];
+    int rc = modbus_sim_listen(d, host ? host : "127.0.0.1", port);
+    if (rc)
+        return rc;
+    if (pthread_create(&d->thread, NULL, modbus_sim_tcp_thread, d))
+        return MODBUS_SIM_ERR_THREAD;
+    d->started = true;
+    return MODBUS_SIM_OK;
+}
+
+/* Starts every drive's TCP server: drive i on base_port + i. */
 int modbus_sim_start_tcp(struct modbus_sim *s, const char *host, int base_port)
 {
     if (base_port < 0 || base_port + s->n - 1 > 65535)
         return MODBUS_SIM_ERR_ARG;
     for (int i = 0; i < s->n; i++) {
-        struct modbus_sim_drive *d = &s->d[i];
-        if (d->ctx)
-            return MODBUS_SIM_ERR_ARG;
-        int rc = modbus_sim_listen(d, host ? host : "127.0.0.1", base_port ? base_port + i : 0);
+        int rc = modbus_sim_start_tcp_port(s, i, host, base_port ? base_port + i : 0);
         if (rc)
             return rc;
-        if (pthread_create(&d->thread, NULL, modbus_sim_tcp_thread, d))
-            return MODBUS_SIM_ERR_THREAD;
-        d->started = true;
     }
     return MODBUS_SIM_OK;
 }

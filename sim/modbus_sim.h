@@ -69,6 +69,8 @@ int modbus_sim_create(struct modbus_sim **out, int ndrives, const struct modbus_
 /* Starts TCP servers on 127.0.0.1 (or `host`): drive i on base_port + i; base_port 0 gives
  * every drive an ephemeral port (read it with modbus_sim_port). */
 int modbus_sim_start_tcp(struct modbus_sim *s, const char *host, int base_port);
+/* Starts drive i alone on host:port (0 = ephemeral). */
+int modbus_sim_start_tcp_port(struct modbus_sim *s, int i, const char *host, int port);
 /* Starts drive i as an RTU server on a new pseudo-terminal; `slave_path` receives the
  * device the client opens (e.g. /dev/pts/7). */
 int modbus_sim_start_rtu_pty(struct modbus_sim *s, int i, char *slave_path, size_t len);

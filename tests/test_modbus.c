@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hal/drivers/modbus_cfg.h"
 #include "hal/drivers/modbus_drive.h"
 #include "sim/modbus_sim.h"
 
@@ -180,6 +181,70 @@ START_TEST(test_drive_model_lag)
 }
 END_TEST
 
+/* A tiny INI: {section, key, value} triples. */
+static const char *const ini_table[][3] = {
+    { "MODBUS", "BASE_PORT", "15020" },
+    { "MODBUS", "COUNTS_PER_MM", "-2000" },
+    { "MODBUS", "TIMEOUT", "2.5" },
+    { "MODBUS", "WORD_ORDER", "Low-First" },
+    { "MODBUS", "SETPOINT_PERIOD", "4000000" },
+    { "MODBUS_DRIVE_1", "PORT", "502" },
+    { "MODBUS_DRIVE_1", "HOST", "127.0.0.2" },
+    { "MODBUS_DRIVE_1", "EXCHANGE", "separate" },
+    { "MODBUS_DRIVE_2", "TRANSPORT", "rtu" },
+    { "MODBUS_DRIVE_2", "DEVICE", "/dev/ttyUSB0" },
+    { "MODBUS_DRIVE_2", "BAUD", "57600" },
+    { "MODBUS_DRIVE_2", "PARITY", "E" },
+    { "MODBUS_DRIVE_2", "UNIT", "7" },
+    { "MODBUS_DRIVE_3", "TIMEOUT", "soon" },
+    { "MODBUS_DRIVE_4", "TRANSPORT", "rtu" },
+};
+
+static const char *ini_get(void *ctx, const char *section, const char *key)
+{
+    (void)ctx;
+    for (size_t i = 0; i < sizeof(ini_table) / sizeof(ini_table[0]); i++)
+        if (!strcmp(ini_table[i][0], section) && !strcmp(ini_table[i][1], key))
+            return ini_table[i][2];
+    return NULL;
+}
+
+START_TEST(test_cfg_from_ini)
+{
+    struct modbus_drive_cfg c;
+    char err[256];
+    ck_assert_int_eq(modbus_cfg_read(&c, 0, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_OK);
+    ck_assert_int_eq(c.port, 15020);
+    ck_assert_double_eq(c.counts_per_mm, -2000.0);
+    ck_assert_int_eq(c.timeout_us, 2500);
+    ck_assert_int_eq(c.map.order, MODBUS_WORDS_LOW_FIRST);
+    ck_assert_int_eq(c.period_ns, 4000000);
+    ck_assert_int_eq(c.exchange, MODBUS_EXCHANGE_FC23);
+    ck_assert_int_eq(modbus_cfg_read(&c, 5, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_OK);
+    ck_assert_int_eq(c.port, 15025);                 /* BASE_PORT + n */
+    ck_assert_int_eq(modbus_cfg_read(&c, 1, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_OK);
+    ck_assert_int_eq(c.port, 502);                   /* the drive's own PORT wins */
+    ck_assert_str_eq(c.host, "127.0.0.2");
+    ck_assert_int_eq(c.exchange, MODBUS_EXCHANGE_SEPARATE);
+    ck_assert_int_eq(modbus_cfg_read(&c, 2, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_OK);
+    ck_assert_int_eq(c.transport, MODBUS_DRIVE_RTU);
+    char where[96];
+    modbus_drive_cfg_where(&c, where, sizeof(where));
+    ck_assert_str_eq(where, "/dev/ttyUSB0@57600,8E1");
+    ck_assert_int_eq(c.unit, 7);
+    ck_assert_int_eq(modbus_cfg_read(&c, 3, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_ERR_CONFIG);
+    ck_assert_str_eq(err, "m.ini: [MODBUS_DRIVE_3] TIMEOUT = soon: expected a number above 0");
+    ck_assert_int_eq(modbus_cfg_read(&c, 4, "MODBUS", ini_get, NULL, "m.ini", err, sizeof(err)),
+                     MODBUS_DRIVE_ERR_CONFIG);
+    ck_assert_ptr_nonnull(strstr(err, "TRANSPORT = rtu needs DEVICE"));
+}
+END_TEST
+
 static Suite *modbus_suite(void)
 {
     Suite *s = suite_create("modbus");
@@ -188,6 +253,7 @@ static Suite *modbus_suite(void)
     tcase_add_test(tc, test_words_both_orders);
     tcase_add_test(tc, test_scaling_and_range);
     tcase_add_test(tc, test_config_rejects_bad_maps);
+    tcase_add_test(tc, test_cfg_from_ini);
     tcase_add_test(tc, test_exchange_high_first_fc23);
     tcase_add_test(tc, test_exchange_low_first_fc23);
     tcase_add_test(tc, test_exchange_low_first_separate);

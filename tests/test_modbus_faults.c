@@ -30,6 +30,7 @@ static void link_to(struct modbus_link *l, struct modbus_sim *s, int i, long tim
     c.timeout_us = timeout_us;
     c.counts_per_mm = 1000.0;
     ck_assert_int_eq(modbus_link_init(l, &c), MODBUS_DRIVE_OK);
+    modbus_link_command(l, 0.0, false);
 }
 
 /* The expected "modbus drive N (127.0.0.1:PORT): " prefix. */
@@ -97,6 +98,12 @@ START_TEST(test_real_exception_illegal_address)
     c.map.target = 101;
     struct modbus_link l;
     ck_assert_int_eq(modbus_link_init(&l, &c), MODBUS_DRIVE_OK);
+    /* Before the first command a cycle only connects: nothing is written. */
+    ck_assert_int_eq(modbus_link_cycle(&l), MODBUS_DRIVE_OK);
+    struct modbus_sim_drive_state st;
+    modbus_sim_state(s, 0, &st);
+    ck_assert_uint_eq(st.requests, 0);
+    modbus_link_command(&l, 0.0, false);
     ck_assert_int_eq(modbus_link_cycle(&l), MODBUS_DRIVE_ERR_EXCEPTION);
     expect_msg(&l, s, 0, "exception 2 illegal data address at register 100");
     modbus_link_fini(&l);
@@ -311,6 +318,7 @@ START_TEST(test_rtu_over_pty)
     c.unit = 9;
     c.timeout_us = 20000;
     ck_assert_int_eq(modbus_link_init(&l, &c), MODBUS_DRIVE_OK);
+    modbus_link_command(&l, 0.0, false);
     ck_assert_int_eq(modbus_link_cycle(&l), MODBUS_DRIVE_ERR_TIMEOUT);
     char want[128];
     snprintf(want, sizeof(want), "modbus drive 1 (%s@115200,8N1): no answer within 20 ms", dev);

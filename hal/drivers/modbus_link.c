@@ -35,6 +35,7 @@ void modbus_link_command(struct modbus_link *l, double pos_mm, bool enable)
     memcpy(&bits, &pos_mm, sizeof(bits));
     atomic_store_explicit(&l->cmd_pos_bits, bits, memory_order_relaxed);
     atomic_store_explicit(&l->cmd_enable, enable ? 1u : 0u, memory_order_relaxed);
+    atomic_store_explicit(&l->cmd_posted, 1u, memory_order_release);
 }
 
 /* The servo side asks to clear the fault and reconnect. */
@@ -50,7 +51,11 @@ void modbus_link_feedback(struct modbus_link *l, struct modbus_feedback *fb)
     fb->pos_mm = modbus_counts_to_mm((int32_t)(uint32_t)(w & 0xffffffffu),
                                      l->drive.cfg.counts_per_mm);
     fb->status_word = (uint16_t)(w >> 32);
-    fb->fault = atomic_load_explicit(&l->fault, memory_order_acquire) != 0;
+    /* A reset not yet taken by the I/O side hides the old fault, so an e-stop chain can be
+     * reset in the same period; a retry that fails raises it again. */
+    bool pending = atomic_load_explicit(&l->reset_req, memory_order_relaxed) !=
+                   atomic_load_explicit(&l->reset_ack, memory_order_acquire);
+    fb->fault = !pending && atomic_load_explicit(&l->fault, memory_order_acquire) != 0;
     fb->fault_seq = atomic_load_explicit(&l->fault_seq, memory_order_acquire);
     fb->connected = atomic_load_explicit(&l->connected, memory_order_relaxed) != 0;
     fb->rtt_us = atomic_load_explicit(&l->rtt_ns, memory_order_relaxed) / 1000.0;
@@ -82,15 +87,15 @@ static int modbus_link_raise(struct modbus_link *l, int status, const char *msg)
 static void modbus_link_take_reset(struct modbus_link *l)
 {
     uint32_t req = atomic_load_explicit(&l->reset_req, memory_order_acquire);
-    if (req == l->reset_seen)
+    if (req == atomic_load_explicit(&l->reset_ack, memory_order_relaxed))
         return;
-    l->reset_seen = req;
-    if (!atomic_load_explicit(&l->fault, memory_order_relaxed))
-        return;
-    modbus_drive_disconnect(&l->drive);
-    atomic_store_explicit(&l->connected, 0u, memory_order_relaxed);
-    l->send_fault_reset = true;
-    atomic_store_explicit(&l->fault, 0u, memory_order_release);
+    if (atomic_load_explicit(&l->fault, memory_order_relaxed)) {
+        modbus_drive_disconnect(&l->drive);
+        atomic_store_explicit(&l->connected, 0u, memory_order_relaxed);
+        l->send_fault_reset = true;
+        atomic_store_explicit(&l->fault, 0u, memory_order_release);
+    }
+    atomic_store_explicit(&l->reset_ack, req, memory_order_release);
 }
 
 /* Publishes a good exchange's results and round trip. */
@@ -119,6 +124,8 @@ int modbus_link_cycle(struct modbus_link *l)
             return modbus_link_raise(l, rc, modbus_drive_message(d));
         atomic_store_explicit(&l->connected, 1u, memory_order_relaxed);
     }
+    if (!atomic_load_explicit(&l->cmd_posted, memory_order_acquire))
+        return MODBUS_DRIVE_OK;
     uint64_t bits = atomic_load_explicit(&l->cmd_pos_bits, memory_order_relaxed);
     double pos_mm;
     memcpy(&pos_mm, &bits, sizeof(pos_mm));

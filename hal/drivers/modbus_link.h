@@ -29,7 +29,8 @@
 struct modbus_feedback {
     double pos_mm;           /* actual position of the last good exchange, mm */
     uint16_t status_word;    /* status word of the last good exchange */
-    bool fault;              /* latched until modbus_link_reset() */
+    bool fault;              /* latched; reads false from modbus_link_reset() until the I/O
+                              * side has retried (and true again if the retry fails) */
     bool connected;          /* a connection is open */
     double rtt_us;           /* round trip of the last good exchange, us */
     double rtt_max_us;       /* largest round trip since start, us */
@@ -45,7 +46,9 @@ struct modbus_link {
     struct modbus_drive drive;          /* the connection (I/O side only) */
     _Atomic uint64_t cmd_pos_bits;      /* commanded position, the bits of a double, mm */
     _Atomic uint32_t cmd_enable;        /* 1: enable the drive */
+    _Atomic uint32_t cmd_posted;        /* 1 once the servo side has posted a command */
     _Atomic uint32_t reset_req;         /* bumped by modbus_link_reset() */
+    _Atomic uint32_t reset_ack;         /* the reset_req the I/O side has acted on */
     _Atomic uint64_t fb_word;           /* actual counts (low 32) | status word << 32 */
     _Atomic uint32_t rtt_ns;            /* last round trip, ns */
     _Atomic uint32_t rtt_max_ns;        /* largest round trip, ns */
@@ -55,7 +58,6 @@ struct modbus_link {
     _Atomic uint32_t fault_seq;         /* faults raised so far */
     _Atomic uint32_t connected;         /* 1 while connected */
     char fault_msg[320];                /* why, valid while fault is set */
-    uint32_t reset_seen;                /* I/O side: last reset_req acted on */
     bool send_fault_reset;              /* I/O side: set FAULT_RESET in the next exchange */
     modbus_link_report_fn report;       /* optional fault reporter (I/O side) */
     void *report_arg;
@@ -85,7 +87,8 @@ const char *modbus_link_fault_message(const struct modbus_link *l);
 /* ---- I/O side ---------------------------------------------------------------------------- */
 
 /* One set-point cycle: act on a reset, connect if needed, exchange, publish. Does nothing
- * while a fault is latched. Returns the exchange status (MODBUS_DRIVE_OK when idle). */
+ * while a fault is latched, and only connects until the first command is posted (so a drive
+ * never sees a made-up target). Returns the exchange status (MODBUS_DRIVE_OK when idle). */
 int modbus_link_cycle(struct modbus_link *l);
 
 #endif

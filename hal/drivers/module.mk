@@ -9,3 +9,4 @@ LIB_SRCS += hal/drivers/canopen.c hal/drivers/canopen_config.c hal/drivers/canop
 HAL_COMPS += cia402
 TESTS += test_can_proto
 TESTS += test_cia402_master
+TESTS += test_can_bus

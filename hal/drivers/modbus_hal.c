@@ -1,0 +1,210 @@
+/* modbus_hal.c: HAL component `modbus`: Modbus position drives (pins modbus.N.*, funct modbus.update). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hal/hal.h"
+#include "hal/drivers/modbus_cfg.h"
+#include "hal/drivers/modbus_link.h"
+
+/*
+ * A thin shell over modbus_link: `modbus.update` runs in the servo thread, posts each
+ * drive's command into its mailbox and copies the latest feedback to the pins; it never
+ * waits on the network. The exchanges happen in one I/O thread per drive (io=thread, the
+ * default on the real-time clock) or, with the simulated clock (io=inline), in modbus.update
+ * itself once every set-point period, so simulated runs are deterministic.
+ *
+ *   loadrt modbus [count=N] [section=MODBUS] [io=thread|inline]
+ */
+
+#define MODBUS_HAL_MAX_DRIVES 16
+
+/* Pins and link of one drive. */
+struct modbus_hal_drive {
+    double *pos_cmd;          /* in: commanded position, mm */
+    bool *enable;             /* in: enable the drive */
+    bool *fault_reset;        /* in: rising edge clears the fault and reconnects */
+    double *pos_fb;           /* out: actual position, mm */
+    bool *fault;              /* out: latched communication or drive fault */
+    bool *connected;          /* out: a connection is open */
+    double *rtt_us;           /* out: last round trip, us */
+    double *rtt_max_us;       /* out: largest round trip, us */
+    uint32_t *errors;         /* out: failed connects and exchanges */
+    uint32_t *status_word;    /* out: the drive's status word */
+    bool reset_last;          /* fault-reset in the previous period (edge detection) */
+    bool linked;              /* link initialised (needs fini) */
+    struct modbus_link link;
+};
+
+/* The loaded component. */
+struct modbus_hal {
+    int count;                /* drives */
+    bool inline_io;           /* exchanges in modbus.update instead of I/O threads */
+    long setpoint_ticks;      /* inline: servo periods per set-point period (0 = not yet) */
+    long tick;                /* inline: servo periods since the last exchange */
+    bool *fault_any;          /* out: any drive faulted (to the e-stop chain) */
+    struct modbus_hal_drive d[MODBUS_HAL_MAX_DRIVES];
+};
+
+/* The lookup the INI reader uses. */
+static const char *modbus_hal_ini_get(void *ctx, const char *section, const char *key)
+{
+    return hal_ini_get(ctx, section, key);
+}
+
+/* Prints a fault once, when it is raised (on the I/O side, never in the servo thread). */
+static void modbus_hal_report(void *arg, const char *msg)
+{
+    (void)arg;
+    fprintf(stderr, "hexcnc: %s\n", msg);
+}
+
+/* The servo-thread function: commands in, feedback out, inline exchanges when configured. */
+static void modbus_hal_update(void *arg, long period_ns)
+{
+    struct modbus_hal *c = arg;
+    bool exchange_now = false;
+    if (c->inline_io) {
+        if (!c->setpoint_ticks) {
+            long sp = c->d[0].link.drive.cfg.period_ns;
+            c->setpoint_ticks = period_ns > 0 ? (sp + period_ns / 2) / period_ns : 1;
+            if (c->setpoint_ticks < 1)
+                c->setpoint_ticks = 1;
+        }
+        exchange_now = c->tick == 0;
+        c->tick = (c->tick + 1) % c->setpoint_ticks;
+    }
+    bool any = false;
+    for (int i = 0; i < c->count; i++) {
+        struct modbus_hal_drive *d = &c->d[i];
+        if (*d->fault_reset && !d->reset_last)
+            modbus_link_reset(&d->link);
+        d->reset_last = *d->fault_reset;
+        modbus_link_command(&d->link, *d->pos_cmd, *d->enable);
+        if (exchange_now)
+            modbus_link_cycle(&d->link);
+        struct modbus_feedback fb;
+        modbus_link_feedback(&d->link, &fb);
+        *d->pos_fb = fb.pos_mm;
+        *d->fault = fb.fault;
+        *d->connected = fb.connected;
+        *d->rtt_us = fb.rtt_us;
+        *d->rtt_max_us = fb.rtt_max_us;
+        *d->errors = fb.errors;
+        *d->status_word = fb.status_word;
+        any = any || fb.fault;
+    }
+    *c->fault_any = any;
+}
+
+/* Stops the I/O threads and closes the connections (hal_destroy). */
+static void modbus_hal_free(void *arg)
+{
+    struct modbus_hal *c = arg;
+    for (int i = 0; i < c->count; i++)
+        if (c->d[i].linked)
+            modbus_link_fini(&c->d[i].link);
+    free(c);
+}
+
+/* Creates drive i's pins. */
+static int modbus_hal_pins(struct hal *h, struct modbus_hal_drive *d, int i)
+{
+    int rc;
+    if ((rc = hal_pin_float_newf(h, HAL_IN, &d->pos_cmd, "modbus.%d.position-cmd", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &d->enable, "modbus.%d.enable", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &d->fault_reset, "modbus.%d.fault-reset", i)) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &d->pos_fb, "modbus.%d.position-fb", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_OUT, &d->fault, "modbus.%d.fault", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_OUT, &d->connected, "modbus.%d.connected", i)) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &d->rtt_us, "modbus.%d.rtt-us", i)) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &d->rtt_max_us, "modbus.%d.rtt-max-us", i)) ||
+        (rc = hal_pin_u32_newf(h, HAL_OUT, &d->errors, "modbus.%d.errors", i)) ||
+        (rc = hal_pin_u32_newf(h, HAL_OUT, &d->status_word, "modbus.%d.status-word", i)))
+        return rc;
+    return HAL_OK;
+}
+
+/* Parses count=, section= and io= into the outputs. */
+static int modbus_hal_args(struct hal *h, int argc, char **argv, long *count, char *section,
+                           size_t len, bool *inline_io)
+{
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strncmp(a, "count=", 6)) {
+            char *end;
+            *count = strtol(a + 6, &end, 10);
+            if (*end || *count < 1 || *count > MODBUS_HAL_MAX_DRIVES)
+                return hal_error(h, HAL_ERR_ARG, "modbus: count must be 1..%d, not '%s'",
+                                 MODBUS_HAL_MAX_DRIVES, a + 6);
+        } else if (!strncmp(a, "section=", 8) && a[8] && strlen(a + 8) < len - 16) {
+            snprintf(section, len, "%s", a + 8);
+        } else if (!strcmp(a, "io=thread") || !strcmp(a, "io=inline")) {
+            *inline_io = !strcmp(a, "io=inline");
+        } else {
+            return hal_error(h, HAL_ERR_ARG, "modbus: unknown argument '%s' (expected count=N, "
+                             "section=NAME, io=thread or io=inline)", a);
+        }
+    }
+    return HAL_OK;
+}
+
+/* Reads drive i's config from the INI and opens its link. */
+static int modbus_hal_drive_new(struct hal *h, struct modbus_hal *c, int i, const char *section)
+{
+    struct modbus_drive_cfg cfg;
+    char err[320];
+    if (modbus_cfg_read(&cfg, i, section, modbus_hal_ini_get, h, hal_ini_path(h), err,
+                        sizeof(err)))
+        return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s", err);
+    struct modbus_hal_drive *d = &c->d[i];
+    if (modbus_link_init(&d->link, &cfg)) {
+        snprintf(err, sizeof(err), "%s", modbus_drive_message(&d->link.drive));
+        modbus_link_fini(&d->link);
+        return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s: %s",
+                         hal_ini_path(h) ? hal_ini_path(h) : "INI", err);
+    }
+    d->linked = true;
+    d->link.report = modbus_hal_report;
+    return modbus_hal_pins(h, d, i);
+}
+
+/* `loadrt modbus ...`: the drives, their pins, modbus.fault-any and modbus.update. */
+static int modbus_hal_load(struct hal *h, int argc, char **argv)
+{
+    char section[48] = "MODBUS", err[200];
+    bool inline_io = hal_sim_clock(h);
+    long count = -1;
+    int rc = modbus_hal_args(h, argc, argv, &count, section, sizeof(section), &inline_io);
+    if (rc)
+        return rc;
+    if (count < 0) {
+        count = modbus_cfg_drive_count(section, modbus_hal_ini_get, h, hal_ini_path(h), 1,
+                                       MODBUS_HAL_MAX_DRIVES, err, sizeof(err));
+        if (count < 0)
+            return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s", err);
+    }
+    struct modbus_hal *c = calloc(1, sizeof(*c));
+    if (!c)
+        return hal_error(h, HAL_ERR_NOMEM, "modbus: out of memory");
+    if ((rc = hal_on_destroy(h, modbus_hal_free, c))) {
+        free(c);
+        return rc;
+    }
+    c->inline_io = inline_io;
+    for (int i = 0; i < count; i++) {
+        c->count = i + 1;
+        if ((rc = modbus_hal_drive_new(h, c, i, section)))
+            return rc;
+    }
+    if ((rc = hal_pin_bit_newf(h, HAL_OUT, &c->fault_any, "modbus.fault-any")) ||
+        (rc = hal_export_functf(h, modbus_hal_update, c, "modbus.update")))
+        return rc;
+    for (int i = 0; !inline_io && i < c->count; i++)
+        if (modbus_link_start(&c->d[i].link))
+            return hal_error(h, HAL_ERR_RT, "modbus: drive %d: %s", i,
+                             modbus_drive_strerror(MODBUS_DRIVE_ERR_THREAD));
+    return HAL_OK;
+}
+
+const struct hal_comp_type hal_comp_modbus = { "modbus", modbus_hal_load };
