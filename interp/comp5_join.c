@@ -56,7 +56,7 @@ static void comp5_join_outside(const struct comp5_seg *a, const double ua[3],
     }
     j->kind = COMP5_JOIN_OUTSIDE;
     for (int i = 0; i < 3; i++)
-        j->normal[i] = n[i] / sin_mag;
+        j->normal[i] = n[i] / sin_mag + 0.0; /* + 0.0 turns -0 into 0 for the printout */
 }
 
 /* Classifies the corner: inside when the next segment turns towards the compensation side
