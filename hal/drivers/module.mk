@@ -3,6 +3,7 @@
 LIB_SRCS += hal/drivers/modbus_drive.c hal/drivers/modbus_link.c hal/drivers/modbus_cfg.c \
             hal/drivers/modbus_hal.c
 HAL_COMPS += modbus
+BENCHES += bench_modbus
 # CiA 402 over CAN: CiA 301 codec, master core, SocketCAN transport, bus-load arithmetic.
 LIB_SRCS += hal/drivers/canopen.c hal/drivers/canopen_config.c hal/drivers/canopen_master.c \
             hal/drivers/cia402.c hal/drivers/can_bus.c hal/drivers/can_load.c hal/drivers/cia402_hal.c
@@ -10,3 +11,4 @@ HAL_COMPS += cia402
 TESTS += test_can_proto
 TESTS += test_cia402_master
 TESTS += test_can_bus
+TESTS += test_can_hal
