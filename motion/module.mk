@@ -1,4 +1,4 @@
 # motion/: segment queue, velocity planner, servo-period interpolator, and its HAL component.
 LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/motion_plan.c \
             motion/motion_step.c
-TESTS += test_motion
+TESTS += test_motion test_motion_run test_motion_legs

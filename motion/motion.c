@@ -120,6 +120,8 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);
+    if (err && errlen)
+        err[0] = 0;
     return MOTION_OK;
 }
 
@@ -252,9 +254,9 @@ int motion_feedback(struct motion *m, const double *fb)
         if (!(fabs(m->ferror[i]) <= lim)) {
             char at[200];
             where(m, at, sizeof at);
-            motion_set_msg(m, "%s: following error on leg %d: the leg is %.4f mm "
-                     "off its commanded length, more than the %.4f mm allowed at %.2f mm/s; "
-                     "machine stopped", at, i + 1, fabs(m->ferror[i]), lim,
+            motion_set_msg(m, "%s: following error on leg %d ([JOINT_%d]): the leg "
+                     "is %.4f mm off its commanded length, more than the %.4f mm allowed at "
+                     "%.2f mm/s; machine stopped", at, i + 1, i, fabs(m->ferror[i]), lim,
                      fabs(m->joint_vel[i]));
             halt(m, MOTION_ERR_FERROR);
             return MOTION_ERR_FERROR;

@@ -24,6 +24,7 @@
 #define FD_H 0.05              /* finite-difference step along the path, mm (deg) */
 #define LEG_ACC_SPLIT 0.5      /* share of a leg's acceleration for the path acceleration term */
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
+#define KIN_TOL_SHARE 0.9      /* the d^2 estimate is first order: keep 10 % in hand */
 
 /* One path sample through the kinematics: pose, its s-derivative, legs and their
  * first and second s-derivatives. */
@@ -122,9 +123,9 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg, const s
         ang = fmax(ang, fabs(q[i] - shift * S->dp[i]));
     double dmax = HUGE_VAL;
     if (perp2 > 1e-30)
-        dmax = sqrt(8 * c->kin_tol_mm / sqrt(perp2));
+        dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / sqrt(perp2));
     if (ang > 1e-30 && c->kin_tol_deg > 0)
-        dmax = fmin(dmax, sqrt(8 * c->kin_tol_deg / ang));
+        dmax = fmin(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
     double T = c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
     return dmax / T;
 }
@@ -139,9 +140,9 @@ static int unreachable(struct motion *m, const struct motion_seg *sg, const stru
     for (int i = 0; i < m->nj; i++) {
         double over = S->L[i] - k->joint_max[i], under = k->joint_min[i] - S->L[i];
         if (over > 0 || under > 0) {
-            snprintf(err, errlen, "%s:%d: the move leaves the machine's reach: leg %d would be "
-                     "%.3f mm long, %.3f mm %s its %s of %.3f mm, at X%.3f Y%.3f Z%.3f A%.3f "
-                     "B%.3f C%.3f", f, sg->line, i + 1, S->L[i], over > 0 ? over : under,
+            snprintf(err, errlen, "%s:%d: the move leaves the machine's reach: leg %d "
+                     "([JOINT_%d]) would be %.3f mm long, %.3f mm %s its %s of %.3f mm, at X%.3f "
+                     "Y%.3f Z%.3f A%.3f B%.3f C%.3f", f, sg->line, i + 1, i, S->L[i], over > 0 ? over : under,
                      over > 0 ? "beyond" : "below", over > 0 ? "maximum" : "minimum",
                      over > 0 ? k->joint_max[i] : k->joint_min[i], P[0], P[1], P[2], P[3], P[4], P[5]);
             return MOTION_ERR_UNREACHABLE;

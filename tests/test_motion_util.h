@@ -166,4 +166,70 @@ static inline void tm_run(struct motion *m, double dt, int max_steps, struct tm_
     s->last = prev;
 }
 
+/* The kinematic deviation a drive produces: it gets a set point every T and moves each leg
+ * linearly between set points. Between successive set points (legs La, Lb) the legs pass
+ * La + (Lb - La) j / 10, j = 1..9; the forward kinematics of those gives the pose really
+ * reached. Its distance from the programmed line S -> E (X Y Z) and its orientation's
+ * deviation from the programmed A B C at the same place along the line are the errors.
+ * Runs the loaded, started program to its end; returns -1 if a forward solve failed. */
+struct tm_dev { double pos_mm, ang_deg, time_s; int setpoints; };
+static inline int tm_deviation(struct motion *m, struct kins *k, const double *S,
+                               const double *E, double T, struct tm_dev *out)
+{
+    struct motion_out a, b;
+    double d[3], n2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = E[i] - S[i], n2 += d[i] * d[i];
+    memset(out, 0, sizeof *out);
+    motion_step(m, T, &a);
+    for (int step = 0; step < 10000000 && a.state != MOTION_DONE; step++) {
+        motion_step(m, T, &b);
+        double guess[6];
+        memcpy(guess, a.pose, sizeof guess);
+        for (int j = 1; j < 10; j++) {
+            double L[KINS_MAX_JOINTS], P[6], u = 0, e2 = 0;
+            for (int i = 0; i < 6; i++)
+                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+            memcpy(P, guess, sizeof P);
+            if (kins_forward(k, L, P, NULL) != KINS_OK)
+                return -1;
+            memcpy(guess, P, sizeof guess);
+            for (int i = 0; i < 3; i++)
+                u += (P[i] - S[i]) * d[i];
+            u /= n2;
+            for (int i = 0; i < 3; i++)
+                e2 += (P[i] - S[i] - u * d[i]) * (P[i] - S[i] - u * d[i]);
+            out->pos_mm = fmax(out->pos_mm, sqrt(e2));
+            for (int i = 3; i < 6; i++)
+                out->ang_deg = fmax(out->ang_deg, fabs(P[i] - S[i] - u * (E[i] - S[i])));
+        }
+        out->setpoints++;
+        a = b;
+    }
+    out->time_s = a.time_elapsed_s;
+    return 0;
+}
+
+/* The TMU hexapod with generous path and leg limits, so that only the kinematic-error bound
+ * holds a fast five-axis move back; set points every period_s; tol_mm 0 turns the bound off. */
+static inline struct tk_cfg *tm_fast_hexapod_cfg(double period_s, double tol_mm)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    if (!c)
+        return NULL;
+    tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "1000");
+    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "2000");
+    tk_set(c, "TRAJ", "MAX_ANGULAR_VELOCITY", "1000");
+    tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "20000");
+    tk_setf(c, "TRAJ", "KINEMATIC_TOLERANCE", tol_mm);
+    tk_setf(c, "EMCMOT", "SERVO_PERIOD", period_s * 1e9);
+    for (int i = 0; i < 6; i++) {
+        char sec[16];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        tk_set(c, sec, "MAX_VELOCITY", "1000");
+        tk_set(c, sec, "MAX_ACCELERATION", "20000");
+    }
+    return c;
+}
+
 #endif

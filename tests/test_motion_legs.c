@@ -1,0 +1,156 @@
+/* test_motion_legs.c: leg speed and acceleration limits, and the kinematic-error bound. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+
+static const double S0[6] = {-60, -40, 630, -8, 6, -12};
+static const double E0[6] = {60, 40, 660, 8, -6, 12};
+
+/* Loads S0 -> E0 at feed_mm_min and starts it. */
+static void load_move(struct tm_machine *mc, const double *S, const double *E,
+                      double feed_mm_min)
+{
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, S, 6 * sizeof *S);
+    tm_add(&p, CANON_FEED, 8, E, feed_mm_min, 0);
+    char err[512] = "";
+    ck_assert_msg(motion_load(mc->m, &p, err, sizeof err) == MOTION_OK, "load: %s", err);
+    ck_assert_int_eq(motion_start(mc->m), MOTION_OK);
+    canon_prog_free(&p);
+}
+
+/* Tight legs (20 mm/s, 200 mm/s^2) and a feed of 100 mm/s that would drive some leg far
+ * beyond 20 mm/s: no leg ever exceeds its limits, and the busiest leg still gets close to
+ * its speed limit (the feed is lowered only as far as needed). */
+START_TEST(test_leg_limits_hold)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c);
+    for (int i = 0; i < 6; i++) {
+        char sec[16];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        tk_set(c, sec, "MAX_VELOCITY", "20");
+        tk_set(c, sec, "MAX_ACCELERATION", "200");
+    }
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    /* what the programmed feed would ask of the legs at the middle of the move */
+    double mid[6], vel[6], rates[6], worst = 0, len = 0;
+    for (int i = 0; i < 3; i++)
+        len += (E0[i] - S0[i]) * (E0[i] - S0[i]);
+    len = sqrt(len);
+    for (int i = 0; i < 6; i++)
+        mid[i] = 0.5 * (S0[i] + E0[i]), vel[i] = (E0[i] - S0[i]) / len * 100;
+    ck_assert_int_eq(kins_leg_rates(mc.kins, mid, vel, rates), KINS_OK);
+    for (int i = 0; i < 6; i++)
+        worst = fmax(worst, fabs(rates[i]));
+    ck_assert_msg(worst > 40, "the test move is not demanding enough: %.1f mm/s", worst);
+    load_move(&mc, S0, E0, 6000);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    ck_assert_int_gt(info.limited_by_legs, 0);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 1000000, &s, NULL, NULL);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    double busiest = 0;
+    for (int i = 0; i < 6; i++) {
+        ck_assert_msg(s.max_leg_v[i] <= 20, "leg %d at %.4f mm/s", i + 1, s.max_leg_v[i]);
+        ck_assert_msg(s.max_cmd_leg_v[i] <= 20, "leg %d rate %.4f", i + 1, s.max_cmd_leg_v[i]);
+        ck_assert_msg(s.max_leg_a[i] <= 200 * 1.001, "leg %d at %.2f mm/s^2", i + 1,
+                      s.max_leg_a[i]);
+        busiest = fmax(busiest, s.max_leg_v[i]);
+        ck_assert_double_eq_tol(s.last.pose[i], E0[i], 1e-9);
+    }
+    ck_assert_msg(busiest > 0.9 * 20, "legs held far below their limit: %.2f mm/s", busiest);
+    tm_close(&mc);
+}
+END_TEST
+
+/* The machine's own legs (100 mm/s) on a move that keeps them well within: the path runs at
+ * the programmed feed, not lower. */
+START_TEST(test_leg_limits_not_needless)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c);
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    load_move(&mc, S0, E0, 1200);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    ck_assert_int_eq(info.limited_by_legs, 0);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 1000000, &s, NULL, NULL);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_msg(s.max_v_mm_s > 20 * (1 - 1e-9) && s.max_v_mm_s <= 20 * (1 + 1e-9),
+                  "path speed %.6f, feed 20", s.max_v_mm_s);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Runs S -> E at a fast feed with set points every T; returns the measured deviation. */
+static struct tm_dev deviation(const double *S, const double *E, double T, double tol_mm)
+{
+    struct tk_cfg *c = tm_fast_hexapod_cfg(T, tol_mm);
+    ck_assert_ptr_nonnull(c);
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    load_move(&mc, S, E, 30000);              /* 500 mm/s programmed */
+    struct tm_dev d;
+    ck_assert_int_eq(tm_deviation(mc.m, mc.kins, S, E, T, &d), 0);
+    tm_close(&mc);
+    return d;
+}
+
+/* The paper's interpolator: with set points at 1 kHz and at 100 Hz, the tool point leaves the
+ * programmed line by at most KINEMATIC_TOLERANCE (0.001 mm) and the orientation by at most
+ * KINEMATIC_ANGULAR_TOLERANCE (0.001 deg), measured through the forward kinematics of the
+ * legs as the drives interpolate them. Without the bound, 100 Hz set points on the same move
+ * leave the line by far more. */
+START_TEST(test_kinematic_deviation)
+{
+    static const double moves[2][2][6] = {
+        {{-60, -40, 630, -8, 6, -12}, {60, 40, 660, 8, -6, 12}},
+        {{80, -90, 660, 10, 0, 15}, {-80, 90, 625, -10, 8, -15}},
+    };
+    for (int k = 0; k < 2; k++) {
+        const double *S = moves[k][0], *E = moves[k][1];
+        struct tm_dev fast = deviation(S, E, 0.001, 0.001);
+        struct tm_dev slow = deviation(S, E, 0.01, 0.001);
+        struct tm_dev off = deviation(S, E, 0.01, 0);
+        ck_assert_msg(fast.pos_mm <= 0.001 && fast.ang_deg <= 0.001,
+                      "1 kHz: %.6f mm %.6f deg", fast.pos_mm, fast.ang_deg);
+        ck_assert_msg(slow.pos_mm <= 0.001 && slow.ang_deg <= 0.001,
+                      "100 Hz: %.6f mm %.6f deg", slow.pos_mm, slow.ang_deg);
+        ck_assert_msg(off.pos_mm > 0.003, "100 Hz without the bound: only %.6f mm", off.pos_mm);
+        ck_assert(slow.time_s > off.time_s);          /* the bound costs time */
+        ck_assert_int_gt(fast.setpoints, 100);
+    }
+}
+END_TEST
+
+static Suite *legs_suite(void)
+{
+    Suite *s = suite_create("motion_legs");
+    TCase *tc = tcase_create("legs");
+    tcase_add_test(tc, test_leg_limits_hold);
+    tcase_add_test(tc, test_leg_limits_not_needless);
+    tcase_add_test(tc, test_kinematic_deviation);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(legs_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
