@@ -60,7 +60,8 @@ static int centre_from_ijk(struct interp *in, const struct plane_axes *p, const 
                            "words of this plane are %c and %c", p->wn - 32, in->plane,
                            p->w1 - 32, p->w2 - 32);
     if (!W(p->w1) && !W(p->w2))
-        return interp_fail(in, INTERP_ERR_WORD, 0, "arc with neither R nor a centre word (%c, "
+        return interp_fail(in, INTERP_ERR_WORD, in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0,
+                           "arc with neither R nor a centre word (%c, "
                            "%c) for G%d", p->w1 - 32, p->w2 - 32, in->plane);
     double o1 = W(p->w1) ? interp_len_mm(in, V(p->w1)) : 0.0;
     double o2 = W(p->w2) ? interp_len_mm(in, V(p->w2)) : 0.0;
@@ -81,14 +82,15 @@ static int check_radii(struct interp *in, const double s[2], const double e[2], 
 {
     double r1 = hypot(s[0] - c[0], s[1] - c[1]), r2 = hypot(e[0] - c[0], e[1] - c[1]);
     double k = in->inch ? 1.0 / MM_PER_INCH : 1.0, tol = in->inch ? ARC_TOL_IN : ARC_TOL_MM;
+    int col = in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0;
     const char *u = in->inch ? "in" : "mm";
     if (r1 * k < 1e-9 || r2 * k < 1e-9)
-        return interp_fail(in, INTERP_ERR_ARC, 0, "zero-radius arc: the centre is on the %s "
+        return interp_fail(in, INTERP_ERR_ARC, col, "zero-radius arc: the centre is on the %s "
                            "point (start radius %.4f %s, end radius %.4f %s)",
                            r1 * k < 1e-9 ? "start" : "end", r1 * k, u, r2 * k, u);
     double err = fabs(r1 - r2) * k, rel = err / fmax(r1 * k, r2 * k);
     if (err > tol * 100.0 || (rel > ARC_REL_TOL && err > tol))
-        return interp_fail(in, INTERP_ERR_ARC, 0, "the end of the arc is not on its circle: "
+        return interp_fail(in, INTERP_ERR_ARC, col, "the end of the arc is not on its circle: "
                            "radius %.4f %s at the start, %.4f %s at the end (difference %.4f %s; "
                            "check the centre words and the end point)", r1 * k, u, r2 * k, u,
                            err, u);

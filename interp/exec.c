@@ -83,11 +83,12 @@ int interp_straight(struct interp *in, enum canon_type t, const double end[6])
 /* Feed moves need a feed: a non-zero F in force, or F in this very block under G93. */
 int interp_need_feed(struct interp *in, const char *what)
 {
+    int col = in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0;
     if (in->inverse_time && !W('f'))
-        return interp_fail(in, INTERP_ERR_WORD, 0, "%s in inverse time mode (G93) needs an F "
+        return interp_fail(in, INTERP_ERR_WORD, col, "%s in inverse time mode (G93) needs an F "
                            "word in the same block", what);
     if (in->f_word <= 0.0)
-        return interp_fail(in, INTERP_ERR_WORD, 0, "%s with zero feed rate: give an F word "
+        return interp_fail(in, INTERP_ERR_WORD, col, "%s with zero feed rate: give an F word "
                            "first", what);
     return 0;
 }

@@ -112,9 +112,13 @@ static int read_word(struct interp *in, int *pos)
     if (c == 'e' || (c < 'a' || c > 'z'))
         return interp_fail(in, INTERP_ERR_SYNTAX, col,
                            c >= '0' && c <= '9' ? "a number without a word letter before it"
-                                                : "'%c' is not a G-code word", c);
+                                                : "'%c' is not a G-code word",
+                           c >= 'a' && c <= 'z' ? c - 32 : c);
     (*pos)++;
-    if (in->norm[*pos] == 0)
+    int k = *pos;
+    while (in->norm[k] >= 'a' && in->norm[k] <= 'z')
+        k++;
+    if (in->norm[*pos] == 0 || (k > *pos && in->norm[k] != '['))
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value", c - 32);
     double v;
     CHP(interp_read_value(in, pos, &v));
@@ -131,7 +135,7 @@ static int read_word(struct interp *in, int *pos)
         b->n_present = 1;
         return 0;
     }
-    int k = c - 'a';
+    k = c - 'a';
     if (b->col[k])
         return interp_fail(in, INTERP_ERR_WORD, col,
                            "two %c words in one block (the first is at column %d)", c - 32,

@@ -99,10 +99,9 @@ int interp_home(struct interp *in, int g)
     }
     double t[6];
     int all = !any_axis(in);
-    if (!all) {
-        interp_target(in, 0, t);
-        CHP(interp_straight(in, CANON_TRAVERSE, t));
-    }
+    interp_target(in, 0, t); /* the intermediate point (LinuxCNC moves there even when it is
+                              * the current point) */
+    CHP(interp_straight(in, CANON_TRAVERSE, t));
     for (int i = 0; i < 6; i++)
         t[i] = all || W(axis_letter[i]) ? in->params[base + i] : in->pos[i];
     return interp_straight(in, CANON_TRAVERSE, t);

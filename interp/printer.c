@@ -108,26 +108,44 @@ static void put_arc(struct interp_printer *p, const struct interp_view *v,
     put(p, ")\n", 2);
 }
 
-/* The offsets in force, in program units, as rs274's SET_*_OFFSET lines. */
-static void put_offsets(struct interp_printer *p, const struct interp_view *v)
+/* Six values scaled to program units (X Y Z), separated by sep. */
+static void put_six(struct interp_printer *p, const double v[6], double k, const char *sep)
 {
-    double k = v->inch ? 1.0 / MM_PER_INCH : 1.0, g5x[7], g92[6];
-    g5x[0] = v->coord_system;
     for (int i = 0; i < 6; i++) {
-        g5x[i + 1] = v->g5x_mm[i] * (i < 3 ? k : 1.0);
-        g92[i] = v->g92_mm[i] * (i < 3 ? k : 1.0);
+        if (i)
+            puts_(p, i == 3 ? ", " : sep);
+        put_num(p, v[i] * (i < 3 ? k : 1.0), 4);
     }
-    char tmp[32];
-    line_start(p, NULL);
-    put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_G5X_OFFSET(%d, ", v->coord_system));
-    for (int i = 1; i < 7; i++) {
-        if (i > 1)
-            put(p, ", ", 2);
-        put_num(p, g5x[i], 4);
+}
+
+/* The offsets that changed, in program units, as rs274's SET_G5X_OFFSET, SET_G92_OFFSET and
+ * USE_TOOL_LENGTH_OFFSET lines (all of them when all is set). */
+static void put_offsets(struct interp_printer *p, const struct interp_view *v, int all)
+{
+    double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
+    char tmp[48];
+    if (all || v->coord_system != p->coord || memcmp(v->g5x_mm, p->g5x, sizeof p->g5x)) {
+        line_start(p, NULL);
+        put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_G5X_OFFSET(%d, ", v->coord_system));
+        put_six(p, v->g5x_mm, k, ", ");
+        put(p, ")\n", 2);
     }
-    put(p, ")\n", 2);
-    line_start(p, NULL);
-    put_call(p, "SET_G92_OFFSET", g92, 6, 4);
+    if (all || memcmp(v->g92_mm, p->g92, sizeof p->g92)) {
+        line_start(p, NULL);
+        puts_(p, "SET_G92_OFFSET(");
+        put_six(p, v->g92_mm, k, ", ");
+        put(p, ")\n", 2);
+    }
+    if (!all && memcmp(v->tool_mm, p->tool, sizeof p->tool)) {
+        line_start(p, NULL);
+        puts_(p, "USE_TOOL_LENGTH_OFFSET(");
+        put_six(p, v->tool_mm, k, " ");
+        puts_(p, ", 0.0000 0.0000 0.0000)\n");
+    }
+    p->coord = v->coord_system;
+    memcpy(p->g5x, v->g5x_mm, sizeof p->g5x);
+    memcpy(p->g92, v->g92_mm, sizeof p->g92);
+    memcpy(p->tool, v->tool_mm, sizeof p->tool);
 }
 
 /* Everything but the moves. */
@@ -192,7 +210,7 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
         puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
     }
     if (c->type == CANON_OFFSETS) {
-        put_offsets(p, &v);
+        put_offsets(p, &v, 0);
         return p->failed ? -1 : 0;
     }
     line_start(p, c);
@@ -230,7 +248,7 @@ int interp_printer_preamble(struct interp_printer *p)
     interp_get_view(p->in, &v);
     line_start(p, NULL);
     puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
-    put_offsets(p, &v);
+    put_offsets(p, &v, 1);
     line_start(p, NULL);
     puts_(p, "SET_XY_ROTATION(0.0000)\n");
     line_start(p, NULL);

@@ -20,6 +20,8 @@ struct interp_printer {
     int digits;                  /* decimals of coordinates (rs274: 4) */
     long seq;                    /* output line counter, as rs274's first column */
     int inch;                    /* units last announced */
+    int coord;                   /* offsets last announced: coordinate system, */
+    double g5x[6], g92[6], tool[6]; /* work, G92 and tool offsets (mm, deg) */
     int failed;                  /* a write failed */
     size_t len;                  /* bytes waiting in buf */
     char buf[INTERP_PRINTER_BUF];

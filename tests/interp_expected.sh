@@ -1,0 +1,41 @@
+#!/bin/sh
+# Runs `hexcnc interp` on tests/interp_expected/*.ngc and compares its motion lines
+# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL) with those in NAME.out, which LinuxCNC's
+# `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists). The first column
+# (rs274's output line counter) is left out: the two print different non-motion lines.
+# With rs274 installed and REGEN=1 the .out files are made again.
+root=${HEXCNC_ROOT:-.}
+bin=${HEXCNC_BIN:-$root/bin/hexcnc}
+dir=$root/tests/interp_expected
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+pass=0; fail=0
+motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL' | cut -c7-; }
+for ngc in "$dir"/*.ngc; do
+    name=$(basename "$ngc" .ngc)
+    opt=""
+    [ -f "$dir/$name.tbl" ] && opt="-t $name.tbl"
+    if [ "${REGEN:-0}" = 1 ]; then
+        (cd "$dir" && rs274 -g $opt "$name.ngc" > "$name.out" 2>/dev/null)
+    fi
+    motion < "$dir/$name.out" > "$tmp/expected"
+    if ! (cd "$dir" && "$bin" interp $opt "$name.ngc") > "$tmp/out" 2> "$tmp/err"; then
+        echo "FAIL $name: hexcnc interp failed: $(cat "$tmp/err")"
+        fail=$((fail + 1))
+        continue
+    fi
+    motion < "$tmp/out" > "$tmp/got"
+    if [ ! -s "$tmp/expected" ]; then
+        echo "FAIL $name: no motion lines in $name.out"
+        fail=$((fail + 1))
+    elif diff -u "$tmp/expected" "$tmp/got" > "$tmp/diff"; then
+        echo "ok   $name ($(wc -l < "$tmp/expected") motion lines)"
+        pass=$((pass + 1))
+    else
+        echo "FAIL $name: motion lines differ from rs274's:"
+        head -20 "$tmp/diff"
+        fail=$((fail + 1))
+    fi
+done
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
