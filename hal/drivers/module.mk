@@ -12,3 +12,4 @@ TESTS += test_can_proto
 TESTS += test_cia402_master
 TESTS += test_can_bus
 TESTS += test_can_hal
+BENCHES += bench_can
