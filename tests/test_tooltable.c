@@ -103,8 +103,16 @@ START_TEST(test_save_round_trip)
     ck_assert_int_eq(tooltable_load(&t, path, err, sizeof err), TOOLTABLE_OK);
     ck_assert_int_eq(tooltable_set_wear(&t, 3, -0.125), TOOLTABLE_OK);
     ck_assert_int_eq(tooltable_set_wear(&t, 7, -0.1), TOOLTABLE_ERR_NO_TOOL);
+    /* A second name for the old file: a save that renames a new file into place leaves it
+     * alone, one that rewrote the file in place would change it. */
+    char old_link[160];
+    snprintf(old_link, sizeof old_link, "%s/old.tbl", dir);
+    ck_assert_int_eq(link(path, old_link), 0);
     ck_assert_int_eq(tooltable_save(&t, path, err, sizeof err), TOOLTABLE_OK);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir), 2); /* tool.tbl and old.tbl: no temporary left */
+    ck_assert_int_eq(tooltable_load(&u, old_link, err, sizeof err), TOOLTABLE_OK);
+    ck_assert_double_eq(tooltable_find(&u, 3)->wear_mm, 0.0);
+    unlink(old_link);
     ck_assert_int_eq(tooltable_load(&u, path, err, sizeof err), TOOLTABLE_OK);
     ck_assert_int_eq(u.count, t.count);
     for (int i = 0; i < t.count; i++) {
