@@ -70,9 +70,26 @@ static double leg_cmd(int i, int k)
     return 600.0 + 10.0 * i + 5.0 * sin(2.0 * M_PI * 2.0 * k * 1e-3);
 }
 
-/* A graph of the modbus component on a simulated 1 kHz thread, loaded from `ini`. */
+/* The legs' commands, one row per servo period, for the streamer; path in buf. */
+static void write_rows(char *buf, size_t len, int nrows)
+{
+    snprintf(buf, len, "/tmp/test_modbus_rows_XXXXXX");
+    int fd = mkstemp(buf);
+    ck_assert_int_ge(fd, 0);
+    FILE *f = fdopen(fd, "w");
+    for (int k = 0; k < nrows; k++)
+        for (int i = 0; i < NDRIVES; i++)
+            fprintf(f, "%.17g%c", leg_cmd(i, k), i + 1 < NDRIVES ? ' ' : '\n');
+    fclose(f);
+}
+
+/* A graph on a simulated 1 kHz thread, loaded from `ini`:
+ *   streamer (leg commands) -> modbus.N.position-cmd, modbus.fault-any -> estop-latch,
+ *   estop-latch ok-out -> modbus.N.enable, one reset signal for the latch and the drives. */
 static struct hal *make_graph(const char *ini, bool with_server)
 {
+    char rows[64], line[160];
+    write_rows(rows, sizeof(rows), 1200);
     struct hal *h = hal_create();
     ck_assert_ptr_nonnull(h);
     hal_set_sim_clock(h, true);
@@ -81,6 +98,14 @@ static struct hal *make_graph(const char *ini, bool with_server)
     if (with_server)
         cmd(h, "loadrt modbus-sim-server");
     cmd(h, "loadrt modbus");
+    snprintf(line, sizeof(line), "loadrt streamer cfg=ffffff file=%s", rows);
+    cmd(h, line);
+    unlink(rows);
+    for (int i = 0; i < NDRIVES; i++) {
+        snprintf(line, sizeof(line), "net leg-%d-cmd streamer.0.pin.%d => modbus.%d.position-cmd",
+                 i, i, i);
+        cmd(h, line);
+    }
     cmd(h, "loadrt estop-latch");
     cmd(h, "setp estop-latch.0.ok-in 1");
     cmd(h, "net drive-fault modbus.fault-any => estop-latch.0.fault-in");
@@ -88,49 +113,47 @@ static struct hal *make_graph(const char *ini, bool with_server)
            "modbus.2.fault-reset modbus.3.fault-reset modbus.4.fault-reset modbus.5.fault-reset");
     cmd(h, "net machine-ok estop-latch.0.ok-out => modbus.0.enable modbus.1.enable "
            "modbus.2.enable modbus.3.enable modbus.4.enable modbus.5.enable");
+    cmd(h, "addf streamer.0 servo-thread");
     cmd(h, "addf modbus.update servo-thread");
     cmd(h, "addf estop-latch.0 servo-thread");
     ck_assert_int_eq(hal_start(h), HAL_OK);
     return h;
 }
 
-/* One servo period with the legs commanded at period k. */
-static void step(struct hal *h, double **cmds, int k)
+/* One servo period; the streamer puts out row k (the legs at period k). */
+static void step(struct hal *h, int k)
 {
-    for (int i = 0; i < NDRIVES; i++)
-        *cmds[i] = leg_cmd(i, k);
     ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
+    ck_assert_int_eq(*(int32_t *)pin(h, "streamer.0.row", HAL_S32), k + 1);
 }
 
 /* Presses and releases the machine reset (one period each). */
-static void press_reset(struct hal *h, double **cmds, int *k)
+static void press_reset(struct hal *h, int *k)
 {
     cmd(h, "sets machine-reset 1");
-    step(h, cmds, (*k)++);
+    step(h, (*k)++);
     cmd(h, "sets machine-reset 0");
-    step(h, cmds, (*k)++);
+    step(h, (*k)++);
 }
 
 /* Six drives follow a motion; one exchange per 4 servo periods; feedback within the lag. */
 static void follow_motion(struct hal *h, struct modbus_sim *s)
 {
-    double *cmds[NDRIVES], *fb[NDRIVES];
+    double *fb[NDRIVES];
     char name[64];
     for (int i = 0; i < NDRIVES; i++) {
-        snprintf(name, sizeof(name), "modbus.%d.position-cmd", i);
-        cmds[i] = pin(h, name, HAL_FLOAT);
         snprintf(name, sizeof(name), "modbus.%d.position-fb", i);
         fb[i] = pin(h, name, HAL_FLOAT);
     }
     int k = 0;
-    press_reset(h, cmds, &k);                       /* leave the start-up e-stop */
+    press_reset(h, &k);                             /* leave the start-up e-stop */
     ck_assert(*(bool *)pin(h, "estop-latch.0.ok-out", HAL_BIT));
     struct modbus_sim_drive_state st0[NDRIVES];
     for (int i = 0; i < NDRIVES; i++)
         modbus_sim_state(s, i, &st0[i]);
     double worst_mm = 0.0;
     for (int n = 0; n < 1000; n++, k++) {
-        step(h, cmds, k);
+        step(h, k);
         for (int i = 0; n > 20 && i < NDRIVES; i++)
             worst_mm = fmax(worst_mm, fabs(*fb[i] - leg_cmd(i, k)));
     }
@@ -216,32 +239,26 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
     char ini[64];
     write_ini(ini, sizeof(ini), ports, "");
     struct hal *h = make_graph(ini, false);
-    double *cmds[NDRIVES];
-    char name[64];
-    for (int i = 0; i < NDRIVES; i++) {
-        snprintf(name, sizeof(name), "modbus.%d.position-cmd", i);
-        cmds[i] = pin(h, name, HAL_FLOAT);
-    }
     bool *ok = pin(h, "estop-latch.0.ok-out", HAL_BIT);
     bool *fault3 = pin(h, "modbus.3.fault", HAL_BIT), *fault2 = pin(h, "modbus.2.fault", HAL_BIT);
     int k = 0;
-    press_reset(h, cmds, &k);
+    press_reset(h, &k);
     for (int n = 0; n < 20; n++)
-        step(h, cmds, k++);
+        step(h, k++);
     ck_assert(*ok && !*fault3);
     modbus_sim_inject(s, 3, MODBUS_SIM_FAULT_DISCONNECT, 0);
     for (int n = 0; n < 8; n++)
-        step(h, cmds, k++);
+        step(h, k++);
     ck_assert(*fault3);
     ck_assert(!*fault2);
     ck_assert(*(bool *)pin(h, "modbus.fault-any", HAL_BIT));
     ck_assert(!*ok);                                /* e-stop: motion loses enable */
     ck_assert(!*(bool *)pin(h, "modbus.3.connected", HAL_BIT));
     ck_assert_uint_eq(*(uint32_t *)pin(h, "modbus.3.errors", HAL_U32), 1);
-    press_reset(h, cmds, &k);
+    press_reset(h, &k);
     ck_assert(*ok);                                 /* the chain resets in the same press */
     for (int n = 0; n < 8; n++)
-        step(h, cmds, k++);
+        step(h, k++);
     ck_assert(!*fault3 && *ok);
     ck_assert(*(bool *)pin(h, "modbus.3.connected", HAL_BIT));
     struct modbus_sim_drive_state st;
@@ -250,11 +267,11 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
     /* A drive still silent at the reset faults again at its next set point. */
     modbus_sim_inject(s, 1, MODBUS_SIM_FAULT_NO_ANSWER, 0);
     for (int n = 0; n < 8; n++)
-        step(h, cmds, k++);
+        step(h, k++);
     ck_assert(!*ok);
-    press_reset(h, cmds, &k);
+    press_reset(h, &k);
     for (int n = 0; n < 8; n++)
-        step(h, cmds, k++);
+        step(h, k++);
     ck_assert(*(bool *)pin(h, "modbus.1.fault", HAL_BIT));
     ck_assert(!*ok);
     hal_destroy(h);
