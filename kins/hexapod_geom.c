@@ -79,7 +79,7 @@ static int hexapod_read_parametric(struct hexapod *h, const struct kins_config *
 static int hexapod_read_limits(struct hexapod *h, const struct kins_config *cfg, char *err,
                                size_t errlen)
 {
-    char sec[16];
+    char sec[24];
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         int st = kins_cfg_numbers(cfg, sec, "MIN_LIMIT", &h->base.joint_min[i], 1, NULL, err,

@@ -19,7 +19,9 @@ enum kins_status {
     KINS_ERR_UNREACHABLE,    /* pose outside the workspace: some leg length out of range */
     KINS_ERR_LEG_RANGE,      /* a given leg length is outside [min, max] */
     KINS_ERR_IMPOSSIBLE,     /* leg lengths no pose can have (assembly impossible) */
-    KINS_ERR_SINGULAR,       /* Jacobian singular (or above the condition threshold) */
+    KINS_ERR_SINGULAR,       /* Jacobian singular: forward met a pivot too small to divide
+                              * by (check() reports the condition number against the
+                              * configured threshold instead of failing) */
     KINS_ERR_NO_CONVERGE,    /* forward solve hit its iteration limit without converging */
     KINS_ERR_ARG,            /* bad argument (NaN, wrong count) */
     KINS_STATUS_COUNT

@@ -100,7 +100,7 @@ static int trivial_create(const struct kins_config *cfg, struct kins **out, char
     k->ops = &kins_trivial_ops;
     k->njoints = (int)n;
     for (int i = 0; i < k->njoints; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         k->joint_min[i] = -INFINITY;
         k->joint_max[i] = INFINITY;

@@ -49,7 +49,7 @@ START_TEST(test_home_by_hand)
     const double bdeg[6] = { 10, 110, 130, 230, 250, 350 }, pdeg[6] = { 50, 70, 170, 190,
                                                                         290, 310 };
     for (int i = 0; i < 6; i++) {
-        char key[16], val[96];
+        char key[24], val[128];
         snprintf(key, sizeof key, "BASE_%d", i);
         snprintf(val, sizeof val, "%.17g %.17g 0", 500 * cos(bdeg[i] * DEG),
                  500 * sin(bdeg[i] * DEG));
@@ -374,7 +374,7 @@ START_TEST(test_rotation_order)
     struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 100, 2000);
     struct kins *ref = make_kins(c);
     for (int i = 0; i < 6; i++) {
-        char key[16], val[96];
+        char key[24], val[128];
         snprintf(key, sizeof key, "BASE_%d", i);
         snprintf(val, sizeof val, "%.17g %.17g 0", 500 * cos((i * 60 + 5) * DEG),
                  500 * sin((i * 60 + 5) * DEG));
@@ -417,6 +417,8 @@ START_TEST(test_trivial_static)
     pose[2] = 150;
     ck_assert_int_eq(kins_inverse(k, pose, j), KINS_ERR_UNREACHABLE);
     ck_assert_int_eq(kins_tool_point(k, pose, NULL, NULL), KINS_ERR_ARG);
+    kins_free(k);
+    k = NULL;
     tk_set(c, "KINS", "JOINTS", "12");
     ck_assert_int_eq(kins_create(&kins_trivial_ops, &cfg, &k, err, sizeof err),
                      KINS_ERR_CONFIG);

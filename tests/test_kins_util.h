@@ -75,7 +75,7 @@ static inline struct tk_cfg *tk_hexapod(double rb, double rp, double hb, double 
     tk_setf(c, "KINS", "BASE_HALF_ANGLE", hb);
     tk_setf(c, "KINS", "PLATFORM_HALF_ANGLE", hp);
     for (int i = 0; i < 6; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         tk_setf(c, sec, "MIN_LIMIT", lmin);
         tk_setf(c, sec, "MAX_LIMIT", lmax);
