@@ -1,0 +1,218 @@
+/* motion.c: the `motion` HAL component: planner and interpolator of motion/ on the servo thread. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hal/hal.h"
+#include "kins/kins.h"
+#include "motion/motion.h"
+#include "motion/motion_hal.h"
+
+static const char motion_axis_names[KINS_POSE_DIM] = { 'x', 'y', 'z', 'a', 'b', 'c' };
+
+/* The instance: the motion core and its pins. */
+struct motion_comp {
+    struct motion *m;                        /* the planner/interpolator (object "motion") */
+    int nj;                                  /* joints */
+    int start_pending;                       /* a program was handed over and waits to start */
+    double *joint_pos_cmd[KINS_MAX_JOINTS];  /* out: leg length commands, mm */
+    double *joint_vel_cmd[KINS_MAX_JOINTS];  /* out: leg rate commands, mm/s */
+    double *joint_pos_fb[KINS_MAX_JOINTS];   /* in: leg length feedback, mm */
+    double *ferror[KINS_MAX_JOINTS];         /* out: following error (command - feedback), mm */
+    double *pose_cmd[KINS_POSE_DIM];         /* out: commanded pose, mm and deg */
+    double *path_vel;                        /* out: path speed, mm/s */
+    double *feed_override;                   /* in: feed override 0..2 (default 1) */
+    double *time_elapsed;                    /* out: s since the program started */
+    double *time_remaining;                  /* out: planned s left (at override 1) */
+    int32_t *program_line;                   /* out: line being executed */
+    int32_t *state;                          /* out: enum motion_state */
+    bool *done;                              /* out: the program has ended */
+    bool *fault;                             /* out: e-stop, following error or kinematics fault */
+    bool *enable;                            /* in: machine on; dropping it while moving faults */
+    bool *amp_enable;                        /* out: drives may move (enabled, no fault) */
+    bool *estop;                             /* in: true = stop now */
+    bool *pause, *resume, *abort;            /* in: edge triggered */
+    bool last_pause, last_resume, last_abort;/* previous values, for the edges */
+};
+
+/* The command inputs: e-stop, enable, edges of pause/resume/abort, override. */
+static void motion_comp_commands(struct motion_comp *c)
+{
+    enum motion_state st = motion_get_state(c->m);
+    int moving = st == MOTION_RUNNING || st == MOTION_PAUSING || st == MOTION_PAUSED ||
+                 st == MOTION_STOPPING;
+    if (*c->estop || (!*c->enable && moving))
+        motion_estop(c->m);
+    if (*c->enable && c->start_pending && st == MOTION_IDLE) {
+        c->start_pending = 0;
+        motion_start(c->m);
+    }
+    if (*c->pause && !c->last_pause)
+        motion_pause(c->m);
+    if (*c->resume && !c->last_resume)
+        motion_resume(c->m);
+    if (*c->abort && !c->last_abort) {
+        c->start_pending = 0;
+        motion_abort(c->m);
+    }
+    c->last_pause = *c->pause, c->last_resume = *c->resume, c->last_abort = *c->abort;
+    motion_set_feed_override(c->m, *c->feed_override);
+}
+
+/* One servo period: feedback check, commands, then the next set point. */
+static void motion_comp_update(void *arg, long period_ns)
+{
+    struct motion_comp *c = arg;
+    double fb[KINS_MAX_JOINTS];
+    struct motion_out o;
+    for (int i = 0; i < c->nj; i++)
+        fb[i] = *c->joint_pos_fb[i];
+    motion_feedback(c->m, fb);
+    motion_comp_commands(c);
+    motion_step(c->m, (double)period_ns * 1e-9, &o);
+    for (int i = 0; i < c->nj; i++) {
+        *c->joint_pos_cmd[i] = o.joint_pos[i];
+        *c->joint_vel_cmd[i] = o.joint_vel[i];
+        *c->ferror[i] = o.ferror_mm[i];
+    }
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        *c->pose_cmd[i] = o.pose[i];
+    *c->path_vel = o.path_vel;
+    *c->time_elapsed = o.time_elapsed_s;
+    *c->time_remaining = o.time_remaining_s;
+    *c->program_line = o.line;
+    *c->state = (int32_t)o.state;
+    *c->done = o.state == MOTION_DONE;
+    *c->fault = o.state == MOTION_FAULT;
+    *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
+}
+
+/* Frees the instance at hal_destroy. */
+static void motion_comp_free(void *arg)
+{
+    struct motion_comp *c = arg;
+    motion_destroy(c->m);
+    free(c);
+}
+
+/* kins_config over the runtime's INI. */
+static const char *motion_comp_ini(void *ctx, const char *section, const char *key)
+{
+    return hal_ini_get(ctx, section, key);
+}
+
+/* Pins, one group per call so each stays short. */
+static int motion_comp_joint_pins(struct hal *h, struct motion_comp *c)
+{
+    int st = HAL_OK;
+    for (int i = 0; i < c->nj && st == HAL_OK; i++) {
+        st = hal_pin_float_newf(h, HAL_OUT, &c->joint_pos_cmd[i], "motion.joint-pos-cmd-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_float_newf(h, HAL_OUT, &c->joint_vel_cmd[i], "motion.joint-vel-cmd-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_float_newf(h, HAL_IN, &c->joint_pos_fb[i], "motion.joint-pos-fb-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_float_newf(h, HAL_OUT, &c->ferror[i], "motion.ferror-%d", i);
+    }
+    for (int i = 0; i < KINS_POSE_DIM && st == HAL_OK; i++)
+        st = hal_pin_float_newf(h, HAL_OUT, &c->pose_cmd[i], "motion.pose-cmd-%c",
+                                motion_axis_names[i]);
+    return st;
+}
+
+static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
+{
+    int st = hal_pin_float_newf(h, HAL_OUT, &c->path_vel, "motion.path-vel");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_IN, &c->feed_override, "motion.feed-override");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_OUT, &c->time_elapsed, "motion.time-elapsed");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_OUT, &c->time_remaining, "motion.time-remaining");
+    if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->program_line, "motion.program-line");
+    if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->state, "motion.state");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->done, "motion.done");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->fault, "motion.fault");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->enable, "motion.enable");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->amp_enable, "motion.amp-enable");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->estop, "motion.estop");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->pause, "motion.pause");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->resume, "motion.resume");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->abort, "motion.abort");
+    return st;
+}
+
+/* Reads the configuration, creates the motion core on the machine's kinematics, the pins and
+ * motion.update; registers the core as the object "motion". */
+static int motion_comp_load(struct hal *h, int argc, char **argv)
+{
+    struct kins *k = hal_get_object(h, "kins");
+    if (!k)
+        return hal_error(h, HAL_ERR_COMPONENT, "loadrt motion: no kinematics loaded; load it "
+                         "first, e.g. loadrt [KINS]KINEMATICS");
+    int st = hal_args_check(h, "motion", argc, argv, "");
+    if (st != HAL_OK)
+        return st;
+    struct motion_config cfg;
+    struct kins_config kc = { motion_comp_ini, h };
+    char err[400] = "";
+    motion_config_default(&cfg);
+    if (motion_config_read(&cfg, &kc, k->njoints, err, sizeof err) != MOTION_OK)
+        return hal_error(h, HAL_ERR_COMPONENT, "loadrt motion: %s", err);
+    struct motion_comp *c = calloc(1, sizeof *c);
+    if (!c)
+        return hal_error(h, HAL_ERR_NOMEM, "loadrt motion: out of memory");
+    if (motion_create(&cfg, k, &c->m, err, sizeof err) != MOTION_OK) {
+        free(c);
+        return hal_error(h, HAL_ERR_COMPONENT, "loadrt motion: %s", err);
+    }
+    if ((st = hal_on_destroy(h, motion_comp_free, c)) != HAL_OK) {
+        motion_comp_free(c);
+        return st;
+    }
+    c->nj = k->njoints;
+    if ((st = hal_set_object(h, "motion", c->m)) != HAL_OK)
+        return hal_error(h, st, "loadrt motion: a motion component is loaded already");
+    if ((st = motion_comp_joint_pins(h, c)) != HAL_OK || (st = motion_comp_state_pins(h, c)) != HAL_OK)
+        return st;
+    if ((st = hal_set_object(h, "motion-comp", c)) != HAL_OK)
+        return st;
+    if ((st = hal_export_functf(h, motion_comp_update, c, "motion.update")) != HAL_OK)
+        return st;
+    /* Start consistent: commands and unconnected feedback at the home pose's legs. */
+    struct motion_out o;
+    motion_step(c->m, cfg.servo_period_s, &o);
+    for (int i = 0; i < c->nj; i++)
+        *c->joint_pos_cmd[i] = *c->joint_pos_fb[i] = o.joint_pos[i];
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        *c->pose_cmd[i] = o.pose[i];
+    *c->feed_override = 1;
+    return HAL_OK;
+}
+
+const struct hal_comp_type hal_comp_motion = { "motion", motion_comp_load };
+
+/* The motion core of h. */
+struct motion *motion_hal_get(const struct hal *h)
+{
+    return h ? hal_get_object(h, "motion") : NULL;
+}
+
+/* Plans prog and marks it to start when enabled. Call it while motion is idle (it refuses
+ * otherwise), so the servo thread is not reading the plan being replaced. */
+int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, size_t errlen)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c) {
+        if (err && errlen)
+            snprintf(err, errlen, "no motion component: the HAL files must `loadrt motion`");
+        return MOTION_ERR_STATE;
+    }
+    int st = motion_load(c->m, prog, err, errlen);
+    c->start_pending = st == MOTION_OK;
+    return st;
+}
+
+/* The motion core's fault or error text. */
+const char *motion_hal_fault(const struct hal *h)
+{
+    struct motion *m = motion_hal_get(h);
+    return m ? motion_last_error(m) : "no motion component loaded";
+}
