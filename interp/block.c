@@ -93,6 +93,8 @@ int interp_add_m(struct interp *in, double v, int column)
 /* The motion this block will do: its group 1 code, else the modal one for axis words. */
 static int block_motion(const struct interp *in)
 {
+    if (in->blk.g[1] == 800)
+        return -1;
     return in->blk.g[1] >= 0 ? in->blk.g[1] : in->motion;
 }
 

@@ -104,10 +104,7 @@ static int exec_machine_words(struct interp *in)
     if (W('f')) {
         if (V('f') < 0)
             return interp_fail(in, INTERP_ERR_WORD, W('f'), "negative F word (feed) %g", V('f'));
-        in->f_word = V('f');
-        in->feed_mm_min = in->inch ? V('f') * MM_PER_INCH : V('f') * in->feed_factor;
-        if (!in->inverse_time)
-            CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+        in->f_word = V('f'); /* converted once the block's units are known */
     }
     if (W('s')) {
         if (V('s') < 0)
@@ -155,6 +152,10 @@ static int exec_modes(struct interp *in)
         in->plane = b->g[2] / 10;
     if (b->g[6] >= 0)
         in->inch = b->g[6] == 200;
+    /* F is in the units in force (inch/min under G20, else FEED_UNITS) */
+    in->feed_mm_min = in->inch ? in->f_word * MM_PER_INCH : in->f_word * in->feed_factor;
+    if (W('f') && !in->inverse_time)
+        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
     if (b->g[8] >= 0)
         CHP(interp_tool_length(in, b->g[8]));
     if (b->g[12] >= 0) {

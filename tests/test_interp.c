@@ -1,0 +1,321 @@
+/* test_interp.c: lexer, expressions, parameters, modal checks and error behaviour. */
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tests/test_interp_util.h"
+
+/* X of the first traverse of a one-line program "G0 X<expr>". */
+static double eval(const char *expr)
+{
+    char prog[256];
+    struct canon_prog p;
+    snprintf(prog, sizeof prog, "G0 X%s\nM2\n", expr);
+    int rc = run_text(prog, &p, NULL);
+    ck_assert_msg(rc == INTERP_OK, "%s did not run", expr);
+    double x = nth(&p, CANON_TRAVERSE, 0)->end[0];
+    canon_prog_free(&p);
+    return x;
+}
+
+/* The error of a program expected to fail. */
+static struct interp_error fail_of(const char *text)
+{
+    struct canon_prog p;
+    struct interp_error e;
+    int rc = run_text(text, &p, &e);
+    ck_assert_msg(rc != INTERP_OK, "program was accepted: %s", text);
+    ck_assert_int_eq(rc, e.status);
+    canon_prog_free(&p);
+    return e;
+}
+
+START_TEST(lexer_case_spaces_numbers)
+{
+    ck_assert_double_eq(eval("1 2 . 5"), 12.5);
+    ck_assert_double_eq(eval("-.5"), -0.5);
+    ck_assert_double_eq(eval("+3."), 3.0);
+    struct canon_prog p;
+    ck_assert_int_eq(run_text("g1 x 1 y-2 z 3 a4 b 5 c6 f 100\nm2\n", &p, NULL), 0);
+    ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 1, -2, 3, 4, 5, 6, 1e-12);
+    canon_prog_free(&p);
+}
+END_TEST
+
+START_TEST(lexer_comments_n_percent)
+{
+    struct canon_prog p;
+    ck_assert_int_eq(run_text("%\n(first) G0 X1 (second)\nN20 G0 X2 ; not a comment command\n%\n"
+                              "G0 X99\n", &p, NULL), 0);
+    ck_assert_int_eq(count_type(&p, CANON_COMMENT), 1);
+    ck_assert_str_eq(nth(&p, CANON_COMMENT, 0)->text, "second");
+    ck_assert_int_eq(count_type(&p, CANON_TRAVERSE), 2); /* nothing after the closing % */
+    const struct canon_cmd *c = nth(&p, CANON_TRAVERSE, 1);
+    ck_assert_int_eq(c->has_n, 1);
+    ck_assert_int_eq(c->n_number, 20);
+    ck_assert_int_eq(c->line, 3);
+    ck_assert_int_eq(nth(&p, CANON_TRAVERSE, 0)->has_n, 0);
+    canon_prog_free(&p);
+}
+END_TEST
+
+START_TEST(lexer_block_delete)
+{
+    const char *prog = "G0 X1\n/G0 X2\n  / G0 X3\nM2\n";
+    struct canon_prog p;
+    struct interp *in = interp_create();
+    ck_assert_int_eq(run_on(in, prog, &p), 0);
+    ck_assert_int_eq(count_type(&p, CANON_TRAVERSE), 3); /* switch off: lines run */
+    canon_prog_free(&p);
+    interp_set_block_delete(in, 1);
+    ck_assert_int_eq(run_on(in, prog, &p), 0);
+    ck_assert_int_eq(count_type(&p, CANON_TRAVERSE), 1);
+    canon_prog_free(&p);
+    interp_destroy(in);
+}
+END_TEST
+
+START_TEST(expr_precedence)
+{
+    ck_assert_double_eq(eval("[1+2*3]"), 7);
+    ck_assert_double_eq(eval("[2**3**2]"), 64);     /* left to right, as LinuxCNC */
+    ck_assert_double_eq(eval("[2*3**2]"), 18);      /* ** binds tighter than * */
+    ck_assert_double_eq(eval("[10-4-3]"), 3);
+    ck_assert_double_eq(eval("[8/4/2]"), 1);
+    ck_assert_double_eq(eval("[7 MOD 3]"), 1);
+    ck_assert_double_eq(eval("[-7 MOD 3]"), 2);     /* LinuxCNC: never negative */
+    ck_assert_double_eq(eval("[1+2 EQ 3]"), 1);     /* + before EQ */
+    ck_assert_double_eq(eval("[1 OR 0 AND 0]"), 0); /* same level: left to right */
+    ck_assert_double_eq(eval("[2 GT 1 AND 3 LT 2]"), 0);
+    ck_assert_double_eq(eval("[1 XOR 1]"), 0);
+    ck_assert_double_eq(eval("[1 NE 1.00001]"), 0); /* EQ/NE tolerance 0.0001 */
+    ck_assert_double_eq(eval("[2 GE 2]"), 1);
+    ck_assert_double_eq(eval("[2 LE 1]"), 0);
+    ck_assert_double_eq(eval("[[1+2]*[3+4]]"), 21);
+    ck_assert_double_eq(eval("-[2*3]"), -6);
+}
+END_TEST
+
+START_TEST(expr_functions)
+{
+    ck_assert_double_eq_tol(eval("[SIN[30]]"), 0.5, 1e-12);
+    ck_assert_double_eq_tol(eval("[COS[60]]"), 0.5, 1e-12);
+    ck_assert_double_eq_tol(eval("[TAN[45]]"), 1.0, 1e-12);
+    ck_assert_double_eq_tol(eval("[ASIN[1]]"), 90.0, 1e-12);
+    ck_assert_double_eq_tol(eval("[ACOS[0]]"), 90.0, 1e-12);
+    ck_assert_double_eq_tol(eval("[ATAN[1]/[-1]]"), 135.0, 1e-12);
+    ck_assert_double_eq_tol(eval("[SQRT[2]]"), sqrt(2.0), 1e-15);
+    ck_assert_double_eq(eval("[ABS[-3.5]]"), 3.5);
+    ck_assert_double_eq_tol(eval("[EXP[1]]"), exp(1.0), 1e-15);
+    ck_assert_double_eq_tol(eval("[LN[10]]"), log(10.0), 1e-15);
+    ck_assert_double_eq(eval("[FIX[-2.5]]"), -3);
+    ck_assert_double_eq(eval("[FUP[-2.5]]"), -2);
+    ck_assert_double_eq(eval("[ROUND[2.5]]"), 3);
+    ck_assert_double_eq(eval("[ROUND[-2.5]]"), -3);
+    ck_assert_double_eq(eval("sin[90]"), 1);
+}
+END_TEST
+
+START_TEST(expr_errors)
+{
+    struct interp_error e = fail_of("G0 X[1/0]\nM2\n");
+    ck_assert_int_eq(e.status, INTERP_ERR_EXPR);
+    ck_assert_int_eq(e.line, 1);
+    ck_assert_int_eq(e.column, 7);
+    ck_assert_int_eq(fail_of("G0 X[SQRT[-1]]\nM2\n").status, INTERP_ERR_EXPR);
+    ck_assert_int_eq(fail_of("G0 X[LN[0]]\nM2\n").status, INTERP_ERR_EXPR);
+    ck_assert_int_eq(fail_of("G0 X[ASIN[1.5]]\nM2\n").status, INTERP_ERR_EXPR);
+    ck_assert_int_eq(fail_of("G0 X[1 MOD 0]\nM2\n").status, INTERP_ERR_EXPR);
+    ck_assert_int_eq(fail_of("G0 X[1+2\nM2\n").status, INTERP_ERR_SYNTAX);
+    ck_assert_int_eq(fail_of("G0 X[1 ? 2]\nM2\n").status, INTERP_ERR_SYNTAX);
+    ck_assert_int_eq(fail_of("G0 X[FOO[1]]\nM2\n").status, INTERP_ERR_SYNTAX);
+    ck_assert_int_eq(fail_of("G0 X[ATAN[1]]\nM2\n").status, INTERP_ERR_SYNTAX);
+    char deep[200] = "G0 X";
+    for (int i = 0; i < 40; i++)
+        strcat(deep, "[");
+    strcat(deep, "1\nM2\n");
+    ck_assert_int_eq(fail_of(deep).status, INTERP_ERR_EXPR);
+}
+END_TEST
+
+START_TEST(params_read_after_line)
+{
+    struct canon_prog p;
+    ck_assert_int_eq(run_text("#1=5 #2=#1 #3=1 G0 X#1 Y#2\nG0 X#1 Y[#2+1] Z##3\nM2\n", &p, NULL),
+                     0);
+    ck_assert_pose(nth(&p, CANON_TRAVERSE, 0)->end, 0, 0, 0, 0, 0, 0, 1e-12); /* old values */
+    ck_assert_pose(nth(&p, CANON_TRAVERSE, 1)->end, 5, 1, 5, 0, 0, 0, 1e-12);
+    canon_prog_free(&p);
+    ck_assert_int_eq(fail_of("#0=1\nM2\n").status, INTERP_ERR_PARAM);
+    ck_assert_int_eq(fail_of("#1.5=1\nM2\n").status, INTERP_ERR_WORD);
+    ck_assert_int_eq(fail_of("G0 X#<x>\nM2\n").status, INTERP_ERR_UNSUPPORTED);
+}
+END_TEST
+
+/* G10 L2 and G92 values survive in the parameter file, written atomically. */
+START_TEST(params_file_persistence)
+{
+    char dir[] = "/tmp/hexcnc_interp_XXXXXX", path[128], tmp[140];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/hexcnc.var", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    struct interp *in = interp_create();
+    ck_assert_int_eq(interp_set_param_file(in, path), 0); /* missing: starts from zero */
+    struct canon_prog p;
+    ck_assert_int_eq(run_on(in, "G10 L2 P2 X5 Y-6 A7\nG0 X1\nG92 Z3\nM2\n", &p), 0);
+    canon_prog_free(&p);
+    interp_destroy(in);
+    ck_assert_int_ne(access(path, R_OK), -1);
+    ck_assert_int_eq(access(tmp, F_OK), -1);
+    FILE *f = fopen(path, "r");
+    char line[64];
+    int found = 0;
+    while (fgets(line, sizeof line, f))
+        found += strcmp(line, "5241\t5.000000\n") == 0 || strcmp(line, "5244\t7.000000\n") == 0 ||
+                 strcmp(line, "5213\t-3.000000\n") == 0 || strcmp(line, "5210\t1.000000\n") == 0;
+    fclose(f);
+    ck_assert_int_eq(found, 4);
+    in = interp_create();
+    ck_assert_int_eq(interp_set_param_file(in, path), 0);
+    ck_assert_double_eq(interp_param(in, 5242), -6);
+    ck_assert_int_eq(run_on(in, "G55 G0 X0 Y0 Z0\nM2\n", &p), 0);
+    ck_assert_pose(nth(&p, CANON_TRAVERSE, 0)->end, 5, -6, -3, 0, 0, 0, 1e-12); /* G92 back */
+    canon_prog_free(&p);
+    interp_destroy(in);
+    unlink(path);
+    rmdir(dir);
+}
+END_TEST
+
+START_TEST(params_file_errors)
+{
+    char dir[] = "/tmp/hexcnc_interp_XXXXXX", path[128];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/bad.var", dir);
+    FILE *f = fopen(path, "w");
+    fputs("5161 0.0\nabc\n", f);
+    fclose(f);
+    struct interp *in = interp_create();
+    ck_assert_int_eq(interp_set_param_file(in, path), INTERP_ERR_PARAM);
+    ck_assert_ptr_nonnull(strstr(interp_last_error(in)->message, ":2:"));
+    interp_destroy(in);
+    unlink(path);
+    rmdir(dir);
+}
+END_TEST
+
+START_TEST(modal_groups)
+{
+    struct interp_error e = fail_of("G0 G1 X1 F1\nM2\n");
+    ck_assert_int_eq(e.status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(e.column, 4);
+    ck_assert_ptr_nonnull(strstr(e.message, "modal group 1"));
+    ck_assert_int_eq(fail_of("G90 G91\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G54 G55\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G4 P1 G10 L2 P1\nM2\n").status, INTERP_ERR_MODAL); /* group 0 */
+    ck_assert_int_eq(fail_of("M7 M9\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G1 G92 X1 F1\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G80 X1\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G2 G141 X1 W1 F1\nM2\n").status, INTERP_ERR_MODAL);
+    ck_assert_int_eq(fail_of("G1 X1 R2 F1\nM2\n").status, INTERP_ERR_WORD);
+    ck_assert_int_eq(fail_of("G1 X1 X2 F1\nM2\n").status, INTERP_ERR_WORD);
+    e = fail_of("G41 G1 X1 F1\nM2\n");
+    ck_assert_int_eq(e.status, INTERP_ERR_UNSUPPORTED);
+    ck_assert_ptr_nonnull(strstr(e.message, "G141"));
+    e = fail_of("O100 sub\nM2\n");
+    ck_assert_ptr_nonnull(strstr(e.message, "O-words"));
+    ck_assert_ptr_nonnull(strstr(e.message, "not supported yet"));
+}
+END_TEST
+
+/* Nothing is emitted from the failing line on, and the error names file, line and column. */
+START_TEST(error_stops_output)
+{
+    struct canon_prog p;
+    struct interp_error e;
+    ck_assert_int_eq(run_text("G0 X1\nG1 X2 F10\nG1 X3 Y[1/0]\nG0 X4\nM2\n", &p, &e),
+                     INTERP_ERR_EXPR);
+    for (size_t i = 0; i < p.count; i++)
+        ck_assert_int_lt(p.cmds[i].line, 3);
+    ck_assert_int_eq(count_type(&p, CANON_PROGRAM_END), 0);
+    char buf[400];
+    interp_error_format(&e, buf, sizeof buf);
+    ck_assert_str_eq(buf, "t.ngc:3:10: error: division by zero in expression");
+    canon_prog_free(&p);
+    e = fail_of("G0 X1\n");
+    ck_assert_ptr_nonnull(strstr(e.message, "M2"));
+    ck_assert_str_eq(interp_strerror(INTERP_ERR_ARC), "impossible arc");
+}
+END_TEST
+
+/* A sink that stops after n commands. */
+static int stop_after(void *ctx, const struct canon_cmd *c)
+{
+    (void)c;
+    int *n = ctx;
+    return --*n < 0;
+}
+
+START_TEST(sink_can_stop)
+{
+    struct interp *in = interp_create();
+    int n = 1;
+    const char *prog = "G0 X1\nG0 X2\nG0 X3\nM2\n";
+    ck_assert_int_eq(interp_run_text(in, "s.ngc", prog, strlen(prog), stop_after, &n),
+                     INTERP_ERR_SINK);
+    ck_assert_int_eq(interp_last_error(in)->line, 2);
+    interp_destroy(in);
+}
+END_TEST
+
+/* Two interpreters, interleaved, keep their own state. */
+START_TEST(two_interpreters)
+{
+    struct interp *a = interp_create(), *b = interp_create();
+    struct canon_prog pa, pb;
+    ck_assert_int_eq(run_on(a, "G20 G10 L2 P1 X1\n%\n", &pa), 0);
+    ck_assert_int_eq(run_on(b, "G21 G91 G0 X1\n%\n", &pb), 0);
+    canon_prog_free(&pa);
+    canon_prog_free(&pb);
+    ck_assert_int_eq(run_on(a, "G0 X1\nM2\n", &pa), 0);
+    ck_assert_int_eq(run_on(b, "G0 X1\nM2\n", &pb), 0);
+    ck_assert_double_eq_tol(nth(&pa, CANON_TRAVERSE, 0)->end[0], 50.8, 1e-12);
+    ck_assert_double_eq_tol(nth(&pb, CANON_TRAVERSE, 0)->end[0], 2.0, 1e-12);
+    canon_prog_free(&pa);
+    canon_prog_free(&pb);
+    interp_destroy(a);
+    interp_destroy(b);
+}
+END_TEST
+
+static Suite *interp_suite(void)
+{
+    Suite *s = suite_create("interp");
+    TCase *tc = tcase_create("core");
+    tcase_add_test(tc, lexer_case_spaces_numbers);
+    tcase_add_test(tc, lexer_comments_n_percent);
+    tcase_add_test(tc, lexer_block_delete);
+    tcase_add_test(tc, expr_precedence);
+    tcase_add_test(tc, expr_functions);
+    tcase_add_test(tc, expr_errors);
+    tcase_add_test(tc, params_read_after_line);
+    tcase_add_test(tc, params_file_persistence);
+    tcase_add_test(tc, params_file_errors);
+    tcase_add_test(tc, modal_groups);
+    tcase_add_test(tc, error_stops_output);
+    tcase_add_test(tc, sink_can_stop);
+    tcase_add_test(tc, two_interpreters);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(interp_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
