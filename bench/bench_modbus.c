@@ -10,8 +10,10 @@
 #include "sim/modbus_sim.h"
 
 #define NDRIVES 6
-#define CYCLES 2000          /* set-point cycles per approach */
-#define WARMUP 100           /* cycles not counted (connections, caches) */
+#define ROUNDS 10            /* the approaches take turns, so they see the same machine load */
+#define PER_ROUND 200        /* cycles of one approach in one round */
+#define CYCLES (ROUNDS * PER_ROUND)
+#define WARMUP 20            /* cycles not counted at the start of each turn */
 
 /* Monotonic time, ns. */
 static int64_t now_ns(void)
@@ -43,13 +45,12 @@ static struct stats stats_of(double *us, int n)
 }
 
 /* Six drives connected to the simulator with the given exchange. */
-static int open_drives(struct modbus_drive *d, struct modbus_sim *s, enum modbus_exchange ex)
+static int open_drives(struct modbus_drive *d, struct modbus_sim *s)
 {
     for (int i = 0; i < NDRIVES; i++) {
         struct modbus_drive_cfg c;
         modbus_drive_cfg_default(&c, i);
         c.port = modbus_sim_port(s, i);
-        c.exchange = ex;
         c.timeout_us = 500000;
         if (modbus_drive_open(&d[i], &c) || modbus_drive_connect(&d[i])) {
             fprintf(stderr, "bench_modbus: %s\n", modbus_drive_message(&d[i]));
@@ -71,12 +72,11 @@ static int exchange(struct modbus_drive *d, int k)
 }
 
 /* Serial: the calling thread exchanges with each drive in turn; one sample per cycle. */
-static int run_serial(struct modbus_sim *s, enum modbus_exchange ex, double *cycle_us)
+static int run_serial(struct modbus_drive *d, enum modbus_exchange ex, double *cycle_us)
 {
-    struct modbus_drive d[NDRIVES];
-    if (open_drives(d, s, ex))
-        return -1;
-    for (int k = 0; k < CYCLES + WARMUP; k++) {
+    for (int i = 0; i < NDRIVES; i++)
+        d[i].cfg.exchange = ex;
+    for (int k = 0; k < PER_ROUND + WARMUP; k++) {
         int64_t t0 = now_ns();
         for (int i = 0; i < NDRIVES; i++)
             if (exchange(&d[i], k))
@@ -84,8 +84,6 @@ static int run_serial(struct modbus_sim *s, enum modbus_exchange ex, double *cyc
         if (k >= WARMUP)
             cycle_us[k - WARMUP] = (now_ns() - t0) / 1000.0;
     }
-    for (int i = 0; i < NDRIVES; i++)
-        modbus_drive_close(&d[i]);
     return 0;
 }
 
@@ -99,7 +97,7 @@ struct worker {
 static void *worker_main(void *arg)
 {
     struct worker *w = arg;
-    for (int k = 0; k < CYCLES + WARMUP; k++) {
+    for (int k = 0; k < PER_ROUND + WARMUP; k++) {
         pthread_barrier_wait(w->start);
         if (!w->failed && exchange(w->d, k))
             w->failed = 1;
@@ -109,11 +107,10 @@ static void *worker_main(void *arg)
 }
 
 /* One sample per cycle: from release to the last drive's answer. */
-static int run_parallel(struct modbus_sim *s, double *cycle_us)
+static int run_parallel(struct modbus_drive *d, double *cycle_us)
 {
-    struct modbus_drive d[NDRIVES];
-    if (open_drives(d, s, MODBUS_EXCHANGE_FC23))
-        return -1;
+    for (int i = 0; i < NDRIVES; i++)
+        d[i].cfg.exchange = MODBUS_EXCHANGE_FC23;
     pthread_barrier_t start, done;
     pthread_barrier_init(&start, NULL, NDRIVES + 1);
     pthread_barrier_init(&done, NULL, NDRIVES + 1);
@@ -123,7 +120,7 @@ static int run_parallel(struct modbus_sim *s, double *cycle_us)
         w[i] = (struct worker){ &d[i], &start, &done, 0 };
         pthread_create(&t[i], NULL, worker_main, &w[i]);
     }
-    for (int k = 0; k < CYCLES + WARMUP; k++) {
+    for (int k = 0; k < PER_ROUND + WARMUP; k++) {
         int64_t t0 = now_ns();
         pthread_barrier_wait(&start);
         pthread_barrier_wait(&done);
@@ -134,11 +131,25 @@ static int run_parallel(struct modbus_sim *s, double *cycle_us)
     for (int i = 0; i < NDRIVES; i++) {
         pthread_join(t[i], NULL);
         failed |= w[i].failed;
-        modbus_drive_close(&d[i]);
     }
     pthread_barrier_destroy(&start);
     pthread_barrier_destroy(&done);
     return failed ? -1 : 0;
+}
+
+/* The three approaches in turn, ROUNDS times, over one set of connections. */
+static int run_rounds(struct modbus_sim *s, double *a, double *b, double *c)
+{
+    struct modbus_drive d[NDRIVES];
+    int rc = open_drives(d, s);
+    for (int r = 0; !rc && r < ROUNDS; r++) {
+        int o = r * PER_ROUND;
+        rc = run_serial(d, MODBUS_EXCHANGE_SEPARATE, a + o) ||
+             run_serial(d, MODBUS_EXCHANGE_FC23, b + o) || run_parallel(d, c + o);
+    }
+    for (int i = 0; i < NDRIVES; i++)
+        modbus_drive_close(&d[i]);
+    return rc ? -1 : 0;
 }
 
 /* The servo thread's side with the mailbox: post six commands and read six feedbacks while
@@ -195,8 +206,7 @@ int main(void)
     }
     static double a[CYCLES], b[CYCLES], c[CYCLES], m[CYCLES / 2];
     uint32_t mailbox_exchanges = 0;
-    if (run_serial(s, MODBUS_EXCHANGE_SEPARATE, a) || run_serial(s, MODBUS_EXCHANGE_FC23, b) ||
-        run_parallel(s, c) || run_mailbox(s, m, &mailbox_exchanges)) {
+    if (run_rounds(s, a, b, c) || run_mailbox(s, m, &mailbox_exchanges)) {
         modbus_sim_destroy(s);
         return 1;
     }
@@ -204,7 +214,8 @@ int main(void)
     struct stats sa = stats_of(a, CYCLES), sb = stats_of(b, CYCLES), sc = stats_of(c, CYCLES);
     struct stats sm = stats_of(m, CYCLES / 2);
     printf("Modbus TCP, %d simulated drives on 127.0.0.1, %d cycles each; time for all %d drives "
-           "to exchange target+control / actual+status once:\n", NDRIVES, CYCLES, NDRIVES);
+           "to exchange target+control / actual+status once (approaches interleaved in %d rounds):\n",
+           NDRIVES, CYCLES, NDRIVES, ROUNDS);
     print_row("serial, FC16 write + FC3 read (baseline)", sa, sa);
     print_row("serial, one FC23 write-and-read per drive", sb, sa);
     print_row("parallel I/O threads, one FC23 per drive", sc, sa);
