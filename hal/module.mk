@@ -8,4 +8,16 @@ $(BUILD)/hal/hal_load.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
 # Built-in generic components (hal/components/motion.c adds itself elsewhere).
 LIB_SRCS += hal/components/kins.c hal/components/logic.c hal/components/stream.c
 HAL_COMPS += kins sum2 and2 not estop_latch streamer sampler
-TESTS += test_hal_core test_hal_cmd test_hal_ini test_hal_graph test_hal_rt
+TESTS += test_hal_core test_hal_cmd test_hal_ini test_hal_graph test_hal_rt test_hal_plugin
+SCRIPT_TESTS += tests/hal/halcmd.sh
+
+# Plugins for test_hal_plugin (never installed): their hal_* symbols come from the test
+# program, which exports them (-rdynamic).
+HAL_TEST_PLUGINS := $(BUILD)/tests/plugins/hal/demo-plugin.so $(BUILD)/tests/plugins/hal/nosym.so
+$(BUILD)/tests/plugins/hal/demo-plugin.so: tests/hal/plugin_demo.c hal/hal.h
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
+$(BUILD)/tests/plugins/hal/nosym.so: tests/hal/plugin_nosym.c
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
+$(BUILD)/tests/test_hal_plugin: $(HAL_TEST_PLUGINS)

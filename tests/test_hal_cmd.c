@@ -1,11 +1,13 @@
 /* test_hal_cmd.c: the HAL command language: the error message of every file in
  * tests/hal/errors, word for word, and the commands' effects and output. */
 #include <check.h>
+#include <dlfcn.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "hal/hal.h"
+#include "kins/kins.h"
 
 /* Runs in tests/hal so that messages carry the short relative paths. */
 static void enter_test_dir(void)
@@ -218,6 +220,14 @@ END_TEST
 
 START_TEST(kinematics_by_name_becomes_the_kins_component)
 {
+    void *dl = NULL;
+    char err[512];
+    if (!kins_find("trivial", &dl, err, sizeof err)) {
+        fprintf(stderr, "test_hal_cmd: skipping loadrt of kinematics: %s\n", err);
+        return;
+    }
+    if (dl)
+        dlclose(dl);
     struct hal *h = new_hal();
     ck_assert_int_eq(hal_cmd(h, "loadrt [KINS]KINEMATICS", NULL, 0, NULL), HAL_OK);
     ck_assert_ptr_nonnull(hal_get_object(h, "kins"));
