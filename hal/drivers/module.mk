@@ -13,3 +13,4 @@ TESTS += test_cia402_master
 TESTS += test_can_bus
 TESTS += test_can_hal
 BENCHES += bench_can
+TESTS += test_can_e2e
