@@ -127,7 +127,7 @@ static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
 {
     double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_rad / SAMPLE_RAD);
     n = ceil(n);
-    return n < 2 ? 2 : n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
+    return n < 1 ? 1 : n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
 }
 
 /* Spreads the knots of sg evenly over [0, len]. */

@@ -1,6 +1,7 @@
 /* motion_plan.c: samples every move through the kinematics and plans the velocity profile. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "motion/motion_priv.h"
@@ -86,6 +87,28 @@ int motion_solve6(double a[6][6], double b[6])
     return 0;
 }
 
+/* The Jacobian dL/dpose (mm/mm, mm/deg) at S's pose by finite differences of the inverse,
+ * or the cached one when S lies within 2 mm and 1 deg of where that was taken. */
+static void jacobian_near(struct motion *m, const struct sample *S, double J[6][6])
+{
+    int near = m->jc_valid;
+    for (int i = 0; i < 6 && near; i++)
+        near = fabs(S->pose[i] - m->jc_pose[i]) <= (i < 3 ? 2.0 : 1.0);
+    if (!near) {
+        double L1[KINS_MAX_JOINTS], p1[KINS_POSE_DIM], d = 1e-4;
+        for (int j = 0; j < 6; j++) {
+            memcpy(p1, S->pose, sizeof p1);
+            p1[j] += d;
+            kins_inverse(m->kins, p1, L1);
+            for (int i = 0; i < 6; i++)
+                m->jc_J[i][j] = (L1[i] - S->L[i]) / d;
+        }
+        memcpy(m->jc_pose, S->pose, sizeof m->jc_pose);
+        m->jc_valid = 1;
+    }
+    memcpy(J, m->jc_J, sizeof m->jc_J);
+}
+
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
  * linearly between set points T apart, so over a chord of path length d the legs sit off the
  * leg-space curve by d2L d^2 / 8 at mid-chord; through the inverse Jacobian that is a pose
@@ -97,15 +120,10 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg, const s
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0 || m->nj != 6)
         return HUGE_VAL;
-    double J[6][6], q[6], L1[KINS_MAX_JOINTS], p1[KINS_POSE_DIM], d = 1e-4;
-    for (int j = 0; j < 6; j++) {
-        memcpy(p1, S->pose, sizeof p1);
-        p1[j] += d;
-        kins_inverse(m->kins, p1, L1);
-        for (int i = 0; i < 6; i++)
-            J[i][j] = (L1[i] - S->L[i]) / d;
+    double J[6][6], q[6];
+    jacobian_near(m, S, J);
+    for (int j = 0; j < 6; j++)
         q[j] = S->d2L[j];
-    }
     if (motion_solve6(J, q) < 0)
         return -1;
     double shift, w2 = 0;      /* shift: the along-path part of q, in s units */
@@ -158,12 +176,14 @@ static int unreachable(struct motion *m, const struct motion_seg *sg, const stru
 /* Speed caps of one knot: hard (machine, legs, kinematic error) into *hard, with the feed
  * into *cap, and the path acceleration limit into *acc. */
 static int knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
-                     double *hard, double *cap, double *acc, char *err, size_t errlen)
+                     struct sample *Sp, double *hard, double *cap, double *acc, char *err,
+                     size_t errlen)
 {
     const struct motion_config *c = &m->cfg;
     const struct kins *k = m->kins;
     struct sample S;
     int st = sample_at(m, sg, s, &S);
+    *Sp = S;
     for (int i = 0; i < m->nj && st == KINS_OK; i++)  /* catches a leg peaking between knots */
         if (S.L[i] + fabs(S.d2L[i]) * hs * hs / 8 > k->joint_max[i] ||
             S.L[i] - fabs(S.d2L[i]) * hs * hs / 8 < k->joint_min[i])
@@ -221,14 +241,13 @@ static int knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
  * than one servo period of acceleration on every axis and leg, and a corner cut (by the set
  * point chord) within the blend tolerance. 0 when the moves must stop between them. */
 static double junction_speed(struct motion *m, const struct motion_seg *a,
-                             const struct motion_seg *b)
+                             const struct motion_seg *b, const struct sample *Ap,
+                             const struct sample *Bp)
 {
     const struct motion_config *c = &m->cfg;
     if (a->blend_tol_mm <= 0 || a->rotary != b->rotary || a->kind > SEG_ARC || b->kind > SEG_ARC)
         return 0;
-    struct sample A, B;
-    if (sample_at(m, a, a->len, &A) != KINS_OK || sample_at(m, b, 0, &B) != KINS_OK)
-        return 0;
+    const struct sample A = *Ap, B = *Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
     double dx = 0, da = 0, v = HUGE_VAL;
     for (int i = 0; i < 3; i++)
@@ -250,47 +269,68 @@ static double junction_speed(struct motion *m, const struct motion_seg *a,
     return v;
 }
 
-/* Caps at every knot: hard caps into kt (temporarily), caps into kv, acceleration into iacc
- * (per knot here, per interval after passes()); interval caps into ivp and irho (hard). */
-static int all_caps(struct motion *m, char *err, size_t errlen)
+/* Caps of the knots of one segment: hard caps into kt, caps into kv, acceleration into iacc
+ * (per knot here, per interval after passes()); each knot's leg gains |dL/ds| into gain.
+ * first/last receive the samples at the segment's ends (for the joints between segments). */
+static int segment_caps(struct motion *m, const struct motion_seg *sg, double *gain,
+                        struct sample *first, struct sample *last, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
+    double hs = sg->len / (double)(sg->nk - 1);
+    for (size_t i = 0; i < sg->nk; i++) {
+        size_t k = sg->k0 + i;
+        double hard = 0, cap = 0, acc = HUGE_VAL;
+        if (sg->kind <= SEG_ARC) {
+            struct sample S;
+            int st = knot_caps(m, sg, p->ks[k], hs, &S, &hard, &cap, &acc, err, errlen);
+            if (st)
+                return st;
+            for (int l = 0; l < m->nj; l++)
+                gain[k * (size_t)m->nj + l] = fabs(S.dL[l]);
+            if (i == 0)
+                *first = S;
+            if (i + 1 == sg->nk)
+                *last = S;
+        } else {
+            memset(&gain[k * (size_t)m->nj], 0, (size_t)m->nj * sizeof *gain);
+        }
+        p->kt[k] = hard, p->kv[k] = cap, p->iacc[k] = fmin(acc, 1e30);
+    }
+    return MOTION_OK;
+}
+
+/* Caps at every knot (see segment_caps); interval caps into ivp and irho (hard); a knot's
+ * speed suits both neighbouring intervals; joints between segments get their speed. */
+static int all_caps(struct motion *m, double *gain, char *err, size_t errlen)
+{
+    struct motion_plan *p = &m->plan;
+    struct sample prev_end, first, last;
     for (size_t j = 0; j < p->nseg; j++) {
         struct motion_seg *sg = &p->segs[j];
-        double hs = sg->len / (double)(sg->nk - 1);
-        for (size_t i = 0; i < sg->nk; i++) {
-            size_t k = sg->k0 + i;
-            double hard = 0, cap = 0, acc = HUGE_VAL;
-            if (sg->kind <= SEG_ARC) {
-                int st = knot_caps(m, sg, p->ks[k], hs, &hard, &cap, &acc, err, errlen);
-                if (st)
-                    return st;
-            }
-            p->kt[k] = hard, p->kv[k] = cap, p->iacc[k] = fmin(acc, 1e30);
-        }
-        /* An interval's cruise suits both its ends; a knot's speed suits both neighbouring
-         * intervals: the lowest of three. */
-        size_t last = sg->k0 + sg->nk - 1;
-        for (size_t k = sg->k0; k < last; k++) {
+        int st = segment_caps(m, sg, gain, &first, &last, err, errlen);
+        if (st)
+            return st;
+        size_t lk = sg->k0 + sg->nk - 1;
+        for (size_t k = sg->k0; k < lk; k++) {
             p->ivp[k] = fmin(p->kv[k], p->kv[k + 1]);
             p->irho[k] = fmin(p->kt[k], p->kt[k + 1]);
         }
-        p->ivp[last] = p->irho[last] = 0;
-        for (size_t k = sg->k0; k <= last; k++) {
-            double c = k > sg->k0 ? p->ivp[k - 1] : p->ivp[k], h = k > sg->k0 ? p->irho[k - 1] : p->irho[k];
-            if (k < last)
+        p->ivp[lk] = p->irho[lk] = 0;
+        for (size_t k = sg->k0; k <= lk; k++) {
+            double c = k > sg->k0 ? p->ivp[k - 1] : p->ivp[k];
+            double h = k > sg->k0 ? p->irho[k - 1] : p->irho[k];
+            if (k < lk)
                 c = fmin(c, p->ivp[k]), h = fmin(h, p->irho[k]);
             p->kv[k] = c, p->kt[k] = h;
         }
+        double vin = j > 0 ? junction_speed(m, &p->segs[j - 1], sg, &prev_end, &first) : 0;
+        p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
+        if (j > 0)
+            p->kv[p->segs[j - 1].k0 + p->segs[j - 1].nk - 1] =
+                fmin(p->kv[p->segs[j - 1].k0 + p->segs[j - 1].nk - 1], vin);
+        p->kv[lk] = j + 1 < p->nseg ? p->kv[lk] : 0;
+        prev_end = last;
         p->info.samples += sg->nk;
-    }
-    for (size_t j = 0; j < p->nseg; j++) {
-        struct motion_seg *sg = &p->segs[j];
-        size_t first = sg->k0, last = sg->k0 + sg->nk - 1;
-        double vin = j > 0 ? junction_speed(m, &p->segs[j - 1], sg) : 0;
-        double vout = j + 1 < p->nseg ? junction_speed(m, sg, &p->segs[j + 1]) : 0;
-        p->kv[first] = fmin(p->kv[first], vin);
-        p->kv[last] = fmin(p->kv[last], vout);
     }
     return MOTION_OK;
 }
@@ -375,31 +415,46 @@ static void passes(struct motion *m)
     }
 }
 
+/* The largest planned leg rate per leg: |dL/ds| at the knots times the fastest speed of
+ * the intervals on either side. */
+static void leg_rate_report(struct motion *m, const double *gain)
+{
+    struct motion_plan *p = &m->plan;
+    for (size_t k = 0; k < p->nknot; k++) {
+        double v = p->kv[k];
+        if (k > 0)
+            v = fmax(v, p->ivp[k - 1]);
+        if (k + 1 < p->nknot)
+            v = fmax(v, p->ivp[k]);
+        for (int l = 0; l < m->nj; l++)
+            p->info.max_leg_vel_mm_s[l] = fmax(p->info.max_leg_vel_mm_s[l],
+                                               gain[k * (size_t)m->nj + l] * v);
+    }
+}
+
 /* Plans the speeds of the segments made by motion_path_build. */
 int motion_plan_profile(struct motion *m, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
     memset(&p->info, 0, sizeof p->info);
+    m->jc_valid = 0;
     if (p->nseg == 0) {
         p->total_time_s = 0;
         return MOTION_OK;
     }
-    int st = all_caps(m, err, errlen);
-    if (st)
-        return st;
-    passes(m);
-    p->info.time_s = p->total_time_s;
-    p->info.length_mm = p->total_len_mm;
-    p->info.segments = p->nseg;
-    for (size_t j = 0; j < p->nseg; j++) {   /* largest planned leg rate, for the report */
-        const struct motion_seg *sg = &p->segs[j];
-        for (size_t i = 0; i < sg->nk && sg->kind <= SEG_ARC; i += 1 + sg->nk / 16) {
-            struct sample S;
-            sample_at(m, sg, p->ks[sg->k0 + i], &S);
-            for (int l = 0; l < m->nj; l++)
-                p->info.max_leg_vel_mm_s[l] = fmax(p->info.max_leg_vel_mm_s[l],
-                                                  fabs(S.dL[l]) * p->kv[sg->k0 + i]);
-        }
+    double *gain = malloc(p->nknot * (size_t)m->nj * sizeof *gain);
+    if (!gain) {
+        snprintf(err, errlen, "out of memory planning the program");
+        return MOTION_ERR_NOMEM;
     }
-    return MOTION_OK;
+    int st = all_caps(m, gain, err, errlen);
+    if (!st) {
+        passes(m);
+        leg_rate_report(m, gain);
+        p->info.time_s = p->total_time_s;
+        p->info.length_mm = p->total_len_mm;
+        p->info.segments = p->nseg;
+    }
+    free(gain);
+    return st;
 }

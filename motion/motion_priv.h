@@ -75,6 +75,11 @@ struct motion {
     int fault_status;
     char msg[320];           /* last error / fault text */
     double start_pose[KINS_POSE_DIM];
+    /* planning scratch: the Jacobian dL/dpose near jc_pose, reused while the path stays
+     * within a few mm and a degree of it (it changes by well under 1 % there) */
+    double jc_pose[KINS_POSE_DIM];
+    double jc_J[6][6];
+    int jc_valid;
     /* run state */
     double tau_s;            /* position on the plan's time axis, s */
     double rate;             /* current time-scaling rate (feed override in effect) */

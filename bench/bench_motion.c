@@ -1,0 +1,121 @@
+/* bench_motion.c: kinematic deviation with and without the bound, motion_step cost, load time. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "tests/test_motion_util.h"
+
+/* Monotonic time, s. */
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Measured deviation of S -> E at 500 mm/s programmed, set points every T s. */
+static int deviation(const double *S, const double *E, double T, double tol_mm, struct tm_dev *d)
+{
+    struct tk_cfg *c = tm_fast_hexapod_cfg(T, tol_mm);
+    struct tm_machine mc;
+    if (!c || tm_open(&mc, c, &kins_hexapod_ops))
+        return -1;
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, S, 6 * sizeof *S);
+    tm_add(&p, CANON_FEED, 1, E, 30000, 0);
+    char err[512];
+    int st = motion_load(mc.m, &p, err, sizeof err) || motion_start(mc.m) ||
+             tm_deviation(mc.m, mc.kins, S, E, T, d);
+    canon_prog_free(&p);
+    tm_close(&mc);
+    return st ? -1 : 0;
+}
+
+/* A long program of short five-axis moves (a raster with tilts), n blocks, G64. */
+static void long_program(struct canon_prog *p, int n)
+{
+    canon_prog_init(p);
+    double s[6] = {-50, -50, 640, 0, 0, 0};
+    memcpy(p->start, s, sizeof s);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "long.ngc", .value = 0.01};
+    canon_prog_sink(p, &pm);
+    for (int i = 0; i < n; i++) {
+        double e[6], t = i * 0.01;
+        e[0] = -50 + fmod(i * 0.5, 100.0);
+        e[1] = -50 + (double)((i / 200) % 100);
+        e[2] = 640 + 2 * sin(t);
+        e[3] = 3 * sin(0.7 * t), e[4] = 3 * cos(0.5 * t), e[5] = 5 * sin(0.3 * t);
+        tm_add(p, CANON_FEED, i + 2, e, 3000, 0);
+    }
+}
+
+int main(void)
+{
+    static const double S[6] = {-60, -40, 630, -8, 6, -12}, E[6] = {60, 40, 660, 8, -6, 12};
+    struct tm_dev f_on, f_off, s_on, s_off;
+    if (deviation(S, E, 0.001, 0.001, &f_on) || deviation(S, E, 0.001, 0, &f_off) ||
+        deviation(S, E, 0.01, 0.001, &s_on) || deviation(S, E, 0.01, 0, &s_off)) {
+        fprintf(stderr, "bench_motion: cannot build the TMU hexapod (HEXCNC_ROOT?)\n");
+        return 1;
+    }
+    printf("kinematic deviation, five-axis move X-60..60 Y-40..40 Z630..660 A B C +-8..12 deg,\n"
+           "500 mm/s programmed, KINEMATIC_TOLERANCE 0.001 mm, forward kinematics of legs\n"
+           "interpolated linearly between set points (9 points per interval):\n");
+    printf("  1 kHz set points: with bound %.6f mm %.6f deg (%.3f s), without %.6f mm %.6f deg "
+           "(%.3f s): ratio %.2f\n", f_on.pos_mm, f_on.ang_deg, f_on.time_s, f_off.pos_mm,
+           f_off.ang_deg, f_off.time_s, f_off.pos_mm / f_on.pos_mm);
+    printf("  100 Hz set points: with bound %.6f mm %.6f deg (%.3f s), without %.6f mm %.6f deg "
+           "(%.3f s): ratio %.2f\n", s_on.pos_mm, s_on.ang_deg, s_on.time_s, s_off.pos_mm,
+           s_off.ang_deg, s_off.time_s, s_off.pos_mm / s_on.pos_mm);
+
+    struct tm_machine mc;
+    if (tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops))
+        return 1;
+    int n = 200000;
+    struct canon_prog p;
+    long_program(&p, n);
+    char err[512];
+    double t0 = now_s();
+    int st = motion_load(mc.m, &p, err, sizeof err);
+    double t_load = now_s() - t0;
+    if (st) {
+        fprintf(stderr, "bench_motion: %s\n", err);
+        return 1;
+    }
+    /* baseline: one inverse kinematics per block end */
+    double legs[KINS_MAX_JOINTS], sink = 0;
+    t0 = now_s();
+    for (size_t i = 0; i < p.count; i++) {
+        kins_inverse(mc.kins, p.cmds[i].end, legs);
+        sink += legs[0];
+    }
+    double t_ik_blocks = now_s() - t0;
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    printf("load (plan) of %d short five-axis blocks: %.3f s (%.2f us/block, %zu samples); "
+           "one inverse kinematics per block: %.4f s: ratio %.1f\n", n, t_load,
+           1e6 * t_load / n, info.samples, t_ik_blocks, t_load / t_ik_blocks);
+    motion_start(mc.m);
+    struct motion_out o;
+    int steps = 200000;
+    t0 = now_s();
+    for (int k = 0; k < steps; k++)
+        motion_step(mc.m, 0.001, &o);
+    double t_step = (now_s() - t0) / steps;
+    double pose[6] = {10, 5, 645, 1, 2, 3};
+    t0 = now_s();
+    for (int k = 0; k < steps; k++) {
+        pose[0] = 10 + 1e-6 * k;
+        kins_inverse(mc.kins, pose, legs);
+        sink += legs[1];
+    }
+    double t_ik = (now_s() - t0) / steps;
+    printf("motion_step per servo period: %.0f ns; one inverse kinematics: %.0f ns: ratio %.2f "
+           "(%s)\n", 1e9 * t_step, 1e9 * t_ik, t_step / t_ik, sink != 0 ? "ok" : "?");
+    canon_prog_free(&p);
+    tm_close(&mc);
+    return 0;
+}
