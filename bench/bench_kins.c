@@ -12,6 +12,7 @@
 #define NPOSE 50000        /* random poses for the inverse */
 #define NPATH 20000        /* 1 ms samples of the path: 20 s of machining */
 #define NCOLD 5000         /* cold-started forward solves */
+#define CHUNK 500          /* calls per timed chunk */
 #define DEG (M_PI / 180.0)
 
 /* Monotonic time in ns. */
@@ -167,6 +168,160 @@ static int geometry(struct tk_cfg *c, double b[6][3], double p[6][3])
     return 0;
 }
 
+/* Everything the timed loops share. */
+struct bench {
+    struct kins *k;            /* the model under test */
+    double b[6][3], p[6][3];   /* joint coordinates for the baseline, mm */
+    double lever_mm;           /* baseline's lever arm for the stopping rule, mm */
+    double tol_mm;             /* forward tolerance, mm */
+    double (*poses)[6];        /* NPOSE random poses of the working region */
+    double (*legs)[6];         /* their leg lengths (scratch for the inverse loops) */
+    double (*path)[6];         /* NPATH poses of the 1 ms path */
+    double (*plegs)[6];        /* the path's leg lengths */
+    double sink;               /* results folded in so no loop is optimised away */
+    int fails;                 /* forward solves that did not converge */
+};
+
+/* One timed figure: best ns per call of ours and of the baseline, iterations. */
+struct figure {
+    double ns, naive_ns;       /* best of RUNS, ns per call */
+    double iters, naive_iters; /* mean iterations */
+    int max_iters;             /* largest iteration count of ours */
+};
+
+/* Best-of-RUNS ns per inverse, ours and the baseline. Each run is timed in chunks of
+ * CHUNK calls and every chunk keeps its best time, so a chunk preempted by another process
+ * on the shared machine does not count. */
+static struct figure bench_inverse(struct bench *B)
+{
+    struct figure f = { 0, 0, 0, 0, 0 };
+    for (int from = 0; from < NPOSE; from += CHUNK) {
+        double best = 1e99, naive_best = 1e99;
+        for (int run = 0; run < RUNS; run++) {
+            double t0 = now_ns();
+            for (int n = from; n < from + CHUNK; n++)
+                kins_inverse(B->k, B->poses[n], B->legs[n]);
+            double t1 = now_ns();
+            B->sink += B->legs[from][3];
+            for (int n = from; n < from + CHUNK; n++)
+                naive_inverse(B->b, B->p, B->poses[n], B->legs[n]);
+            double t2 = now_ns();
+            B->sink += B->legs[from][2];
+            best = fmin(best, t1 - t0);
+            naive_best = fmin(naive_best, t2 - t1);
+        }
+        f.ns += best / NPOSE;
+        f.naive_ns += naive_best / NPOSE;
+    }
+    return f;
+}
+
+/* Forward solves of legs[from..to); warm: each starts from the previous result (the first
+ * from the path pose before it), else from home. Returns total iterations of ours or, with
+ * naive set, of the baseline. */
+static long bench_forward_pass(struct bench *B, double (*legs)[6], int from, int to, int warm,
+                               int naive, int *max_iters)
+{
+    double q[6];
+    long iters = 0;
+    memcpy(q, warm ? B->path[from] : B->k->home, sizeof q);
+    for (int n = from; n < to; n++) {
+        if (!warm)
+            memcpy(q, B->k->home, sizeof q);
+        if (naive) {
+            int it = naive_forward(B->b, B->p, B->lever_mm, legs[n], q, B->tol_mm);
+            B->fails += it < 0;
+            iters += it;
+            continue;
+        }
+        struct kins_fwd_info info;
+        B->fails += kins_forward(B->k, legs[n], q, &info) != KINS_OK;
+        iters += info.iterations;
+        *max_iters = info.iterations > *max_iters ? info.iterations : *max_iters;
+    }
+    B->sink += q[0];
+    return iters;
+}
+
+/* Best-of-RUNS forward timing (chunked as the inverse), warm along the path or cold from
+ * home on random poses. */
+static struct figure bench_forward(struct bench *B, int warm)
+{
+    struct figure f = { 0, 0, 0, 0, 0 };
+    double (*legs)[6] = warm ? B->plegs + 1 : B->legs;
+    int count = warm ? NPATH - 1 : NCOLD;
+    long it = 0, nit = 0;
+    for (int from = 0; from < count; from += CHUNK) {
+        int to = from + CHUNK < count ? from + CHUNK : count;
+        double best = 1e99, naive_best = 1e99;
+        for (int run = 0; run < RUNS; run++) {
+            double t0 = now_ns();
+            long a = bench_forward_pass(B, legs, from, to, warm, 0, &f.max_iters);
+            double t1 = now_ns();
+            long b = bench_forward_pass(B, legs, from, to, warm, 1, &f.max_iters);
+            double t2 = now_ns();
+            best = fmin(best, t1 - t0);
+            naive_best = fmin(naive_best, t2 - t1);
+            if (run == 0)
+                it += a, nit += b;
+        }
+        f.ns += best / count;
+        f.naive_ns += naive_best / count;
+    }
+    f.iters = (double)it / count;
+    f.naive_iters = (double)nit / count;
+    return f;
+}
+
+/* Fills the poses, the path and their legs; checks the baseline computes the same legs. */
+static int bench_setup(struct bench *B, struct tk_cfg *c, double *top_speed_mm_min)
+{
+    B->poses = malloc(sizeof(double[6]) * NPOSE);
+    B->legs = malloc(sizeof(double[6]) * NPOSE);
+    B->path = malloc(sizeof(double[6]) * NPATH);
+    B->plegs = malloc(sizeof(double[6]) * NPATH);
+    if (!B->poses || !B->legs || !B->path || !B->plegs)
+        return -1;
+    uint64_t rng = 42;
+    for (int n = 0; n < NPOSE; n++)
+        tk_rand_pose(&rng, B->poses[n]);
+    *top_speed_mm_min = 0;
+    for (int n = 0; n < NPATH; n++) {
+        path_pose(n * 1e-3, B->path[n]);
+        if (kins_inverse(B->k, B->path[n], B->plegs[n]) != KINS_OK) {
+            fprintf(stderr, "bench_kins: path leaves the workspace at sample %d\n", n);
+            return -1;
+        }
+        if (n > 0) {
+            double (*q)[6] = B->path;
+            *top_speed_mm_min = fmax(*top_speed_mm_min, 60e3 * hypot(hypot(q[n][0] -
+                                     q[n - 1][0], q[n][1] - q[n - 1][1]), q[n][2] - q[n - 1][2]));
+        }
+    }
+    if (geometry(c, B->b, B->p) != 0) {
+        fprintf(stderr, "bench_kins: the baseline needs the parametric geometry keys\n");
+        return -1;
+    }
+    double chk[6];
+    naive_inverse(B->b, B->p, B->path[123], chk);
+    for (int i = 0; i < 6; i++)
+        if (fabs(chk[i] - B->plegs[123][i]) > 1e-9) {
+            fprintf(stderr, "bench_kins: baseline geometry differs from the INI\n");
+            return -1;
+        }
+    B->lever_mm = 0;
+    for (int i = 0; i < 6; i++)
+        B->lever_mm += hypot(B->p[i][0], B->p[i][1]) / 6;
+    return 0;
+}
+
+/* Prints one row: ours, baseline, ratio. */
+static void bench_row(const char *what, double ns, double naive_ns)
+{
+    printf("%-34s %10.1f %10.1f %7.1fx\n", what, ns, naive_ns, naive_ns / ns);
+}
+
+/* Times inverse and forward on the TMU configuration and prints them beside the baseline. */
 int main(void)
 {
     struct tk_cfg *c = tk_ini("configs/sim/tmu-hexapod.ini");
@@ -174,149 +329,39 @@ int main(void)
         fprintf(stderr, "bench_kins: cannot read configs/sim/tmu-hexapod.ini (HEXCNC_ROOT)\n");
         return 1;
     }
+    struct bench B;
+    memset(&B, 0, sizeof B);
     struct kins_config cfg = tk_config(c);
-    struct kins *k = NULL;
     char err[512];
-    if (kins_create(&kins_hexapod_ops, &cfg, &k, err, sizeof err) != KINS_OK) {
+    if (kins_create(&kins_hexapod_ops, &cfg, &B.k, err, sizeof err) != KINS_OK) {
         fprintf(stderr, "bench_kins: %s\n", err);
         return 1;
     }
-    double tol = atof(tk_get(c, "KINS", "FWD_TOLERANCE"));
-    double (*poses)[6] = malloc(sizeof(double[6]) * NPOSE);
-    double (*path)[6] = malloc(sizeof(double[6]) * NPATH);
-    double (*plegs)[6] = malloc(sizeof(double[6]) * NPATH);
-    double (*legs)[6] = malloc(sizeof(double[6]) * NPOSE);
-    if (!poses || !path || !plegs || !legs)
+    B.tol_mm = atof(tk_get(c, "KINS", "FWD_TOLERANCE"));
+    double top_speed;
+    if (bench_setup(&B, c, &top_speed) != 0)
         return 1;
-    uint64_t rng = 42;
-    for (int n = 0; n < NPOSE; n++)
-        tk_rand_pose(&rng, poses[n]);
-    double top_speed = 0;
-    for (int n = 0; n < NPATH; n++) {
-        path_pose(n * 1e-3, path[n]);
-        if (kins_inverse(k, path[n], plegs[n]) != KINS_OK) {
-            fprintf(stderr, "bench_kins: path leaves the workspace at sample %d\n", n);
-            return 1;
-        }
-        if (n > 0)
-            top_speed = fmax(top_speed, 60.0 * 1e3 * hypot(hypot(path[n][0] - path[n - 1][0],
-                             path[n][1] - path[n - 1][1]), path[n][2] - path[n - 1][2]));
-    }
-    double b[6][3], p[6][3];
-    if (geometry(c, b, p) != 0) {
-        fprintf(stderr, "bench_kins: the baseline needs the parametric geometry keys\n");
-        return 1;
-    }
-    /* The baseline must compute the same legs as the model, else it measures something else. */
-    double chk[6];
-    naive_inverse(b, p, path[123], chk);
-    for (int i = 0; i < 6; i++)
-        if (fabs(chk[i] - plegs[123][i]) > 1e-9) {
-            fprintf(stderr, "bench_kins: baseline geometry differs from the INI\n");
-            return 1;
-        }
-    double lever = 0;
-    for (int i = 0; i < 6; i++)
-        lever += hypot(p[i][0], p[i][1]) / 6;
+    struct figure inv = bench_inverse(&B);
+    struct figure warm = bench_forward(&B, 1);
+    struct figure cold = bench_forward(&B, 0);
 
-    double sink = 0;
-    double best_inv = 1e99, best_inv_naive = 1e99, best_warm = 1e99, best_warm_naive = 1e99,
-           best_cold = 1e99, best_cold_naive = 1e99;
-    long warm_iters = 0, cold_iters = 0, naive_warm_iters = 0, naive_cold_iters = 0;
-    int warm_max = 0, cold_max = 0, fails = 0;
-    double warm_err = 0;
-    for (int run = 0; run < RUNS; run++) {
-        double t0 = now_ns();
-        for (int n = 0; n < NPOSE; n++)
-            kins_inverse(k, poses[n], legs[n]);
-        double t1 = now_ns();
-        best_inv = fmin(best_inv, (t1 - t0) / NPOSE);
-        sink += legs[NPOSE / 2][3];
-        t0 = now_ns();
-        for (int n = 0; n < NPOSE; n++)
-            naive_inverse(b, p, poses[n], legs[n]);
-        t1 = now_ns();
-        best_inv_naive = fmin(best_inv_naive, (t1 - t0) / NPOSE);
-        sink += legs[NPOSE / 3][2];
-
-        /* Warm start along the path: each solve starts from the previous result. */
-        double q[6];
-        struct kins_fwd_info info;
-        long iters = 0;
-        memcpy(q, path[0], sizeof q);
-        t0 = now_ns();
-        for (int n = 1; n < NPATH; n++) {
-            fails += kins_forward(k, plegs[n], q, &info) != KINS_OK;
-            iters += info.iterations;
-            warm_max = info.iterations > warm_max ? info.iterations : warm_max;
-        }
-        t1 = now_ns();
-        best_warm = fmin(best_warm, (t1 - t0) / (NPATH - 1));
-        warm_iters = iters;
-        for (int j = 0; j < 6; j++)
-            warm_err = fmax(warm_err, fabs(q[j] - path[NPATH - 1][j]));
-        iters = 0;
-        memcpy(q, path[0], sizeof q);
-        t0 = now_ns();
-        for (int n = 1; n < NPATH; n++) {
-            int it = naive_forward(b, p, lever, plegs[n], q, tol);
-            fails += it < 0;
-            iters += it;
-        }
-        t1 = now_ns();
-        best_warm_naive = fmin(best_warm_naive, (t1 - t0) / (NPATH - 1));
-        naive_warm_iters = iters;
-        sink += q[0];
-
-        /* Cold start: every solve begins at home. */
-        iters = 0;
-        t0 = now_ns();
-        for (int n = 0; n < NCOLD; n++) {
-            memcpy(q, k->home, sizeof q);
-            fails += kins_forward(k, legs[n], q, &info) != KINS_OK;
-            iters += info.iterations;
-            cold_max = info.iterations > cold_max ? info.iterations : cold_max;
-        }
-        t1 = now_ns();
-        best_cold = fmin(best_cold, (t1 - t0) / NCOLD);
-        cold_iters = iters;
-        sink += q[1];
-        iters = 0;
-        t0 = now_ns();
-        for (int n = 0; n < NCOLD; n++) {
-            memcpy(q, k->home, sizeof q);
-            int it = naive_forward(b, p, lever, legs[n], q, tol);
-            fails += it < 0;
-            iters += it;
-        }
-        t1 = now_ns();
-        best_cold_naive = fmin(best_cold_naive, (t1 - t0) / NCOLD);
-        naive_cold_iters = iters;
-        sink += q[2];
-    }
-    printf("hexapod kinematics, configs/sim/tmu-hexapod.ini, tolerance %g mm, best of %d runs\n",
-           tol, RUNS);
-    printf("path: %d samples at 1 ms, top speed %.0f mm/min; warm end error %.2g\n", NPATH,
-           top_speed, warm_err);
+    printf("hexapod kinematics, configs/sim/tmu-hexapod.ini, tolerance %g mm, best of %d runs"
+           " (per chunk of %d calls)\n", B.tol_mm, RUNS, CHUNK);
+    printf("path: %d samples at 1 ms, top speed %.0f mm/min\n", NPATH, top_speed);
     printf("%-34s %10s %10s %8s\n", "", "hexcnc", "naive", "ratio");
-    printf("%-34s %10.1f %10.1f %7.1fx\n", "inverse, ns/pose", best_inv, best_inv_naive,
-           best_inv_naive / best_inv);
-    printf("%-34s %10.1f %10.1f %7.1fx\n", "forward warm (1 kHz path), ns", best_warm,
-           best_warm_naive, best_warm_naive / best_warm);
-    printf("%-34s %10.2f %10.2f\n", "  mean iterations", (double)warm_iters / (NPATH - 1),
-           (double)naive_warm_iters / (NPATH - 1));
-    printf("%-34s %10d\n", "  max iterations", warm_max);
-    printf("%-34s %10.1f %10.1f %7.1fx\n", "forward cold (from home), ns", best_cold,
-           best_cold_naive, best_cold_naive / best_cold);
-    printf("%-34s %10.2f %10.2f\n", "  mean iterations", (double)cold_iters / NCOLD,
-           (double)naive_cold_iters / NCOLD);
-    printf("%-34s %10d\n", "  max iterations", cold_max);
-    printf("failed solves: %d (checksum %.3f)\n", fails, sink);
-    kins_free(k);
-    free(poses);
-    free(path);
-    free(plegs);
-    free(legs);
+    bench_row("inverse, ns/pose", inv.ns, inv.naive_ns);
+    bench_row("forward warm (1 kHz path), ns", warm.ns, warm.naive_ns);
+    printf("%-34s %10.2f %10.2f\n", "  mean iterations", warm.iters, warm.naive_iters);
+    printf("%-34s %10d\n", "  max iterations", warm.max_iters);
+    bench_row("forward cold (from home), ns", cold.ns, cold.naive_ns);
+    printf("%-34s %10.2f %10.2f\n", "  mean iterations", cold.iters, cold.naive_iters);
+    printf("%-34s %10d\n", "  max iterations", cold.max_iters);
+    printf("failed solves: %d (checksum %.3f)\n", B.fails, B.sink);
+    kins_free(B.k);
+    free(B.poses);
+    free(B.legs);
+    free(B.path);
+    free(B.plegs);
     free(c);
-    return fails ? 1 : 0;
+    return B.fails ? 1 : 0;
 }

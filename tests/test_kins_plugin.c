@@ -291,6 +291,7 @@ static Suite *kins_plugin_suite(void)
     return s;
 }
 
+/* Runs the suite; the exit status says whether every check passed. */
 int main(void)
 {
     SRunner *sr = srunner_create(kins_plugin_suite());
