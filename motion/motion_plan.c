@@ -25,6 +25,7 @@
 #define FD_H 0.05              /* finite-difference step along the path, mm (deg) */
 #define LEG_ACC_SPLIT 0.5      /* share of a leg's acceleration for the path acceleration term */
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
+#define JUMP_SHARE 0.5         /* share of a period's acceleration for a G64 corner's jump */
 #define KIN_TOL_SHARE 0.9      /* the d^2 estimate is first order: keep 10 % in hand */
 
 /* One path sample through the kinematics: pose, its s-derivative, legs and their
@@ -237,9 +238,11 @@ static int knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     return MOTION_OK;
 }
 
-/* The speed at which the joint from segment a into b may be passed: a velocity jump no larger
- * than one servo period of acceleration on every axis and leg, and a corner cut (by the set
- * point chord) within the blend tolerance. 0 when the moves must stop between them. */
+/* The speed at which the joint from segment a into b may be passed (G64): the velocity
+ * changes direction within one servo period there, so its jump may use JUMP_SHARE of one
+ * period's acceleration on every axis (a quarter on every leg) while the moves on either
+ * side give up that share of their path acceleration (all_caps); and the corner cut by the
+ * set-point chord stays within the blend tolerance. 0 when the moves must stop between. */
 static double junction_speed(struct motion *m, const struct motion_seg *a,
                              const struct motion_seg *b, const struct sample *Ap,
                              const struct sample *Bp)
@@ -256,15 +259,15 @@ static double junction_speed(struct motion *m, const struct motion_seg *a,
     for (int i = 3; i < 6; i++)
         da = fmax(da, fabs(B.dp[i] - A.dp[i]));
     if (dx > 1e-12) {
-        v = fmin(v, c->max_lin_acc_mm_s2 * T / dx);
+        v = fmin(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
         v = fmin(v, 4 * a->blend_tol_mm / (Ts * dx));
     }
     if (da > 1e-12)
-        v = fmin(v, c->max_ang_acc_deg_s2 * T / da);
+        v = fmin(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
     for (int i = 0; i < m->nj; i++) {
         double dl = fabs(B.dL[i] - A.dL[i]);
         if (dl > 1e-12)
-            v = fmin(v, c->joint[i].max_acc_mm_s2 * T / dl);
+            v = fmin(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
     }
     return v;
 }
@@ -324,10 +327,14 @@ static int all_caps(struct motion *m, double *gain, char *err, size_t errlen)
             p->kv[k] = c, p->kt[k] = h;
         }
         double vin = j > 0 ? junction_speed(m, &p->segs[j - 1], sg, &prev_end, &first) : 0;
+        size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
         p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
         if (j > 0)
-            p->kv[p->segs[j - 1].k0 + p->segs[j - 1].nk - 1] =
-                fmin(p->kv[p->segs[j - 1].k0 + p->segs[j - 1].nk - 1], vin);
+            p->kv[pk] = fmin(p->kv[pk], vin);
+        if (vin > 0) {                 /* the jump's share of the acceleration, both sides */
+            p->iacc[sg->k0] *= 1 - JUMP_SHARE;
+            p->iacc[pk] *= 1 - JUMP_SHARE;
+        }
         p->kv[lk] = j + 1 < p->nseg ? p->kv[lk] : 0;
         prev_end = last;
         p->info.samples += sg->nk;

@@ -292,6 +292,83 @@ START_TEST(test_unreachable_mid_move)
 }
 END_TEST
 
+/* Lowest path speed seen while the line number is `line` or `line + 1` (around a joint). */
+struct joint_watch { int line; double min_v; double t_started; };
+static int joint_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct joint_watch *w = ctx;
+    if ((o->line == w->line && o->distance_done_mm > 5) ||
+        (o->line == w->line + 1 && o->distance_done_mm < 15))
+        w->min_v = fmin(w->min_v, o->path_vel);
+    return 0;
+}
+
+/* Runs X0 -> X10 -> second end at 1200 mm/min (20 mm/s) in path mode `blend` (0 = G61);
+ * returns the lowest speed around the joint. */
+static double joint_speed(double blend, const double *second)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double a[6] = {10, 0, 0, 0, 0, 0};
+    tm_add(&p, CANON_PATH_MODE, 1, NULL, 0, blend);
+    tm_add(&p, CANON_FEED, 2, a, 1200, 0);
+    tm_add(&p, CANON_FEED, 3, second, 1200, 0);
+    load_start(mc.m, &p);
+    struct joint_watch w = {2, 1e9, 0};
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, joint_hook, &w);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(s.last.pose[0], second[0], 1e-9);
+    ck_assert_double_eq_tol(s.last.pose[1], second[1], 1e-9);
+    ck_assert(s.max_a_mm_s2 <= 1000 * (1 + 1e-6));
+    canon_prog_free(&p);
+    tm_close(&mc);
+    return w.min_v;
+}
+
+/* G61 stops at every joint; G64 passes a collinear joint at the feed and slows to a near stop
+ * at a square corner (the velocity jump there must stay within one period's acceleration). */
+START_TEST(test_blend)
+{
+    double straight[6] = {20, 0, 0, 0, 0, 0}, corner[6] = {10, 10, 0, 0, 0, 0};
+    ck_assert_double_eq_tol(joint_speed(0, straight), 0, 1e-9);
+    ck_assert_msg(joint_speed(0.01, straight) > 20 * (1 - 1e-9), "collinear joint slowed");
+    double v = joint_speed(0.01, corner);
+    ck_assert_msg(v <= 1000 * 0.001 / sqrt(2) + 1e-9, "corner passed at %.3f mm/s", v);
+}
+END_TEST
+
+/* G93 inverse time: a 10 mm move in 0.01 min runs at 16.7 mm/s; a rotary-only move runs at
+ * its feed in deg/min (600 deg/min: 30 deg in about 3 s). */
+START_TEST(test_inverse_time_and_rotary)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    struct canon_cmd c = {.type = CANON_FEED, .line = 1, .file = "t.ngc", .feed_mm_min = 99,
+                          .inverse_time_min = 0.01, .end = {10, 0, 0, 0, 0, 0}};
+    canon_prog_sink(&p, &c);
+    load_start(mc.m, &p);
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, NULL, NULL);
+    ck_assert_double_eq_tol(s.max_v_mm_s, 10 / 0.6, 1e-6);
+    ck_assert_double_eq_tol(s.t_s, 0.6 + 10 / 0.6 / 1000, 0.005);
+    canon_prog_free(&p);
+    canon_prog_init(&p);
+    double r[6] = {0, 0, 0, 30, 0, 0};
+    tm_add(&p, CANON_FEED, 2, r, 600, 0);
+    load_start(mc.m, &p);
+    tm_run(mc.m, DT, 100000, &s, NULL, NULL);
+    ck_assert_double_eq_tol(s.last.pose[3], 30, 1e-9);
+    ck_assert_double_eq_tol(s.t_s, 3 + 10 / 900.0, 0.005);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* Configuration: keys read, a bad value named with its section and key. */
 START_TEST(test_config)
 {
@@ -329,6 +406,8 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_helix);
     tcase_add_test(tc, test_dwell);
     tcase_add_test(tc, test_unreachable_mid_move);
+    tcase_add_test(tc, test_blend);
+    tcase_add_test(tc, test_inverse_time_and_rotary);
     tcase_add_test(tc, test_config);
     suite_add_tcase(s, tc);
     return s;
