@@ -50,6 +50,15 @@ LDFLAGS  := $(SANFLAGS)
 LDLIBS   := $(shell pkg-config --libs $(PKGS)) -ldl -lpthread -lm -lstdc++
 CHECK_LIBS := $(shell pkg-config --libs check)
 
+# Quiet build: one short line per step; `make V=1` prints the full commands.
+ifeq ($(V),1)
+Q :=
+say = @true
+else
+Q := @
+say = @printf '  %-6s %s\n' $(1) $(2)
+endif
+
 LIB_SRCS :=
 LIB_CXXSRCS :=
 CMD_SRCS :=
@@ -82,14 +91,17 @@ all: $(HEXCNC) $(PLUGINS) $(EXTRA_BINS)
 
 $(BUILD)/%.o: %.c | $(GEN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+	$(call say,CC,$<)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 $(BUILD)/%.o: %.cpp | $(GEN_HDRS)
 	@mkdir -p $(@D)
-	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
+	$(call say,CXX,$<)
+	$(Q)$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
 $(LIBHEX): $(LIB_OBJS)
 	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
+	$(call say,AR,$@)
+	$(Q)rm -f $@ && ar rcs $@ $^
 
 # The subcommand table of bin/hexcnc, generated from the tools/cmd_*.c files present.
 $(GENDIR)/hexcnc_cmds.h: $(CMD_SRCS) mk/build.mk
@@ -101,14 +113,17 @@ $(BUILD)/tools/hexcnc.o: $(GENDIR)/hexcnc_cmds.h
 
 $(HEXCNC): $(CMD_OBJS) $(LIBHEX)
 	@mkdir -p $(@D)
-	$(CC) $(LDFLAGS) -rdynamic $(CMD_OBJS) $(LIBHEX) $(LDLIBS) -o $@
+	$(call say,LINK,$@)
+	$(Q)$(CC) $(LDFLAGS) -rdynamic $(CMD_OBJS) $(LIBHEX) $(LDLIBS) -o $@
 
 $(BUILD)/tests/%: tests/%.c $(LIBHEX) | $(GEN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBHEX) $(CHECK_LIBS) $(LDLIBS) -o $@
+	$(call say,TEST,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBHEX) $(CHECK_LIBS) $(LDLIBS) -o $@
 $(BUILD)/bench/%: bench/%.c $(LIBHEX) | $(GEN_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBHEX) $(LDLIBS) -o $@
+	$(call say,BENCH,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBHEX) $(LDLIBS) -o $@
 
 # Tests and benches find the tree through these variables, whatever O is.
 RUN_ENV := HEXCNC_ROOT=$(CURDIR) HEXCNC_BIN=$(abspath $(HEXCNC)) \
