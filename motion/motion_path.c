@@ -306,8 +306,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err
         }
         if (p->nseg > nseg0)
             set_speed(m, &p->segs[p->nseg - 1], c, blend);
-        if (c->type == CANON_PATH_MODE)
-            blend = c->value > 0 ? c->value : c->value < 0 ? m->cfg.blend_tol_mm : 0;
+        if (c->type == CANON_PATH_MODE)  /* G64 (ivalue 640) without P: BLEND_TOLERANCE */
+            blend = c->value > 0 ? c->value : c->ivalue == 640 ? m->cfg.blend_tol_mm : 0;
         if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
             memcpy(at, c->end, sizeof at);
         if (c->type == CANON_PROGRAM_END)

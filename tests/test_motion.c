@@ -305,14 +305,16 @@ static int joint_hook(struct motion *m, const struct motion_out *o, int step, vo
 
 /* Runs X0 -> X10 -> second end at 1200 mm/min (20 mm/s) in path mode `blend` (0 = G61);
  * returns the lowest speed around the joint. */
-static double joint_speed(double blend, const double *second)
+static double joint_speed(double blend, int gcode, const double *second)
 {
     struct tm_machine mc;
     ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
     struct canon_prog p;
     canon_prog_init(&p);
     double a[6] = {10, 0, 0, 0, 0, 0};
-    tm_add(&p, CANON_PATH_MODE, 1, NULL, 0, blend);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "test.ngc",
+                           .value = blend, .ivalue = gcode};
+    canon_prog_sink(&p, &pm);
     tm_add(&p, CANON_FEED, 2, a, 1200, 0);
     tm_add(&p, CANON_FEED, 3, second, 1200, 0);
     load_start(mc.m, &p);
@@ -328,15 +330,19 @@ static double joint_speed(double blend, const double *second)
     return w.min_v;
 }
 
-/* G61 stops at every joint; G64 passes a collinear joint at the feed and slows to a near stop
- * at a square corner (the velocity jump there must stay within one period's acceleration). */
+/* G61 stops at every joint; G64 (with P, or without: [TRAJ]BLEND_TOLERANCE) passes a
+ * collinear joint at the feed and slows to a near stop at a square corner (the velocity jump
+ * there must stay within half a period's acceleration). */
 START_TEST(test_blend)
 {
     double straight[6] = {20, 0, 0, 0, 0, 0}, corner[6] = {10, 10, 0, 0, 0, 0};
-    ck_assert_double_eq_tol(joint_speed(0, straight), 0, 1e-9);
-    ck_assert_msg(joint_speed(0.01, straight) > 20 * (1 - 1e-9), "collinear joint slowed");
-    double v = joint_speed(0.01, corner);
-    ck_assert_msg(v <= 1000 * 0.001 / sqrt(2) + 1e-9, "corner passed at %.3f mm/s", v);
+    ck_assert_double_eq_tol(joint_speed(0, 610, straight), 0, 1e-9);
+    ck_assert_msg(joint_speed(0.01, 640, straight) > 20 * (1 - 1e-9), "collinear joint slowed");
+    ck_assert_msg(joint_speed(0, 640, straight) > 20 * (1 - 1e-9), "G64 without P stopped");
+    double v = joint_speed(0.01, 640, corner);
+    /* the joint speed plus what half the acceleration adds within the period sampled */
+    ck_assert_msg(v <= 0.5 * 1000 * 0.001 / sqrt(2) + 0.5 * 1000 * DT, "corner passed at %.3f "
+                  "mm/s", v);
 }
 END_TEST
 
