@@ -17,6 +17,22 @@ struct motion *motion_hal_get(const struct hal *h);
  * MOTION_ERR_* with a message naming file and line in err on failure. */
 int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, size_t errlen);
 
+/* Asks the component to start the program loaded into its motion instance (by
+ * motion_hal_load or motion_load): it starts at the next motion.update that sees
+ * motion.enable true. MOTION_ERR_STATE when no program is loaded or motion is not idle. */
+int motion_hal_start(struct hal *h);
+
+/* Asks the component to abort (controlled stop along the path, then idle) at its next
+ * motion.update. Safe from another thread than the servo thread. */
+int motion_hal_abort(struct hal *h);
+
+/* The component's output of its last motion.update (pose, legs, state, line, progress);
+ * before the first one, the pose it holds. MOTION_ERR_STATE without `loadrt motion`. */
+int motion_hal_out(const struct hal *h, struct motion_out *out);
+
+/* The commanded pose now (mm, deg): where a program handed over next starts from. */
+int motion_hal_pose(const struct hal *h, double pose[KINS_POSE_DIM]);
+
 /* The fault or last error text ("" when none): what the runner shows the machinist. */
 const char *motion_hal_fault(const struct hal *h);
 

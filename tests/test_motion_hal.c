@@ -119,6 +119,39 @@ START_TEST(test_hal_estop)
 }
 END_TEST
 
+/* The runner's calls: the last output, the pose, start after a plain motion_load, abort. */
+START_TEST(test_hal_runner_calls)
+{
+    struct canon_prog p;
+    struct hal *h = make_machine(&p);
+    advance(h, 500);
+    struct motion_out o;
+    ck_assert_int_eq(motion_hal_out(h, &o), MOTION_OK);
+    ck_assert_int_eq(o.state, MOTION_RUNNING);
+    double pose[6];
+    ck_assert_int_eq(motion_hal_pose(h, pose), MOTION_OK);
+    ck_assert_double_eq(pose[0], *(double *)pin(h, "motion.pose-cmd-x", HAL_FLOAT));
+    ck_assert_int_eq(motion_hal_start(h), MOTION_ERR_STATE);      /* already running */
+    ck_assert_int_eq(motion_hal_abort(h), MOTION_OK);
+    advance(h, 1000);
+    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_IDLE);
+    ck_assert_int_eq(motion_hal_start(h), MOTION_ERR_STATE);      /* program dropped */
+    /* a new program from where it stopped, loaded on the core, started through HAL */
+    canon_prog_free(&p);
+    canon_prog_init(&p);
+    motion_hal_pose(h, p.start);
+    tm_add(&p, CANON_FEED, 7, HOME, 1200, 0);
+    char err[256];
+    ck_assert_int_eq(motion_load(motion_hal_get(h), &p, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(motion_hal_start(h), MOTION_OK);
+    advance(h, 20000);
+    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_DONE);
+    ck_assert_int_eq(*(int32_t *)pin(h, "motion.program-line", HAL_S32), 7);
+    hal_destroy(h);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* motion.pause / motion.resume edges: pauses on the path, resumes, finishes. */
 START_TEST(test_hal_pause)
 {
@@ -147,6 +180,7 @@ static Suite *hal_suite(void)
     tcase_add_test(tc, test_hal_run);
     tcase_add_test(tc, test_hal_estop);
     tcase_add_test(tc, test_hal_pause);
+    tcase_add_test(tc, test_hal_runner_calls);
     suite_add_tcase(s, tc);
     return s;
 }

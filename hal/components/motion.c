@@ -1,4 +1,5 @@
 /* motion.c: the `motion` HAL component: planner and interpolator of motion/ on the servo thread. */
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,7 +15,9 @@ static const char motion_axis_names[KINS_POSE_DIM] = { 'x', 'y', 'z', 'a', 'b', 
 struct motion_comp {
     struct motion *m;                        /* the planner/interpolator (object "motion") */
     int nj;                                  /* joints */
-    int start_pending;                       /* a program was handed over and waits to start */
+    atomic_int start_pending;                /* a program waits to start (motion_hal_start) */
+    atomic_int abort_pending;                /* motion_hal_abort was called */
+    struct motion_out last;                  /* output of the last update (motion_hal_out) */
     double *joint_pos_cmd[KINS_MAX_JOINTS];  /* out: leg length commands, mm */
     double *joint_vel_cmd[KINS_MAX_JOINTS];  /* out: leg rate commands, mm/s */
     double *joint_pos_fb[KINS_MAX_JOINTS];   /* in: leg length feedback, mm */
@@ -51,7 +54,7 @@ static void motion_comp_commands(struct motion_comp *c)
         motion_pause(c->m);
     if (*c->resume && !c->last_resume)
         motion_resume(c->m);
-    if (*c->abort && !c->last_abort) {
+    if ((*c->abort && !c->last_abort) || atomic_exchange(&c->abort_pending, 0)) {
         c->start_pending = 0;
         motion_abort(c->m);
     }
@@ -70,6 +73,7 @@ static void motion_comp_update(void *arg, long period_ns)
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
+    c->last = o;
     for (int i = 0; i < c->nj; i++) {
         *c->joint_pos_cmd[i] = o.joint_pos[i];
         *c->joint_vel_cmd[i] = o.joint_vel[i];
@@ -179,6 +183,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     /* Start consistent: commands and unconnected feedback at the home pose's legs. */
     struct motion_out o;
     motion_step(c->m, cfg.servo_period_s, &o);
+    c->last = o;
     for (int i = 0; i < c->nj; i++)
         *c->joint_pos_cmd[i] = *c->joint_pos_fb[i] = o.joint_pos[i];
     for (int i = 0; i < KINS_POSE_DIM; i++)
@@ -208,6 +213,49 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
     int st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK;
     return st;
+}
+
+/* Requests a start at the next update. */
+int motion_hal_start(struct hal *h)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    struct motion_plan_info info;
+    if (motion_get_state(c->m) != MOTION_IDLE || motion_plan_info(c->m, &info) != MOTION_OK)
+        return MOTION_ERR_STATE;           /* running, done, faulted or nothing loaded */
+    c->start_pending = 1;
+    return MOTION_OK;
+}
+
+/* Requests an abort at the next update. */
+int motion_hal_abort(struct hal *h)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    c->abort_pending = 1;
+    return MOTION_OK;
+}
+
+/* The output of the last update. */
+int motion_hal_out(const struct hal *h, struct motion_out *out)
+{
+    const struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c || !out)
+        return MOTION_ERR_STATE;
+    *out = c->last;
+    return MOTION_OK;
+}
+
+/* The commanded pose of the last update. */
+int motion_hal_pose(const struct hal *h, double pose[KINS_POSE_DIM])
+{
+    const struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c || !pose)
+        return MOTION_ERR_STATE;
+    memcpy(pose, c->last.pose, sizeof c->last.pose);
+    return MOTION_OK;
 }
 
 /* The motion core's fault or error text. */
