@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "interp/interp_int.h"
 #include "interp/tooltable.h"
@@ -236,6 +237,9 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
     if (!f)
         return interp_fail(in, INTERP_ERR_IO, 0, "cannot open the program: %s", strerror(errno));
     size_t cap = 1 << 16, len = 0;
+    struct stat st;
+    if (fstat(fileno(f), &st) == 0 && st.st_size > 0)
+        cap = (size_t)st.st_size + 1; /* one read, no regrowth, for regular files */
     char *buf = malloc(cap);
     int rc = 0;
     while (buf) {

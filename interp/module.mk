@@ -7,4 +7,5 @@ LIB_SRCS += interp/comp5.c interp/comp5_join.c interp/tooltable.c interp/tooltab
 TESTS += test_comp5 test_comp5_join test_tooltable
 SCRIPT_TESTS += tests/paper_programs.sh
 TESTS += test_interp test_interp_number test_interp_motion
+BENCHES += bench_interp
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh

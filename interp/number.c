@@ -41,27 +41,30 @@ static double decimal_slow(const char *s, size_t n)
  */
 size_t interp_parse_decimal(const char *s, size_t len, double *out)
 {
-    size_t i = 0;
+    size_t i = 0, lead;
     int neg = 0;
     if (i < len && (s[i] == '+' || s[i] == '-'))
         neg = s[i++] == '-';
-    uint64_t m = 0;
-    int sig = 0, frac = 0, digits = 0, point = 0;
-    for (; i < len; i++) {
-        char c = s[i];
-        if (c >= '0' && c <= '9') {
-            digits++;
-            if (point)
-                frac++;
-            if (m || c != '0')
-                sig++;
-            if (sig <= 19)
-                m = m * 10 + (uint64_t)(c - '0');
-        } else if (c == '.' && !point) {
-            point = 1;
-        } else {
-            break;
-        }
+    size_t start = i;
+    while (i < len && s[i] == '0')
+        i++;
+    lead = i;
+    uint64_t m = 0; /* wraps when sig > 19: then it is not used */
+    while (i < len && (unsigned)(s[i] - '0') < 10)
+        m = m * 10 + (uint64_t)(s[i++] - '0');
+    size_t sig = i - lead, frac = 0;
+    int digits = i > start;
+    if (i < len && s[i] == '.') {
+        size_t fs = ++i;
+        if (sig == 0)
+            while (i < len && s[i] == '0')
+                i++;
+        size_t fsig = i;
+        while (i < len && (unsigned)(s[i] - '0') < 10)
+            m = m * 10 + (uint64_t)(s[i++] - '0');
+        frac = i - fs;
+        sig += i - fsig;
+        digits |= i > fs;
     }
     if (!digits)
         return 0;
@@ -74,14 +77,32 @@ size_t interp_parse_decimal(const char *s, size_t len, double *out)
     return i;
 }
 
-/* Writes the decimal digits of n (n < 10^19) backwards ending at end; returns the start. */
-static char *utoa_back(uint64_t n, char *end)
+/* "00" .. "99": two digits per division when printing. */
+static const char digit_pairs[201] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/* Writes the decimal digits of n backwards ending at end, exactly `width` of them (zero
+ * padded) or, with width 0, as many as n needs; returns the start. */
+static char *utoa_back(uint64_t n, char *end, int width)
 {
-    do {
-        *--end = (char)('0' + n % 10);
-        n /= 10;
-    } while (n);
-    return end;
+    char *q = end;
+    while (n >= 100) {
+        unsigned d = (unsigned)(n % 100) * 2;
+        n /= 100;
+        *--q = digit_pairs[d + 1];
+        *--q = digit_pairs[d];
+    }
+    if (n >= 10) {
+        *--q = digit_pairs[n * 2 + 1];
+        *--q = digit_pairs[n * 2];
+    } else {
+        *--q = (char)('0' + n);
+    }
+    while (end - q < width)
+        *--q = '0';
+    return q;
 }
 
 /*
@@ -105,18 +126,14 @@ size_t interp_format_fixed(double v, int digits, char *out)
     if (f > 0.5 || (f == 0.5 && (e > 0 || (e == 0 && (n & 1)))))
         n++;
     char tmp[48], *end = tmp + sizeof tmp, *q = end;
-    uint64_t ip = n, fp = 0;
+    uint64_t ip = n;
     if (digits) {
         uint64_t sc = (uint64_t)s;
         ip = n / sc;
-        fp = n % sc;
-        for (int d = 0; d < digits; d++) {
-            *--q = (char)('0' + fp % 10);
-            fp /= 10;
-        }
+        q = utoa_back(n % sc, q, digits);
         *--q = '.';
     }
-    q = utoa_back(ip, q);
+    q = utoa_back(ip, q, 0);
     if (signbit(v))
         *--q = '-';
     size_t len = (size_t)(end - q);

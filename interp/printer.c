@@ -35,17 +35,43 @@ static void put_num(struct interp_printer *p, double v, int digits)
     put(p, tmp, interp_format_fixed(v, digits, tmp));
 }
 
-/* The first columns: rs274's output counter (%5d) and the N number or "N.....". */
+/* Writes n right-aligned in a field of `width` (wider if it needs), returns the length. */
+static size_t put_int(char *out, long n, int width, int left)
+{
+    char tmp[24], *e = tmp + sizeof tmp, *q = e;
+    unsigned long u = n < 0 ? 0UL - (unsigned long)n : (unsigned long)n;
+    do {
+        *--q = (char)('0' + u % 10);
+        u /= 10;
+    } while (u);
+    if (n < 0)
+        *--q = '-';
+    size_t len = (size_t)(e - q), pad = len < (size_t)width ? (size_t)width - len : 0;
+    if (left) {
+        memcpy(out, q, len);
+        memset(out + len, ' ', pad);
+    } else {
+        memset(out, ' ', pad);
+        memcpy(out + pad, q, len);
+    }
+    return len + pad;
+}
+
+/* The first columns: rs274's output counter (%5d) and the N number ("N%-5d") or "N.....". */
 static void line_start(struct interp_printer *p, const struct canon_cmd *c)
 {
-    char tmp[40];
-    int n;
-    p->seq++;
-    if (c && c->has_n)
-        n = snprintf(tmp, sizeof tmp, "%5ld N%-5d ", p->seq, c->n_number);
-    else
-        n = snprintf(tmp, sizeof tmp, "%5ld N..... ", p->seq);
-    put(p, tmp, (size_t)n);
+    char tmp[64];
+    size_t n = put_int(tmp, ++p->seq, 5, 0);
+    tmp[n++] = ' ';
+    tmp[n++] = 'N';
+    if (c && c->has_n) {
+        n += put_int(tmp + n, c->n_number, 5, 1);
+    } else {
+        memcpy(tmp + n, ".....", 5);
+        n += 5;
+    }
+    tmp[n++] = ' ';
+    put(p, tmp, n);
 }
 
 /* NAME(v1, v2, ...) with the given values and digits, then a newline. */
