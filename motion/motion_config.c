@@ -1,6 +1,7 @@
 /* motion_config.c: motion configuration defaults, reading it from the INI, status texts. */
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,12 +96,31 @@ static int check_config(const struct motion_config *c, char *err, size_t errlen)
     }
     for (int i = 0; i < c->njoints; i++)
         if (!(c->joint[i].max_vel_mm_s > 0) || !(c->joint[i].max_acc_mm_s2 > 0)) {
-            snprintf(err, errlen, "[JOINT_%d]: MAX_VELOCITY and MAX_ACCELERATION must be positive",
-                     i);
+            snprintf(err, errlen, "[JOINT_%d]: MAX_VELOCITY and MAX_ACCELERATION must be "
+                     "positive", i);
             return MOTION_ERR_CONFIG;
         }
     return MOTION_OK;
 }
+
+/* The machine-wide keys: section, key, scale to the field's unit, 0 allowed, field. */
+static const struct motion_key {
+    const char *sec, *key;
+    double scale;
+    int zero_ok;
+    size_t off;
+} motion_keys[] = {
+    {"EMCMOT", "SERVO_PERIOD", 1e-9, 0, offsetof(struct motion_config, servo_period_s)},
+    {"TRAJ", "SETPOINT_PERIOD", 1e-9, 1, offsetof(struct motion_config, setpoint_period_s)},
+    {"TRAJ", "MAX_LINEAR_VELOCITY", 1, 0, offsetof(struct motion_config, max_lin_vel_mm_s)},
+    {"TRAJ", "MAX_LINEAR_ACCELERATION", 1, 0, offsetof(struct motion_config, max_lin_acc_mm_s2)},
+    {"TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, offsetof(struct motion_config, max_ang_vel_deg_s)},
+    {"TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, offsetof(struct motion_config, max_ang_acc_deg_s2)},
+    {"TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, offsetof(struct motion_config, default_lin_vel_mm_s)},
+    {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, offsetof(struct motion_config, kin_tol_mm)},
+    {"TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, offsetof(struct motion_config, kin_tol_deg)},
+    {"TRAJ", "BLEND_TOLERANCE", 1, 1, offsetof(struct motion_config, blend_tol_mm)},
+};
 
 /* Reads [EMCMOT], [TRAJ] and [JOINT_n] through cfg (see motion.h). */
 int motion_config_read(struct motion_config *c, const struct kins_config *cfg, int njoints,
@@ -113,23 +133,19 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
     double opt = c->optional_stop;
     int st = MOTION_OK;
     c->njoints = njoints;
-    st = st ? st : read_num(cfg, "EMCMOT", "SERVO_PERIOD", 1e-9, 0, &c->servo_period_s, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "SETPOINT_PERIOD", 1e-9, 1, &c->setpoint_period_s, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "MAX_LINEAR_VELOCITY", 1, 0, &c->max_lin_vel_mm_s, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "MAX_LINEAR_ACCELERATION", 1, 0, &c->max_lin_acc_mm_s2, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, &c->max_ang_vel_deg_s, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, &c->max_ang_acc_deg_s2, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, &c->default_lin_vel_mm_s, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "KINEMATIC_TOLERANCE", 1, 1, &c->kin_tol_mm, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, &c->kin_tol_deg, err, errlen);
-    st = st ? st : read_num(cfg, "TRAJ", "BLEND_TOLERANCE", 1, 1, &c->blend_tol_mm, err, errlen);
+    for (size_t i = 0; i < sizeof motion_keys / sizeof motion_keys[0] && !st; i++) {
+        const struct motion_key *k = &motion_keys[i];
+        st = read_num(cfg, k->sec, k->key, k->scale, k->zero_ok,
+                      (double *)(void *)((char *)c + k->off), err, errlen);
+    }
     st = st ? st : read_num(cfg, "TRAJ", "OPTIONAL_STOP", 1, 1, &opt, err, errlen);
     for (int i = 0; i < njoints && !st; i++) {
         char sec[16];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         struct motion_joint_config *j = &c->joint[i];
-        st = st ? st : read_num(cfg, sec, "MAX_VELOCITY", 1, 0, &j->max_vel_mm_s, err, errlen);
-        st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, &j->max_acc_mm_s2, err, errlen);
+        st = read_num(cfg, sec, "MAX_VELOCITY", 1, 0, &j->max_vel_mm_s, err, errlen);
+        st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, &j->max_acc_mm_s2, err,
+                                errlen);
         st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, &j->ferror_mm, err, errlen);
         st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, &j->min_ferror_mm, err, errlen);
     }

@@ -131,7 +131,28 @@ void motion_plan_free(struct motion_plan *p);
 /* Planning (motion_plan.c). */
 int motion_plan_profile(struct motion *m, char *err, size_t errlen);
 
-/* 6x6 solve with partial pivoting (motion_plan.c); 0 on success, -1 when singular. */
+/* Share of one period's acceleration a G64 corner's velocity jump may use. */
+#define JUMP_SHARE 0.5
+
+/* One path sample through the kinematics: pose, its s-derivative, legs and their
+ * first and second s-derivatives. */
+struct motion_sample {
+    double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM];
+    double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
+};
+
+/* Sampling and caps (motion_caps.c). Speed caps of the knot at s of sg (knot spacing hs):
+ * hard (machine, legs, kinematic error), with the feed (cap), path acceleration (acc); the
+ * sample into S. A leg out of range is an error naming file, line, leg and amount. */
+int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
+                     struct motion_sample *S, double *hard, double *cap, double *acc,
+                     char *err, size_t errlen);
+/* Speed allowed through the joint between segments a and b (0: stop there); A and B are
+ * the samples at the end of a and the start of b. */
+double motion_junction_speed(struct motion *m, const struct motion_seg *a,
+                             const struct motion_seg *b, const struct motion_sample *A,
+                             const struct motion_sample *B);
+/* 6x6 solve with partial pivoting; 0 on success, -1 when singular. */
 int motion_solve6(double a[6][6], double b[6]);
 
 #endif
