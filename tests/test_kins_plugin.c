@@ -230,6 +230,14 @@ START_TEST(test_cli)
     for (int j = 0; j < 6; j++) /* the legs were printed to 1e-9 mm */
         ck_assert_double_eq_tol(back[j], pose[j], 1e-7);
 
+    /* Without HEXCNC_PLUGIN_DIR the plugin is found in lib/kins beside the executable's
+     * bin/ directory. */
+    snprintf(cmd, sizeof cmd, "env -u HEXCNC_PLUGIN_DIR '%s' kins '%s' inverse 59.975641 -80 "
+             "630.697565 0 -4 0", bin, ini);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(sscanf(out, "%lf", &back[0]), 1);
+    ck_assert_double_eq_tol(back[0], want[0], 1e-9);
+
     snprintf(cmd, sizeof cmd, "'%s' kins '%s' inverse 500 0 645 0 0 0", bin, ini);
     ck_assert_int_eq(run(cmd, out, sizeof out), 1);
     ck_assert_msg(strstr(out, "leg 2 would be") && strstr(out, "above its maximum 980.000 mm "
