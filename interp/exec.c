@@ -331,6 +331,8 @@ int interp_execute(struct interp *in)
         CHP(interp_home(in, g0));
     else if (g0 >= 920 && g0 <= 923)
         CHP(interp_g92(in, g0));
+    if (comp && b->g[1] >= 0)
+        in->motion = b->g[1]; /* G1 beside G141/G142 is modal as usual */
     if (comp)
         CHP(exec_comp5(in, g0));
     else

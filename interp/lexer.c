@@ -1,4 +1,5 @@
 /* lexer.c: one program line to a block: spaces and case removed, comments, words, #n= settings. */
+#include <math.h>
 #include <string.h>
 
 #include "interp/interp_int.h"
@@ -88,6 +89,9 @@ static int read_assignment(struct interp *in, int *pos)
                            "'=' expected after #%d (a parameter setting is #n=value)", idx);
     (*pos)++;
     CHP(interp_read_value(in, pos, &v));
+    if (!isfinite(v))
+        return interp_fail(in, INTERP_ERR_EXPR, col, "value for #%d is not a finite number "
+                           "(overflow)", idx);
     if (b->nassign >= INTERP_MAX_ASSIGN)
         return interp_fail(in, INTERP_ERR_PARAM, col, "more than %d parameter settings in one block",
                            INTERP_MAX_ASSIGN);
@@ -122,6 +126,9 @@ static int read_word(struct interp *in, int *pos)
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value", c - 32);
     double v;
     CHP(interp_read_value(in, pos, &v));
+    if (!isfinite(v))
+        return interp_fail(in, INTERP_ERR_EXPR, col, "%c word value is not a finite number "
+                           "(overflow)", c - 32);
     if (c == 'g')
         return interp_add_g(in, v, col);
     if (c == 'm')
