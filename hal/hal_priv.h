@@ -139,6 +139,10 @@ struct hal {
     int64_t start_run_ns;            /* after `start`, advance (or sleep) this long */
     int stop_flag;                   /* real-time threads exit when set (atomic access) */
     bool rt_warned;                  /* the "no real-time scheduling" warning was printed */
+    pthread_mutex_t rt_mutex;        /* with rt_cond: holds new threads until all exist */
+    pthread_cond_t rt_cond;
+    bool rt_go;                      /* the time origin is set: threads may begin */
+    bool rt_locked;                  /* this runtime called mlockall (munlockall at stop) */
 };
 
 /* Internal helpers across files. */

@@ -3,9 +3,15 @@
 #include <sched.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "hal/hal_priv.h"
+
+/* Stack of each real-time thread: room for deep component code, small enough that locking
+ * it in memory (mlockall MCL_FUTURE) is quick. */
+#define HAL_RT_STACK_BYTES (1024 * 1024)
 
 /* CLOCK_MONOTONIC in ns. */
 static int64_t hal_mono_ns(void)
@@ -23,21 +29,16 @@ int64_t hal_now_ns(const struct hal *h)
     return h->sim_now_ns;
 }
 
-/* Warns once per runtime that real-time scheduling is not available. */
-static void hal_rt_warn(struct hal *h, const char *what, int err)
-{
-    if (h->rt_warned)
-        return;
-    h->rt_warned = true;
-    fprintf(stderr, "hal: warning: %s not permitted (%s); threads run with normal priority "
-            "and their timing may jitter\n", what, strerror(err));
-}
-
-/* One real-time thread: sleep to the absolute deadline, run, measure, count overruns. */
+/* One real-time thread: wait for the common origin, then sleep to each absolute deadline,
+ * run, measure, and count missed deadlines while keeping the phase. */
 static void *hal_rt_main(void *arg)
 {
     struct hal_thread *t = arg;
     struct hal *h = t->h;
+    pthread_mutex_lock(&h->rt_mutex);
+    while (!h->rt_go)
+        pthread_cond_wait(&h->rt_cond, &h->rt_mutex);
+    pthread_mutex_unlock(&h->rt_mutex);
     int64_t next_ns = h->start_mono_ns + t->period_ns;
     while (!__atomic_load_n(&h->stop_flag, __ATOMIC_ACQUIRE)) {
         struct timespec ts = { .tv_sec = next_ns / 1000000000, .tv_nsec = next_ns % 1000000000 };
@@ -76,21 +77,27 @@ static int hal_rt_priority(struct hal *h, struct hal_thread *t)
     return prio < 1 ? 1 : prio;
 }
 
-/* Starts one thread, SCHED_FIFO if permitted, otherwise normal (with the warning). */
-static int hal_rt_spawn(struct hal *h, struct hal_thread *t)
+/* Starts one thread: SCHED_FIFO if permitted, else normal priority (*no_fifo set). */
+static int hal_rt_spawn(struct hal *h, struct hal_thread *t, bool *no_fifo)
 {
     pthread_attr_t attr;
     struct sched_param sp = { .sched_priority = hal_rt_priority(h, t) };
     pthread_attr_init(&attr);
-    pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
-    pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
-    pthread_attr_setschedparam(&attr, &sp);
-    int err = pthread_create(&t->tid, &attr, hal_rt_main, t);
-    pthread_attr_destroy(&attr);
-    if (err == EPERM) {
-        hal_rt_warn(h, "SCHED_FIFO", err);
-        err = pthread_create(&t->tid, NULL, hal_rt_main, t);
+    pthread_attr_setstacksize(&attr, HAL_RT_STACK_BYTES);
+    int err = EPERM;
+    if (!*no_fifo) {
+        pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+        pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+        pthread_attr_setschedparam(&attr, &sp);
+        err = pthread_create(&t->tid, &attr, hal_rt_main, t);
+        if (err == EPERM) {
+            *no_fifo = true;
+            pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
+        }
     }
+    if (err == EPERM)
+        err = pthread_create(&t->tid, &attr, hal_rt_main, t);
+    pthread_attr_destroy(&attr);
     if (err)
         return hal_error(h, HAL_ERR_RT, "start: cannot create thread '%s': %s", t->name,
                          strerror(err));
@@ -98,21 +105,43 @@ static int hal_rt_spawn(struct hal *h, struct hal_thread *t)
     return HAL_OK;
 }
 
-/* Starts every thread on a common time origin. */
+/* Locks memory only where the limit allows it; a partial lock would make thread creation
+ * fail (their stacks count against RLIMIT_MEMLOCK). */
+static bool hal_rt_lock_memory(void)
+{
+    struct rlimit rl;
+    if (geteuid() != 0 && (getrlimit(RLIMIT_MEMLOCK, &rl) != 0 || rl.rlim_cur != RLIM_INFINITY))
+        return false;
+    return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+}
+
+/* Starts every thread; they begin together once all exist, on one time origin. */
 int hal_rt_start(struct hal *h)
 {
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-        hal_rt_warn(h, "mlockall", errno);
+    bool locked = hal_rt_lock_memory(), no_fifo = false;
+    h->rt_locked = locked;
+    int st = HAL_OK;
     __atomic_store_n(&h->stop_flag, 0, __ATOMIC_RELEASE);
-    h->start_mono_ns = hal_mono_ns();
-    for (int i = 0; i < h->thread_list.n; i++) {
-        int st = hal_rt_spawn(h, h->thread_list.v[i]);
-        if (st != HAL_OK) {
-            hal_rt_stop(h);
-            return st;
-        }
+    pthread_mutex_init(&h->rt_mutex, NULL);
+    pthread_cond_init(&h->rt_cond, NULL);
+    h->rt_go = false;
+    for (int i = 0; i < h->thread_list.n && st == HAL_OK; i++)
+        st = hal_rt_spawn(h, h->thread_list.v[i], &no_fifo);
+    if ((!locked || no_fifo) && !h->rt_warned) {
+        h->rt_warned = true;
+        fprintf(stderr, "hal: warning: %s%s%s not permitted; threads run %s and their timing "
+                "may jitter\n", no_fifo ? "real-time scheduling (SCHED_FIFO)" : "",
+                no_fifo && !locked ? " and " : "", locked ? "" : "memory locking (mlockall)",
+                no_fifo ? "with normal priority" : "unlocked in memory");
     }
-    return HAL_OK;
+    pthread_mutex_lock(&h->rt_mutex);
+    h->start_mono_ns = hal_mono_ns();
+    h->rt_go = true;
+    pthread_cond_broadcast(&h->rt_cond);
+    pthread_mutex_unlock(&h->rt_mutex);
+    if (st != HAL_OK)
+        hal_rt_stop(h);
+    return st;
 }
 
 /* Asks every thread to finish its period and joins it. */
@@ -126,4 +155,9 @@ void hal_rt_stop(struct hal *h)
         t->tid_valid = false;
     }
     h->sim_now_ns = hal_mono_ns() - h->start_mono_ns;
+    pthread_cond_destroy(&h->rt_cond);
+    pthread_mutex_destroy(&h->rt_mutex);
+    if (h->rt_locked)
+        munlockall();
+    h->rt_locked = false;
 }
