@@ -129,7 +129,8 @@ int hal_export_functf(struct hal *h, hal_funct_fn fn, void *arg, const char *fmt
     __attribute__((format(printf, 4, 5)));
 
 /* A thread calling its functs every period_ns. Creates pins <name>.time (s32, ns of the
- * last run), <name>.tmax (s32, ns) and <name>.overruns (u32). */
+ * last run), <name>.tmax (s32, ns) and <name>.overruns (u32). On the simulated clock they
+ * stay 0 (a measured CPU time would make runs differ). */
 int hal_thread_new(struct hal *h, const char *name, long period_ns);
 /* `addf funct thread [position]`: position 1-based, negative from the end, 0 = append. */
 int hal_addf(struct hal *h, const char *funct, const char *thread, int position);

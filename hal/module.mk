@@ -8,7 +8,7 @@ $(BUILD)/hal/hal_load.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
 # Built-in generic components (hal/components/motion.c adds itself elsewhere).
 LIB_SRCS += hal/components/kins.c hal/components/logic.c hal/components/stream.c
 HAL_COMPS += kins sum2 and2 not estop_latch streamer sampler
-TESTS += test_hal_core test_hal_cmd test_hal_ini test_hal_graph test_hal_rt test_hal_plugin
+TESTS += test_hal_core test_hal_cmd test_hal_ini test_hal_graph test_hal_rt test_hal_plugin test_hal_comps
 SCRIPT_TESTS += tests/hal/halcmd.sh
 
 # Plugins for test_hal_plugin (never installed): their hal_* symbols come from the test
