@@ -29,29 +29,32 @@ static struct plane_axes plane_of(int plane)
     return (struct plane_axes){AX_X, AX_Y, AX_Z, 'i', 'j', 'k'};
 }
 
-/* R form: the centre on the side that gives the short arc (R > 0) or the long one (R < 0). */
+/* R form: the centre on the side that gives the short arc (R > 0) or the long one (R < 0).
+ * Program units, and LinuxCNC's very formula, so that the centres agree to the last bit. */
 static int centre_from_r(struct interp *in, int ccw, const double s[2], const double e[2],
                          double c[2])
 {
-    double r = interp_len_mm(in, V('r')), ar = fabs(r);
-    double dx = e[0] - s[0], dy = e[1] - s[1], half = 0.5 * hypot(dx, dy);
-    if (half < 1e-9)
+    double r = V('r'), ar = fabs(r);
+    double mid0 = (e[0] + s[0]) / 2.0, mid1 = (e[1] + s[1]) / 2.0;
+    double half = hypot(mid0 - e[0], mid1 - e[1]);
+    if (half < 1e-12)
         return interp_fail(in, INTERP_ERR_ARC, W('r'), "an arc in R form cannot end where it "
                            "starts: program a full circle with I J K");
     if (ar < 1e-12 || half / ar > 1.0 + 1e-12)
         return interp_fail(in, INTERP_ERR_ARC, W('r'), "arc radius R%g is too small to reach "
-                           "the end point (half the distance is %.4f)", V('r'),
-                           in->inch ? half / MM_PER_INCH : half);
-    if (half > ar)
-        half = ar;
-    double off = sqrt(ar * ar - half * half);
-    double th = atan2(dy, dx) + (((ccw && r > 0) || (!ccw && r < 0)) ? M_PI_2 : -M_PI_2);
-    c[0] = 0.5 * (s[0] + e[0]) + off * cos(th);
-    c[1] = 0.5 * (s[1] + e[1]) + off * sin(th);
+                           "the end point (half the distance is %.4f)", V('r'), half);
+    if (half / ar > 1.0 - 1e-12)
+        half = ar; /* a half circle, give or take rounding */
+    double th = atan2(e[1] - s[1], e[0] - s[0]) +
+                (((ccw && r > 0) || (!ccw && r < 0)) ? M_PI_2 : -M_PI_2);
+    double off = ar * cos(asin(half / ar));
+    c[0] = mid0 + off * cos(th);
+    c[1] = mid1 + off * sin(th);
     return 0;
 }
 
-/* I J K form: the centre as an offset from the start (G91.1) or absolute (G90.1). */
+/* I J K form, program units: the centre as an offset from the start (G91.1) or absolute
+ * (G90.1). */
 static int centre_from_ijk(struct interp *in, const struct plane_axes *p, const double s[2],
                            double c[2])
 {
@@ -63,50 +66,45 @@ static int centre_from_ijk(struct interp *in, const struct plane_axes *p, const 
         return interp_fail(in, INTERP_ERR_WORD, in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0,
                            "arc with neither R nor a centre word (%c, "
                            "%c) for G%d", p->w1 - 32, p->w2 - 32, in->plane);
-    double o1 = W(p->w1) ? interp_len_mm(in, V(p->w1)) : 0.0;
-    double o2 = W(p->w2) ? interp_len_mm(in, V(p->w2)) : 0.0;
-    if (in->arc_absolute) {
-        double off1 = in->g5x[p->a1] + in->g92[p->a1] + in->tool[p->a1];
-        double off2 = in->g5x[p->a2] + in->g92[p->a2] + in->tool[p->a2];
-        c[0] = o1 + off1;
-        c[1] = o2 + off2;
-    } else {
-        c[0] = s[0] + o1;
-        c[1] = s[1] + o2;
-    }
+    double o1 = W(p->w1) ? V(p->w1) : 0.0, o2 = W(p->w2) ? V(p->w2) : 0.0;
+    c[0] = in->arc_absolute ? o1 : s[0] + o1;
+    c[1] = in->arc_absolute ? o2 : s[1] + o2;
     return 0;
 }
 
-/* Both ends must lie on one circle about the centre (LinuxCNC's tolerances). */
+/* Both ends must lie on one circle about the centre (LinuxCNC's tolerances), program units. */
 static int check_radii(struct interp *in, const double s[2], const double e[2], const double c[2])
 {
     double r1 = hypot(s[0] - c[0], s[1] - c[1]), r2 = hypot(e[0] - c[0], e[1] - c[1]);
-    double k = in->inch ? 1.0 / MM_PER_INCH : 1.0, tol = in->inch ? ARC_TOL_IN : ARC_TOL_MM;
+    double tol = in->inch ? ARC_TOL_IN : ARC_TOL_MM;
     int col = in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0;
     const char *u = in->inch ? "in" : "mm";
-    if (r1 * k < 1e-9 || r2 * k < 1e-9)
+    if (r1 < 1e-9 || r2 < 1e-9)
         return interp_fail(in, INTERP_ERR_ARC, col, "zero-radius arc: the centre is on the %s "
                            "point (start radius %.4f %s, end radius %.4f %s)",
-                           r1 * k < 1e-9 ? "start" : "end", r1 * k, u, r2 * k, u);
-    double err = fabs(r1 - r2) * k, rel = err / fmax(r1 * k, r2 * k);
+                           r1 < 1e-9 ? "start" : "end", r1, u, r2, u);
+    double err = fabs(r1 - r2), rel = err / fmax(r1, r2);
     if (err > tol * 100.0 || (rel > ARC_REL_TOL && err > tol))
         return interp_fail(in, INTERP_ERR_ARC, col, "the end of the arc is not on its circle: "
                            "radius %.4f %s at the start, %.4f %s at the end (difference %.4f %s; "
-                           "check the centre words and the end point)", r1 * k, u, r2 * k, u,
-                           err, u);
+                           "check the centre words and the end point)", r1, u, r2, u, err, u);
     return 0;
 }
 
 int interp_arc(struct interp *in, int g)
 {
+    static const char letter[3] = {'x', 'y', 'z'};
     struct plane_axes p = plane_of(in->plane);
     int ccw = g == 30, turns = 1;
-    double end[6], s[2], e[2], c[2] = {0, 0};
+    double end[6], cur[6], s[2], e[2], c[2] = {0, 0};
     interp_target(in, 0, end);
-    s[0] = in->pos[p.a1];
-    s[1] = in->pos[p.a2];
-    e[0] = end[p.a1];
-    e[1] = end[p.a2];
+    interp_prog_pos(in, cur);
+    int ax[2] = {p.a1, p.a2};
+    for (int i = 0; i < 2; i++) { /* the ends in program units, as LinuxCNC computes arcs */
+        s[i] = cur[ax[i]];
+        e[i] = !W(letter[ax[i]]) ? s[i] : in->incremental ? s[i] + V(letter[ax[i]])
+                                                           : V(letter[ax[i]]);
+    }
     if (W('r') && (W('i') || W('j') || W('k')))
         return interp_fail(in, INTERP_ERR_WORD, W('r'), "arc with both R and I/J/K: use one form "
                            "or the other");
@@ -125,8 +123,9 @@ int interp_arc(struct interp *in, int g)
     struct canon_cmd cmd;
     interp_cmd_init(in, &cmd, CANON_ARC);
     memcpy(cmd.end, end, sizeof cmd.end);
-    cmd.arc.center[p.a1] = c[0];
-    cmd.arc.center[p.a2] = c[1];
+    for (int i = 0; i < 2; i++)
+        cmd.arc.center[ax[i]] = interp_len_mm(in, c[i]) + in->g5x[ax[i]] + in->g92[ax[i]] +
+                                in->tool[ax[i]];
     cmd.arc.center[p.n] = in->pos[p.n];
     cmd.arc.normal[p.n] = 1.0;
     cmd.arc.rotation = ccw ? turns : -turns;
