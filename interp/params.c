@@ -29,16 +29,17 @@ int interp_params_load(struct interp *in, const char *path)
             continue;
         char *end;
         long n = strtol(p, &end, 10);
+        in->line = lineno;
         if (end == p) {
-            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "%s:%d: a parameter number is expected at "
-                             "the start of the line", path, lineno);
+            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "a parameter number is expected at the "
+                             "start of the line");
             break;
         }
         p = end;
         double v = strtod(p, &end);
         if (end == p || n < 1 || n >= INTERP_NPARAMS) {
-            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "%s:%d: expected 'number value' with a "
-                             "number from 1 to %d", path, lineno, INTERP_NPARAMS - 1);
+            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "expected 'number value' with a number "
+                             "from 1 to %d", INTERP_NPARAMS - 1);
             break;
         }
         in->params[n] = v;

@@ -191,6 +191,12 @@ START_TEST(tool_length)
     ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 2)->end[2], 0);
     ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 3)->end[2], 13.5); /* G43 alone: tool 3 */
     canon_prog_free(&p);
+    /* G10 L1 writes the table: radius R (diameter 2R) and length Z */
+    ck_assert_int_eq(run_on(in, "G10 L1 P5 R3 Z7\nG43 H5\nG0 Z0\nG49\nM2\n", &p), 0);
+    ck_assert_double_eq(tooltable_find(tt, 5)->diameter_mm, 6);
+    ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 0)->end[2], 7);
+    canon_prog_free(&p);
+    ck_assert_int_eq(status_of("G10 L1 P5 R3\nM2\n"), INTERP_ERR_TOOL); /* no table */
     ck_assert_int_eq(run_on(in, "G43 H4\nM2\n", &p), INTERP_ERR_TOOL);
     canon_prog_free(&p);
     ck_assert_int_eq(run_on(in, "T9 M6\nM2\n", &p), INTERP_ERR_TOOL);
