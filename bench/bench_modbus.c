@@ -30,8 +30,10 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Mean, 99th percentile and maximum of n samples (us); sorts them. */
+/* Summary of one approach's samples, us. */
 struct stats { double mean_us, p99_us, max_us; };
+
+/* Mean, 99th percentile and maximum of n samples (us); sorts them. */
 static struct stats stats_of(double *us, int n)
 {
     struct stats s = { 0.0, 0.0, 0.0 };
@@ -141,6 +143,7 @@ static int run_parallel(struct modbus_drive *d, double *cycle_us)
 static int run_rounds(struct modbus_sim *s, double *a, double *b, double *c)
 {
     struct modbus_drive d[NDRIVES];
+    memset(d, 0, sizeof(d));                /* closing a never-opened drive is then safe */
     int rc = open_drives(d, s);
     for (int r = 0; !rc && r < ROUNDS; r++) {
         int o = r * PER_ROUND;
@@ -156,15 +159,22 @@ static int run_rounds(struct modbus_sim *s, double *a, double *b, double *c)
  * the drives' I/O threads exchange every 1 ms; one sample per simulated servo period. */
 static int run_mailbox(struct modbus_sim *s, double *servo_us, uint32_t *exchanges)
 {
-    static struct modbus_link l[NDRIVES];
+    struct modbus_link *l = calloc(NDRIVES, sizeof(*l));
+    if (!l)
+        return -1;
     for (int i = 0; i < NDRIVES; i++) {
         struct modbus_drive_cfg c;
         modbus_drive_cfg_default(&c, i);
         c.port = modbus_sim_port(s, i);
         c.period_ns = 1000000;
         c.timeout_us = 500000;
-        if (modbus_link_init(&l[i], &c) || modbus_link_start(&l[i]))
+        if (modbus_link_init(&l[i], &c) || modbus_link_start(&l[i])) {
+            fprintf(stderr, "bench_modbus: %s\n", modbus_drive_message(&l[i].drive));
+            for (int j = 0; j <= i; j++)
+                modbus_link_fini(&l[j]);
+            free(l);
             return -1;
+        }
     }
     struct timespec nap = { 0, 1000000 };
     struct modbus_feedback fb;
@@ -186,6 +196,7 @@ static int run_mailbox(struct modbus_sim *s, double *servo_us, uint32_t *exchang
         failed |= fb.fault;
         modbus_link_fini(&l[i]);
     }
+    free(l);
     return failed ? -1 : 0;
 }
 
@@ -204,10 +215,15 @@ int main(void)
         fprintf(stderr, "bench_modbus: cannot start the simulated drives\n");
         return 1;
     }
-    static double a[CYCLES], b[CYCLES], c[CYCLES], m[CYCLES / 2];
+    double *a = calloc(CYCLES, sizeof(double)), *b = calloc(CYCLES, sizeof(double));
+    double *c = calloc(CYCLES, sizeof(double)), *m = calloc(CYCLES / 2, sizeof(double));
     uint32_t mailbox_exchanges = 0;
-    if (run_rounds(s, a, b, c) || run_mailbox(s, m, &mailbox_exchanges)) {
+    if (!a || !b || !c || !m || run_rounds(s, a, b, c) || run_mailbox(s, m, &mailbox_exchanges)) {
         modbus_sim_destroy(s);
+        free(a);
+        free(b);
+        free(c);
+        free(m);
         return 1;
     }
     modbus_sim_destroy(s);
@@ -225,5 +241,9 @@ int main(void)
     print_row("mailbox: post commands, read feedback (chosen)", sm, sa);
     printf("  per-drive round trip (serial FC23 cycle / %d): mean %.1f us\n", NDRIVES,
            sb.mean_us / NDRIVES);
+    free(a);
+    free(b);
+    free(c);
+    free(m);
     return 0;
 }
