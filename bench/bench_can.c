@@ -18,7 +18,7 @@
  */
 
 #define NDRIVES 6
-#define CYCLES 20000     /* timed cycles per run: 20 s of 1 kHz SYNC */
+#define CYCLES 10000     /* timed cycles per run: 10 s of 1 kHz SYNC */
 #define RUNS 5           /* runs per variant; the best median is reported (shared machine) */
 #define WARMUP 300       /* cycles to configure and enable the drives first */
 
@@ -195,7 +195,12 @@ int main(void)
         return 1;
     }
     free(samples);
-    double core = core_only_ns();
+    double core = 1e30;
+    for (int k = 0; k < RUNS; k++) {  /* best of RUNS, like the I/O figures */
+        double c = core_only_ns();
+        if (c >= 0 && c < core)
+            core = c;
+    }
     printf("CiA 402 master, %d drives, SYNC + %d RPDOs out and %d TPDOs in per cycle, "
            "socketpair, %d cycles x %d runs (best median):\n", NDRIVES, NDRIVES, NDRIVES,
            CYCLES, RUNS);
@@ -204,7 +209,7 @@ int main(void)
     printf("  baseline, read()/write() per frame: median %.2f us, mean %.2f us per cycle\n",
            pm / 1e3, pa / 1e3);
     printf("  ratio baseline / batched (median): %.2f\n", pm / bm);
-    printf("  protocol core alone (no system calls): %.0f ns per cycle\n", core);
+    printf("  protocol core alone (no system calls, best of %d): %.0f ns per cycle\n", RUNS, core);
     printf("  share of a 1 ms servo period (batched median): %.2f %%\n", bm / 1e6 * 100.0);
     printf("  bus load of this traffic at 1 kHz on 1 Mbit/s: %.1f %% (docs/can.md: does not "
            "fit; 500 Hz: %.1f %%)\n", 100.0 * can_csp_load(NDRIVES, 6, 6, 1000, 50, 1e6),
