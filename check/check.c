@@ -1,0 +1,152 @@
+/* check.c: the check of one program: interpret, scan the reach, plan, run on the servo clock. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check/check_priv.h"
+
+static const char *const kind_names[CHECK_KIND_COUNT] = {
+    [CHECK_INTERP] = "interp",
+    [CHECK_UNREACHABLE] = "unreachable",
+    [CHECK_LEG_RANGE] = "leg_range",
+    [CHECK_LEG_VELOCITY] = "leg_velocity",
+    [CHECK_LEG_ACCELERATION] = "leg_acceleration",
+    [CHECK_SINGULAR] = "singular",
+    [CHECK_PLAN] = "plan",
+};
+
+const char *check_kind_name(enum check_kind k)
+{
+    return k < CHECK_KIND_COUNT ? kind_names[k] : "unknown";
+}
+
+void check_opts_default(struct check_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->deviation_every_s = 0.010;
+    o->condition_every_s = 0.050;
+}
+
+void check_result_init(struct check_result *r)
+{
+    memset(r, 0, sizeof *r);
+}
+
+void check_result_free(struct check_result *r)
+{
+    free(r->problems);
+    r->problems = NULL;
+    r->nproblems = r->capproblems = 0;
+}
+
+int check_add_problem(struct check_result *r, const struct check_problem *p)
+{
+    for (size_t i = 0; i < r->nproblems; i++) {
+        struct check_problem *q = &r->problems[i];
+        if (q->kind != p->kind || q->line != p->line || q->leg != p->leg ||
+            strcmp(q->file, p->file) != 0)
+            continue;
+        int count = q->count + p->count;
+        if (fabs(p->value) > fabs(q->value))  /* keep the worst occurrence's figures */
+            *q = *p;
+        q->count = count;
+        return CHECK_OK;
+    }
+    if (r->nproblems == r->capproblems) {
+        size_t cap = r->capproblems ? 2 * r->capproblems : 16;
+        struct check_problem *np = realloc(r->problems, cap * sizeof *np);
+        if (!np)
+            return CHECK_ERR_NOMEM;
+        r->problems = np, r->capproblems = cap;
+    }
+    r->problems[r->nproblems++] = *p;
+    return CHECK_OK;
+}
+
+/* The line number in a "file:line: ..." message from motion, 0 when there is none. */
+static int message_line(const char *msg, const struct canon_prog *prog, char *file, size_t len)
+{
+    for (size_t k = 0; k < prog->count; k++) {
+        const char *f = prog->cmds[k].file;
+        size_t n = f ? strlen(f) : 0;
+        if (n && strncmp(msg, f, n) == 0 && msg[n] == ':') {
+            snprintf(file, len, "%s", f);
+            return atoi(msg + n + 1);
+        }
+    }
+    return 0;
+}
+
+/* Fills the result's header fields from the machine. */
+static void result_header(struct check_machine *mc, const struct check_opts *o,
+                          struct check_result *r)
+{
+    r->servo_period_s = mc->mcfg.servo_period_s;
+    r->kin_tol_mm = mc->mcfg.kin_tol_mm;
+    r->condition_limit = mc->cond_limit;
+    r->deviation_every_s = o->deviation_every_s;
+    r->condition_every_s = o->condition_every_s;
+    r->njoints = mc->kins->njoints;
+    snprintf(r->config, sizeof r->config, "%s", mc->ini);
+}
+
+int check_canon(struct check_machine *mc, const struct canon_prog *prog,
+                const struct check_opts *opts, struct check_result *r)
+{
+    struct check_opts def;
+    if (!opts) {
+        check_opts_default(&def);
+        opts = &def;
+    }
+    result_header(mc, opts, r);
+    int reach = check_scan_reach(mc, prog, r);
+    char msg[400];
+    if (motion_load(mc->motion, prog, msg, sizeof msg) != MOTION_OK) {
+        if (reach == 0) {      /* the planner found what the reach pass did not: report it */
+            struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = -1,
+                                       .count = 1 };
+            p.line = message_line(msg, prog, p.file, sizeof p.file);
+            snprintf(p.message, sizeof p.message, "%s", msg);
+            check_add_problem(r, &p);
+        }
+        return CHECK_ERR_VIOLATION;
+    }
+    if (motion_start(mc->motion) != MOTION_OK)
+        return CHECK_ERR_CONFIG;
+    int st = check_simulate(mc, opts, r);
+    r->simulated = 1;
+    if (st != CHECK_OK) {
+        struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = r->machining_time_s,
+                                   .count = 1 };
+        snprintf(msg, sizeof msg, "%s", motion_last_error(mc->motion));
+        p.line = message_line(msg, prog, p.file, sizeof p.file);
+        snprintf(p.message, sizeof p.message, "motion stopped before the end of the program: "
+                 "%.300s", msg[0] ? msg : "it did not finish in twice the planned time");
+        check_add_problem(r, &p);
+    }
+    return r->nproblems ? CHECK_ERR_VIOLATION : CHECK_OK;
+}
+
+int check_program(struct check_machine *mc, const char *path, const struct check_opts *opts,
+                  struct check_result *r)
+{
+    struct canon_prog prog;
+    struct check_problem p;
+    struct check_opts def;
+    if (!opts) {
+        check_opts_default(&def);
+        opts = &def;
+    }
+    snprintf(r->program, sizeof r->program, "%s", path);
+    canon_prog_init(&prog);
+    int st = check_machine_interpret(mc, path, &prog, &p);
+    if (st != CHECK_OK) {
+        result_header(mc, opts, r);
+        check_add_problem(r, &p);
+    } else {
+        st = check_canon(mc, &prog, opts, r);
+    }
+    canon_prog_free(&prog);
+    return st;
+}

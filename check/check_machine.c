@@ -1,0 +1,203 @@
+/* check_machine.c: the machine of an INI file (kinematics, motion, interpreter settings) without HAL threads. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check/check_priv.h"
+#include "hal/hal.h"
+#include "interp/interp.h"
+#include "interp/tooltable.h"
+
+static const char *const status_text[CHECK_STATUS_COUNT] = {
+    [CHECK_OK] = "ok",
+    [CHECK_ERR_NOMEM] = "out of memory",
+    [CHECK_ERR_CONFIG] = "the machine configuration is wrong",
+    [CHECK_ERR_KINS] = "the kinematics could not be loaded",
+    [CHECK_ERR_IO] = "a file could not be written",
+    [CHECK_ERR_VIOLATION] = "the program has problems",
+};
+
+const char *check_strerror(int status)
+{
+    if (status < 0 || status >= CHECK_STATUS_COUNT)
+        return "unknown check status";
+    return status_text[status];
+}
+
+/* Formats into err and returns status (one-line error paths). */
+static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+/* The kins_config lookup over the INI held by the HAL runtime (only its reader is used). */
+static const char *ini_get(void *ctx, const char *section, const char *key)
+{
+    return hal_ini_get(ctx, section, key);
+}
+
+/* A path from the INI, relative to the INI's folder unless absolute. */
+static void ini_path(const struct check_machine *mc, const char *value, char *out, size_t len)
+{
+    const char *dir = hal_ini_dir(mc->hal);
+    if (value[0] == '/' || !dir || !dir[0])
+        snprintf(out, len, "%s", value);
+    else
+        snprintf(out, len, "%s/%s", dir, value);
+}
+
+/* Reads the interpreter's settings: FEED_UNITS and TOOL_TABLE. */
+static int read_interp_settings(struct check_machine *mc, const char *ini, char *err,
+                                size_t errlen)
+{
+    const char *units = hal_ini_get(mc->hal, "RS274NGC", "FEED_UNITS");
+    mc->feed_factor = 1.0;
+    if (units && interp_feed_units_parse(units, &mc->feed_factor) != 0)
+        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [RS274NGC] FEED_UNITS = %s: expected "
+                    "mm/min or m/min", ini, units);
+    const char *table = hal_ini_get(mc->hal, "RS274NGC", "TOOL_TABLE");
+    if (table && table[0]) {
+        char path[1024], msg[512];
+        ini_path(mc, table, path, sizeof path);
+        if (tooltable_load(mc->tt, path, msg, sizeof msg) != TOOLTABLE_OK)
+            return fail(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
+        mc->have_tt = 1;
+    }
+    for (int i = 0; i < KINS_MAX_JOINTS; i++) {
+        char sec[16];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        if (hal_ini_double(mc->hal, sec, "SCALE", 0, &mc->scale[i]) == HAL_ERR_SYNTAX)
+            return fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+    }
+    return CHECK_OK;
+}
+
+int check_machine_open(const char *ini, struct check_machine **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    struct check_machine *mc = calloc(1, sizeof *mc);
+    int st = CHECK_ERR_NOMEM;
+    if (!mc || !(mc->hal = hal_create()) || !(mc->tt = malloc(sizeof *mc->tt))) {
+        fail(err, errlen, st, "out of memory");
+        goto fail;
+    }
+    tooltable_init(mc->tt);
+    snprintf(mc->ini, sizeof mc->ini, "%s", ini);
+    if (hal_load_ini(mc->hal, ini) != HAL_OK) {
+        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+        goto fail;
+    }
+    struct kins_config kc = { ini_get, mc->hal };
+    const char *name = hal_ini_get(mc->hal, "KINS", "KINEMATICS");
+    char msg[768];
+    if (!name) {
+        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] KINEMATICS is missing: which "
+                  "kinematics does the machine have?", ini);
+        goto fail;
+    }
+    if (kins_load(name, &kc, &mc->kins, msg, sizeof msg) != KINS_OK) {
+        st = fail(err, errlen, CHECK_ERR_KINS, "%s: %s", ini, msg);
+        goto fail;
+    }
+    motion_config_default(&mc->mcfg);
+    if (motion_config_read(&mc->mcfg, &kc, mc->kins->njoints, msg, sizeof msg) != MOTION_OK ||
+        motion_create(&mc->mcfg, mc->kins, &mc->motion, msg, sizeof msg) != MOTION_OK) {
+        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s: %s", ini, msg);
+        goto fail;
+    }
+    mc->cond_limit = 100;
+    if (hal_ini_double(mc->hal, "KINS", "SINGULAR_CONDITION", 100, &mc->cond_limit) ==
+        HAL_ERR_SYNTAX) {
+        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+        goto fail;
+    }
+    if ((st = read_interp_settings(mc, ini, err, errlen)))
+        goto fail;
+    *out = mc;
+    return CHECK_OK;
+fail:
+    check_machine_close(mc);
+    return st;
+}
+
+void check_machine_close(struct check_machine *mc)
+{
+    if (!mc)
+        return;
+    motion_destroy(mc->motion);
+    kins_free(mc->kins);
+    hal_destroy(mc->hal);
+    free(mc->tt);
+    free(mc);
+}
+
+struct kins *check_machine_kins(struct check_machine *mc) { return mc->kins; }
+struct motion *check_machine_motion(struct check_machine *mc) { return mc->motion; }
+const struct motion_config *check_machine_motion_config(const struct check_machine *mc)
+{
+    return &mc->mcfg;
+}
+
+double check_machine_scale(const struct check_machine *mc, int joint)
+{
+    return joint >= 0 && joint < KINS_MAX_JOINTS ? mc->scale[joint] : 0;
+}
+
+double check_machine_tool_radius(struct check_machine *mc, int tool)
+{
+    double r;
+    if (!mc->have_tt || tooltable_radius(mc->tt, tool, &r) != TOOLTABLE_OK)
+        return -1;
+    return r;
+}
+
+/* Interprets a file (text NULL) or text held in memory into prog. */
+static int interpret(struct check_machine *mc, const char *path, const char *text, size_t len,
+                     struct canon_prog *prog, struct check_problem *pb)
+{
+    struct interp *in = interp_create();
+    memset(pb, 0, sizeof *pb);
+    pb->kind = CHECK_INTERP, pb->leg = -1, pb->time_s = -1, pb->count = 1;
+    if (!in) {
+        snprintf(pb->message, sizeof pb->message, "out of memory");
+        return CHECK_ERR_NOMEM;
+    }
+    interp_set_start(in, mc->kins->home);
+    memcpy(prog->start, mc->kins->home, sizeof prog->start);
+    interp_set_feed_factor(in, mc->feed_factor);
+    if (mc->have_tt)
+        interp_set_tooltable(in, mc->tt);
+    int st = CHECK_OK;
+    int ist = text ? interp_run_text(in, path, text, len, canon_prog_sink, prog)
+                   : interp_run_file(in, path, canon_prog_sink, prog);
+    if (ist != INTERP_OK) {
+        const struct interp_error *e = interp_last_error(in);
+        snprintf(pb->file, sizeof pb->file, "%s", e->file[0] ? e->file : path);
+        pb->line = e->line, pb->column = e->column;
+        interp_error_format(e, pb->message, sizeof pb->message);
+        st = CHECK_ERR_VIOLATION;
+    }
+    interp_destroy(in);
+    return st;
+}
+
+int check_machine_interpret(struct check_machine *mc, const char *path, struct canon_prog *prog,
+                            struct check_problem *pb)
+{
+    return interpret(mc, path, NULL, 0, prog, pb);
+}
+
+int check_machine_interpret_text(struct check_machine *mc, const char *name, const char *text,
+                                 size_t len, struct canon_prog *prog, struct check_problem *pb)
+{
+    return interpret(mc, name, text, len, prog, pb);
+}

@@ -1,0 +1,259 @@
+/* check_plot.c: the check's sample trace, the no-compensation variant of a program, and its SVG plots. */
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check/check_priv.h"
+#include "check/plot.h"
+
+static const char *const leg_colors[KINS_MAX_JOINTS] = {
+    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+    "#bcbd22",
+};
+
+void check_trace_init(struct check_trace *t)
+{
+    memset(t, 0, sizeof *t);
+}
+
+void check_trace_free(struct check_trace *t)
+{
+    free(t->t_s), free(t->legs_mm), free(t->rates_mm_s), free(t->pose);
+    free(t->dev_dist_mm), free(t->dev_t_s), free(t->dev_mm);
+    check_trace_init(t);
+}
+
+long check_trace_begin(struct check_trace *t, double planned_s, double period_s)
+{
+    long periods = (long)(planned_s / period_s) + 1;
+    long every = periods / CHECK_TRACE_POINTS + 1;
+    t->dev_every = 1, t->dev_count = 0;
+    return every;
+}
+
+/* Grows an array of doubles to hold cap * width values; 0 or -1. */
+static int grow(double **a, size_t cap, size_t width)
+{
+    double *n = realloc(*a, cap * width * sizeof *n);
+    if (!n)
+        return -1;
+    *a = n;
+    return 0;
+}
+
+void check_trace_add(struct check_trace *t, double t_s, int nj, const double *legs,
+                     const double *rates, const double *pose)
+{
+    if (t->n == t->cap) {
+        size_t cap = t->cap ? 2 * t->cap : 1024;
+        if (grow(&t->t_s, cap, 1) || grow(&t->legs_mm, cap, KINS_MAX_JOINTS) ||
+            grow(&t->rates_mm_s, cap, KINS_MAX_JOINTS) || grow(&t->pose, cap, KINS_POSE_DIM)) {
+            t->failed = 1;
+            return;
+        }
+        t->cap = cap;
+    }
+    t->njoints = nj;
+    t->t_s[t->n] = t_s;
+    memcpy(&t->legs_mm[t->n * KINS_MAX_JOINTS], legs, (size_t)nj * sizeof *legs);
+    memcpy(&t->rates_mm_s[t->n * KINS_MAX_JOINTS], rates, (size_t)nj * sizeof *rates);
+    memcpy(&t->pose[t->n * KINS_POSE_DIM], pose, KINS_POSE_DIM * sizeof *pose);
+    t->n++;
+}
+
+void check_trace_deviation(struct check_trace *t, double dist_mm, double t_s, double dev_mm)
+{
+    if (++t->dev_count < t->dev_every)
+        return;
+    t->dev_count = 0;
+    if (t->ndev == t->capdev) {
+        if (t->capdev >= 4 * CHECK_TRACE_POINTS) {   /* too many: keep every other one */
+            size_t j = 0;
+            for (size_t i = 0; i < t->ndev; i += 2, j++)
+                t->dev_dist_mm[j] = t->dev_dist_mm[i], t->dev_t_s[j] = t->dev_t_s[i],
+                t->dev_mm[j] = t->dev_mm[i];
+            t->ndev = j, t->dev_every *= 2;
+        } else {
+            size_t cap = t->capdev ? 2 * t->capdev : 1024;
+            if (grow(&t->dev_dist_mm, cap, 1) || grow(&t->dev_t_s, cap, 1) ||
+                grow(&t->dev_mm, cap, 1)) {
+                t->failed = 1;
+                return;
+            }
+            t->capdev = cap;
+        }
+    }
+    t->dev_dist_mm[t->ndev] = dist_mm, t->dev_t_s[t->ndev] = t_s, t->dev_mm[t->ndev] = dev_mm;
+    t->ndev++;
+}
+
+/* Length of a number word's value at s (sign, digits, point), 0 when none. */
+static size_t number_len(const char *s, size_t left)
+{
+    size_t i = 0;
+    while (i < left && (s[i] == ' ' || s[i] == '\t'))
+        i++;
+    if (i < left && (s[i] == '+' || s[i] == '-'))
+        i++;
+    size_t d = i;
+    while (i < left && (isdigit((unsigned char)s[i]) || s[i] == '.'))
+        i++;
+    return i > d ? i : 0;
+}
+
+char *check_strip_compensation(const char *text, size_t len)
+{
+    char *o = malloc(len + 1);
+    if (!o)
+        return NULL;
+    memcpy(o, text, len);
+    o[len] = 0;
+    for (size_t i = 0; i < len; i++) {
+        char c = (char)toupper((unsigned char)o[i]);
+        if (c == 'G' && i + 4 <= len && o[i + 1] == '1' && o[i + 2] == '4' &&
+            (o[i + 3] == '1' || o[i + 3] == '2') &&
+            (i + 4 == len || !isdigit((unsigned char)o[i + 4]))) {
+            o[i + 2] = ' ', o[i + 3] = ' ';   /* G141 / G142 -> G1 */
+            i += 3;
+        } else if (c == 'W' || c == 'D') {
+            size_t n = number_len(o + i + 1, len - i - 1);
+            for (size_t j = 0; n && j <= n; j++)
+                o[i + j] = ' ';
+        }
+    }
+    return o;
+}
+
+/* XYZ of the moves of a canonical program, lines as their ends, arcs in 32 pieces. */
+static size_t path_points(const struct canon_prog *p, double *xyz, size_t cap)
+{
+    double from[KINS_POSE_DIM], pose[KINS_POSE_DIM];
+    size_t n = 0;
+    memcpy(from, p->start, sizeof from);
+    if (cap)
+        memcpy(xyz, from, 3 * sizeof *xyz), n = 1;
+    for (size_t k = 0; k < p->count && n < cap; k++) {
+        const struct canon_cmd *c = &p->cmds[k];
+        if (!check_is_motion(c->type))
+            continue;
+        int pieces = c->type == CANON_ARC ? 32 : 1;
+        for (int j = 1; j <= pieces && n < cap; j++, n++) {
+            check_move_pose(from, c, (double)j / pieces, pose);
+            memcpy(&xyz[3 * n], pose, 3 * sizeof *xyz);
+        }
+        memcpy(from, c->end, sizeof from);
+    }
+    return n;
+}
+
+/* Isometric view: u = (X - Y) cos 30, v = Z + (X + Y) sin 30, in place over n points. */
+static void isometric(double *xyz, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+        xyz[3 * i] = (x - y) * cos(M_PI / 6);
+        xyz[3 * i + 1] = z + (x + y) * sin(M_PI / 6);
+    }
+}
+
+/* The two tool path views: programmed contour (dashed) against compensated tool path. */
+static int path_plots(const char *dir, const struct canon_prog *path,
+                      const struct canon_prog *contour, char *file, size_t flen)
+{
+    size_t cap = 1 + 32 * (path->count + (contour ? contour->count : 0));
+    double *a = malloc(3 * cap * sizeof *a), *b = malloc(3 * cap * sizeof *b);
+    int st = -1;
+    if (!a || !b)
+        goto out;
+    size_t na = path_points(path, a, cap), nb = contour ? path_points(contour, b, cap) : 0;
+    struct svg_series s[2] = {
+        { "compensated tool path", a, a + 1, na, 3, "#1f77b4", 0, 0 },
+        { "programmed contour", b, b + 1, nb, 3, "#d62728", 1, 0 },
+    };
+    struct svg_chart top = { "Tool path, top view (program X Y: platform pose)", "X (mm)",
+                             "Y (mm)", 1 };
+    snprintf(file, flen, "%s/toolpath_top.svg", dir);
+    if (svg_write_chart(file, &top, s, nb ? 2 : 1))
+        goto out;
+    isometric(a, na), isometric(b, nb);
+    struct svg_chart iso = { "Tool path, isometric view", "(X - Y) cos 30 deg (mm)",
+                             "Z + (X + Y) sin 30 deg (mm)", 1 };
+    snprintf(file, flen, "%s/toolpath_3d.svg", dir);
+    st = svg_write_chart(file, &iso, s, nb ? 2 : 1);
+out:
+    free(a), free(b);
+    return st;
+}
+
+/* Leg lengths and leg rates against time, one series per leg. */
+static int leg_plots(const char *dir, const struct check_trace *t, char *file, size_t flen)
+{
+    struct svg_series s[KINS_MAX_JOINTS];
+    char names[KINS_MAX_JOINTS][16];
+    for (int i = 0; i < t->njoints; i++) {
+        snprintf(names[i], sizeof names[i], "leg %d", i + 1);
+        s[i] = (struct svg_series){ names[i], t->t_s, NULL, t->n, 0, leg_colors[i], 0, 0 };
+    }
+    /* the legs are stored KINS_MAX_JOINTS apart: copy each into its own run */
+    double *y = malloc((t->n ? t->n : 1) * KINS_MAX_JOINTS * sizeof *y);
+    if (!y)
+        return -1;
+    for (size_t k = 0; k < t->n; k++)
+        for (int i = 0; i < t->njoints; i++)
+            y[i * t->n + k] = t->legs_mm[k * KINS_MAX_JOINTS + i];
+    for (int i = 0; i < t->njoints; i++)
+        s[i].y = y + i * t->n;
+    struct svg_chart c1 = { "Leg lengths", "machine time (s)", "leg length (mm)", 0 };
+    snprintf(file, flen, "%s/legs.svg", dir);
+    int st = svg_write_chart(file, &c1, s, t->njoints);
+    for (size_t k = 0; k < t->n; k++)
+        for (int i = 0; i < t->njoints; i++)
+            y[i * t->n + k] = t->rates_mm_s[k * KINS_MAX_JOINTS + i];
+    struct svg_chart c2 = { "Leg rates", "machine time (s)", "leg rate (mm/s)", 0 };
+    snprintf(file, flen, "%s/leg_rates.svg", dir);
+    st = st ? st : svg_write_chart(file, &c2, s, t->njoints);
+    free(y);
+    return st;
+}
+
+/* Kinematic deviation along the path, with the tolerance. */
+static int deviation_plot(const char *dir, const struct check_trace *t,
+                          const struct check_result *r, char *file, size_t flen)
+{
+    double *um = malloc((t->ndev ? t->ndev : 1) * sizeof *um);
+    if (!um)
+        return -1;
+    for (size_t i = 0; i < t->ndev; i++)
+        um[i] = t->dev_mm[i] * 1e3;
+    double tx[2] = { 0, r->length_mm }, ty[2] = { r->kin_tol_mm * 1e3, r->kin_tol_mm * 1e3 };
+    struct svg_series s[2] = {
+        { "deviation between set points", t->dev_dist_mm, um, t->ndev, 0, "#1f77b4", 0, 1 },
+        { "KINEMATIC_TOLERANCE", tx, ty, 2, 0, "#d62728", 1, 0 },
+    };
+    struct svg_chart c = { "Kinematic deviation from the programmed path",
+                           "distance along the path (mm)", "deviation (um)", 0 };
+    snprintf(file, flen, "%s/deviation.svg", dir);
+    int st = svg_write_chart(file, &c, s, r->kin_tol_mm > 0 ? 2 : 1);
+    free(um);
+    return st;
+}
+
+int check_write_plots(const char *dir, const struct canon_prog *path,
+                      const struct canon_prog *contour, const struct check_trace *trace,
+                      const struct check_result *r, char *err, size_t errlen)
+{
+    char file[1200];
+    if (trace->failed) {
+        snprintf(err, errlen, "out of memory while keeping the plot samples");
+        return CHECK_ERR_NOMEM;
+    }
+    if (path_plots(dir, path, contour, file, sizeof file) ||
+        leg_plots(dir, trace, file, sizeof file) ||
+        deviation_plot(dir, trace, r, file, sizeof file)) {
+        snprintf(err, errlen, "%s: cannot write the plot (does the folder exist?)", file);
+        return CHECK_ERR_IO;
+    }
+    return CHECK_OK;
+}

@@ -1,0 +1,42 @@
+/* check_priv.h: the check library's machine struct and shared internals (inside check/ only). */
+#ifndef HEXCNC_CHECK_PRIV_H
+#define HEXCNC_CHECK_PRIV_H
+
+#include "check/check.h"
+
+struct hal;
+struct tooltable;
+
+/* The machine of one INI: its reader, kinematics, motion and interpreter settings. */
+struct check_machine {
+    struct hal *hal;                 /* used only for its INI reader (no threads) */
+    struct kins *kins;               /* loaded by name from [KINS] KINEMATICS */
+    struct motion *motion;           /* the planner and interpolator the machine runs */
+    struct motion_config mcfg;       /* its limits, from [EMCMOT] [TRAJ] [JOINT_n] */
+    struct tooltable *tt;            /* [RS274NGC] TOOL_TABLE (empty when none) */
+    int have_tt;
+    double feed_factor;              /* mm/min per F unit ([RS274NGC] FEED_UNITS) */
+    double cond_limit;               /* [KINS] SINGULAR_CONDITION */
+    double scale[KINS_MAX_JOINTS];   /* [JOINT_n] SCALE, steps per mm (0 = none) */
+    char ini[256];
+};
+
+/* Whether a canonical command moves the machine. */
+static inline int check_is_motion(enum canon_type t)
+{
+    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC;
+}
+
+/* Pose at fraction u in [0, 1] of move c starting at `from` (lines and arcs/helices). */
+void check_move_pose(const double from[KINS_POSE_DIM], const struct canon_cmd *c, double u,
+                     double pose[KINS_POSE_DIM]);
+
+/* Static pass: every move sampled through the inverse kinematics; reach problems into r.
+ * Returns the number of problems found. */
+int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
+                     struct check_result *r);
+
+/* Servo-rate pass through motion_step (the program must be loaded and started). */
+int check_simulate(struct check_machine *mc, const struct check_opts *o, struct check_result *r);
+
+#endif

@@ -1,0 +1,150 @@
+/* check_report.c: the check's output: a short human table and one JSON object for tools. */
+#include <math.h>
+#include <stdio.h>
+
+#include "check/check.h"
+
+/* Prints a JSON string with the characters JSON requires escaped. */
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+/* A number, or null when it is not finite (JSON has no inf/nan). */
+static void json_num(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.9g", v);
+    else
+        fputs("null", f);
+}
+
+void check_print_json(const struct check_result *r, FILE *f)
+{
+    fputs("{\"program\":", f);
+    json_str(f, r->program);
+    fputs(",\"config\":", f);
+    json_str(f, r->config);
+    fprintf(f, ",\"ok\":%s,\"simulated\":%s,\"servo_period_s\":", r->nproblems ? "false" : "true",
+            r->simulated ? "true" : "false");
+    json_num(f, r->servo_period_s);
+    fputs(",\"machining_time_s\":", f);
+    json_num(f, r->machining_time_s);
+    fputs(",\"planned_time_s\":", f);
+    json_num(f, r->planned_time_s);
+    fputs(",\"length_mm\":", f);
+    json_num(f, r->length_mm);
+    fprintf(f, ",\"periods\":%ld,\"deviation\":{\"max_mm\":", r->periods);
+    json_num(f, r->max_deviation_mm);
+    fprintf(f, ",\"line\":%d,\"max_deg\":", r->max_deviation_line);
+    json_num(f, r->max_deviation_deg);
+    fputs(",\"tolerance_mm\":", f);
+    json_num(f, r->kin_tol_mm);
+    fputs(",\"every_s\":", f);
+    json_num(f, r->deviation_every_s);
+    fprintf(f, ",\"evaluations\":%ld},\"condition\":{\"max\":", r->deviation_evals);
+    json_num(f, r->max_condition);
+    fprintf(f, ",\"line\":%d,\"limit\":", r->max_condition_line);
+    json_num(f, r->condition_limit);
+    fputs(",\"every_s\":", f);
+    json_num(f, r->condition_every_s);
+    fprintf(f, ",\"evaluations\":%ld},\"legs\":[", r->condition_evals);
+    for (int i = 0; r->simulated && i < r->njoints; i++) {
+        const struct check_leg *l = &r->leg[i];
+        fprintf(f, "%s{\"leg\":%d,\"min_mm\":", i ? "," : "", i + 1);
+        json_num(f, l->min_mm);
+        fputs(",\"max_mm\":", f);
+        json_num(f, l->max_mm);
+        fputs(",\"peak_vel_mm_s\":", f);
+        json_num(f, l->peak_vel_mm_s);
+        fputs(",\"peak_acc_mm_s2\":", f);
+        json_num(f, l->peak_acc_mm_s2);
+        fputs(",\"limit_min_mm\":", f);
+        json_num(f, l->limit_min_mm);
+        fputs(",\"limit_max_mm\":", f);
+        json_num(f, l->limit_max_mm);
+        fputs(",\"limit_vel_mm_s\":", f);
+        json_num(f, l->limit_vel_mm_s);
+        fputs(",\"limit_acc_mm_s2\":", f);
+        json_num(f, l->limit_acc_mm_s2);
+        fputc('}', f);
+    }
+    fputs("],\"problems\":[", f);
+    for (size_t i = 0; i < r->nproblems; i++) {
+        const struct check_problem *p = &r->problems[i];
+        fprintf(f, "%s{\"kind\":\"%s\",\"file\":", i ? "," : "", check_kind_name(p->kind));
+        json_str(f, p->file);
+        fprintf(f, ",\"line\":%d,\"column\":%d,\"leg\":%d,\"value\":", p->line, p->column,
+                p->leg >= 0 ? p->leg + 1 : 0);
+        json_num(f, p->value);
+        fputs(",\"limit\":", f);
+        json_num(f, p->limit);
+        fputs(",\"time_s\":", f);
+        json_num(f, p->time_s);
+        fprintf(f, ",\"count\":%d,\"message\":", p->count);
+        json_str(f, p->message);
+        fputc('}', f);
+    }
+    fputs("]}\n", f);
+}
+
+/* Minutes and seconds for people. */
+static void print_duration(FILE *f, double s)
+{
+    if (s >= 60)
+        fprintf(f, "%d min %.3f s", (int)(s / 60), fmod(s, 60));
+    else
+        fprintf(f, "%.3f s", s);
+}
+
+void check_print_table(const struct check_result *r, FILE *f)
+{
+    fprintf(f, "check %s on %s\n", r->program, r->config);
+    if (r->simulated) {
+        fputs("machining time  ", f);
+        print_duration(f, r->machining_time_s);
+        fprintf(f, " (%ld servo periods of %.3f ms), path %.3f mm\n", r->periods,
+                r->servo_period_s * 1e3, r->length_mm);
+        fprintf(f, "deviation       %.6f mm max (line %d), %.6f deg; tolerance %.6f mm; "
+                "measured every %.0f ms and at each line change\n", r->max_deviation_mm,
+                r->max_deviation_line, r->max_deviation_deg, r->kin_tol_mm,
+                r->deviation_every_s * 1e3);
+        fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured every %.0f ms and "
+                "at each line change\n\n", r->max_condition, r->max_condition_line,
+                r->condition_limit, r->condition_every_s * 1e3);
+        fputs("leg   min mm     max mm     range mm         peak mm/s  limit   "
+              "peak mm/s^2  limit\n", f);
+        for (int i = 0; i < r->njoints; i++) {
+            const struct check_leg *l = &r->leg[i];
+            fprintf(f, "%-3d %9.3f  %9.3f  %6.1f..%-7.1f %9.3f  %6.1f  %11.3f  %6.1f\n", i + 1,
+                    l->min_mm, l->max_mm, l->limit_min_mm, l->limit_max_mm, l->peak_vel_mm_s,
+                    l->limit_vel_mm_s, l->peak_acc_mm_s2, l->limit_acc_mm_s2);
+        }
+        fputc('\n', f);
+    } else {
+        fputs("not run through motion: the program cannot start (see below)\n\n", f);
+    }
+    if (!r->nproblems) {
+        fputs("no problems: the program can be cut on this machine\n", f);
+        return;
+    }
+    fprintf(f, "%zu problem%s:\n", r->nproblems, r->nproblems == 1 ? "" : "s");
+    for (size_t i = 0; i < r->nproblems; i++) {
+        const struct check_problem *p = &r->problems[i];
+        if (p->kind == CHECK_INTERP || p->kind == CHECK_PLAN)
+            fprintf(f, "  %s [%s]\n", p->message, check_kind_name(p->kind));
+        else
+            fprintf(f, "  %s:%d: %s [%s%s]\n", p->file, p->line, p->message,
+                    check_kind_name(p->kind), p->count > 1 ? ", repeated" : "");
+    }
+}

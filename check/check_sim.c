@@ -1,0 +1,206 @@
+/* check_sim.c: the servo-rate pass: motion_step on a simulated clock, legs, rates, deviation, singularity. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "check/check_priv.h"
+#include "check/plot.h"
+
+#define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
+#define MAX_PERIODS_FACTOR 2 /* the run stops at twice the planned time (a stuck planner) */
+
+/* State of the pass between periods. */
+struct sim {
+    struct check_machine *mc;
+    const struct check_opts *o;
+    struct check_result *r;
+    int nj;
+    double T;                          /* servo period, s */
+    double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
+    double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s */
+    double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
+    double fwd[KINS_POSE_DIM];         /* last forward solution (the warm start) */
+    int have_v;                        /* v0 valid (two set points seen) */
+    int line;                          /* program line of the previous period */
+    const char *file;
+    double next_dev_s, next_cond_s;    /* machine time of the next scheduled measure */
+    long trace_every, trace_count;
+};
+
+/* Adds a leg limit problem (velocity or acceleration) at the current period. */
+static void leg_limit(struct sim *s, enum check_kind k, int leg, double value, double limit,
+                      double t_s)
+{
+    struct check_problem p = { .kind = k, .line = s->line, .leg = leg, .value = value,
+                               .limit = limit, .time_s = t_s, .count = 1 };
+    snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
+    const char *what = k == CHECK_LEG_VELOCITY ? "moves at" : "accelerates at";
+    const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : "mm/s^2";
+    snprintf(p.message, sizeof p.message, "leg %d %s %.3f %s, over its limit of %.3f %s "
+             "([JOINT_%d] %s) at %.3f s", leg + 1, what, value, unit, limit, unit, leg,
+             k == CHECK_LEG_VELOCITY ? "MAX_VELOCITY" : "MAX_ACCELERATION", t_s);
+    check_add_problem(s->r, &p);
+}
+
+/* Leg lengths, rates from successive set points and accelerations from successive rates. */
+static void legs_period(struct sim *s, const struct motion_out *out)
+{
+    struct check_result *r = s->r;
+    for (int i = 0; i < s->nj; i++) {
+        struct check_leg *lg = &r->leg[i];
+        double L = out->joint_pos[i], v = (L - s->L0[i]) / s->T;
+        lg->min_mm = fmin(lg->min_mm, L);
+        lg->max_mm = fmax(lg->max_mm, L);
+        if (L > lg->limit_max_mm || L < lg->limit_min_mm) {
+            struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = s->line, .leg = i,
+                                       .value = L, .time_s = out->time_elapsed_s, .count = 1 };
+            p.limit = L > lg->limit_max_mm ? lg->limit_max_mm : lg->limit_min_mm;
+            snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
+            snprintf(p.message, sizeof p.message, "leg %d reaches %.3f mm, beyond its limit "
+                     "%.3f mm", i + 1, L, p.limit);
+            check_add_problem(r, &p);
+        }
+        if (fabs(v) > lg->peak_vel_mm_s)
+            lg->peak_vel_mm_s = fabs(v);
+        if (fabs(v) > lg->limit_vel_mm_s * (1 + LIMIT_SLACK))
+            leg_limit(s, CHECK_LEG_VELOCITY, i, fabs(v), lg->limit_vel_mm_s,
+                      out->time_elapsed_s);
+        if (s->have_v) {
+            double a = fabs(v - s->v0[i]) / s->T;
+            if (a > lg->peak_acc_mm_s2)
+                lg->peak_acc_mm_s2 = a;
+            if (a > lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK))
+                leg_limit(s, CHECK_LEG_ACCELERATION, i, a, lg->limit_acc_mm_s2,
+                          out->time_elapsed_s);
+        }
+        s->v0[i] = v;
+    }
+}
+
+/* Kinematic deviation between the previous set point and this one: the legs at mid-chord
+ * (where linear leg motion strays furthest) through the forward kinematics, distance from
+ * the commanded chord. Returns the distance, mm, or -1 when the forward solve failed. */
+static double deviation(struct sim *s, const struct motion_out *out, double *ang_deg)
+{
+    double Lm[KINS_MAX_JOINTS], P[KINS_POSE_DIM], d[3], n2 = 0, u = 0, e2 = 0;
+    for (int i = 0; i < s->nj; i++)
+        Lm[i] = 0.5 * (s->L0[i] + out->joint_pos[i]);
+    if (s->o->cold_forward)
+        memcpy(P, s->mc->kins->home, sizeof P);
+    else
+        memcpy(P, s->fwd, sizeof P);
+    if (kins_forward(s->mc->kins, Lm, P, NULL) != KINS_OK)
+        return -1;
+    memcpy(s->fwd, P, sizeof P);
+    s->r->deviation_evals++;
+    for (int i = 0; i < 3; i++)
+        d[i] = out->pose[i] - s->p0[i], n2 += d[i] * d[i];
+    for (int i = 0; i < 3; i++)
+        u += (P[i] - s->p0[i]) * d[i];
+    u = n2 > 1e-24 ? u / n2 : 0.5;
+    for (int i = 0; i < 3; i++)
+        e2 += (P[i] - s->p0[i] - u * d[i]) * (P[i] - s->p0[i] - u * d[i]);
+    *ang_deg = 0;
+    for (int i = 3; i < 6; i++)
+        *ang_deg = fmax(*ang_deg, fabs(P[i] - s->p0[i] - u * (out->pose[i] - s->p0[i])));
+    return sqrt(e2);
+}
+
+/* Condition number of the pose against [KINS] SINGULAR_CONDITION. */
+static void singularity(struct sim *s, const struct motion_out *out)
+{
+    struct kins_check ck;
+    struct check_result *r = s->r;
+    if (kins_check_pose(s->mc->kins, out->pose, &ck) != KINS_OK)
+        return;
+    r->condition_evals++;
+    if (ck.condition > r->max_condition)
+        r->max_condition = ck.condition, r->max_condition_line = out->line;
+    if (!(ck.condition > r->condition_limit))
+        return;
+    struct check_problem p = { .kind = CHECK_SINGULAR, .line = out->line, .leg = -1,
+                               .value = ck.condition, .limit = r->condition_limit,
+                               .time_s = out->time_elapsed_s, .count = 1 };
+    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
+    snprintf(p.message, sizeof p.message, "the machine comes close to a singular pose at X%.3f "
+             "Y%.3f Z%.3f A%.3f B%.3f C%.3f: condition number %.1f above %.1f ([KINS] "
+             "SINGULAR_CONDITION); it loses stiffness and accuracy there", out->pose[0],
+             out->pose[1], out->pose[2], out->pose[3], out->pose[4], out->pose[5], ck.condition,
+             r->condition_limit);
+    check_add_problem(r, &p);
+}
+
+/* The scheduled measures of one period: at every line change, else on the schedule. */
+static void measures(struct sim *s, const struct motion_out *out)
+{
+    struct check_result *r = s->r;
+    double t = out->time_elapsed_s;
+    int changed = out->line != s->line || out->file != s->file;
+    if (changed || t >= s->next_cond_s) {
+        singularity(s, out);
+        s->next_cond_s = t + s->o->condition_every_s;
+    }
+    if (changed || t >= s->next_dev_s) {
+        double ang = 0, dev = deviation(s, out, &ang);
+        if (dev > r->max_deviation_mm)
+            r->max_deviation_mm = dev, r->max_deviation_line = out->line;
+        if (ang > r->max_deviation_deg)
+            r->max_deviation_deg = ang;
+        if (s->o->trace && dev >= 0)
+            check_trace_deviation(s->o->trace, out->distance_done_mm, t, dev);
+        s->next_dev_s = t + s->o->deviation_every_s;
+    }
+}
+
+/* Per-leg limits from the kinematics and the motion configuration. */
+static void leg_limits(struct sim *s)
+{
+    const struct kins *k = s->mc->kins;
+    for (int i = 0; i < s->nj; i++) {
+        struct check_leg *lg = &s->r->leg[i];
+        lg->limit_min_mm = k->joint_min[i], lg->limit_max_mm = k->joint_max[i];
+        lg->limit_vel_mm_s = s->mc->mcfg.joint[i].max_vel_mm_s;
+        lg->limit_acc_mm_s2 = s->mc->mcfg.joint[i].max_acc_mm_s2;
+        lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
+    }
+}
+
+int check_simulate(struct check_machine *mc, const struct check_opts *o, struct check_result *r)
+{
+    struct sim s = { .mc = mc, .o = o, .r = r, .nj = mc->kins->njoints,
+                     .T = mc->mcfg.servo_period_s };
+    struct motion_out out;
+    struct motion_plan_info info;
+    motion_plan_info(mc->motion, &info);
+    r->planned_time_s = info.time_s;
+    r->njoints = s.nj;
+    leg_limits(&s);
+    if (kins_inverse(mc->kins, mc->kins->home, s.L0) != KINS_OK)
+        return CHECK_ERR_KINS;
+    int st = motion_step(mc->motion, 0.0, &out);   /* the start pose, without advancing */
+    memcpy(s.L0, out.joint_pos, sizeof s.L0);
+    memcpy(s.p0, out.pose, sizeof s.p0);
+    memcpy(s.fwd, out.pose, sizeof s.fwd);
+    long max_periods = (long)(MAX_PERIODS_FACTOR * info.time_s / s.T) + 1000;
+    if (o->trace)
+        s.trace_every = check_trace_begin(o->trace, info.time_s, s.T);
+    for (long n = 0; n < max_periods; n++) {
+        st = motion_step(mc->motion, s.T, &out);
+        r->periods++;
+        legs_period(&s, &out);
+        s.have_v = 1;
+        measures(&s, &out);
+        if (o->trace && ++s.trace_count >= s.trace_every) {
+            check_trace_add(o->trace, out.time_elapsed_s, s.nj, out.joint_pos, s.v0, out.pose);
+            s.trace_count = 0;
+        }
+        memcpy(s.L0, out.joint_pos, sizeof s.L0);
+        memcpy(s.p0, out.pose, sizeof s.p0);
+        s.line = out.line, s.file = out.file;
+        if (out.state == MOTION_DONE || out.state == MOTION_FAULT || st != MOTION_OK)
+            break;
+    }
+    r->machining_time_s = out.time_elapsed_s;
+    r->length_mm = out.distance_total_mm;
+    return st == MOTION_OK && out.state == MOTION_DONE ? CHECK_OK : CHECK_ERR_CONFIG;
+}
