@@ -99,7 +99,7 @@ START_TEST(test_paper_program_on_can)
 END_TEST
 
 /* A drive fault in the middle of the program: the latch trips, motion stops with a fault,
- * every drive is disabled, and the message names the drive. */
+ * every other drive is quick-stopped and holds, and the message names the drive. */
 START_TEST(test_drive_fault_stops_machine)
 {
     struct hal *h = machine_with_program();
@@ -114,9 +114,14 @@ START_TEST(test_drive_fault_stops_machine)
     const struct canopen_master *m = hal_get_object(h, CIA402_OBJ_MASTER);
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "CAN node 3 (joint 2)"));
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "error code 0x2310"));
+    double held[NLEGS];
+    for (int i = 0; i < NLEGS; i++)
+        held[i] = m->node[i].position_fb_mm;
     ck_assert_int_eq(hal_sim_advance(h, 20 * PERIOD_NS), HAL_OK);
-    for (int i = 0; i < NLEGS; i++)  /* the other drives shut down, the faulted one in Fault */
-        ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_SWITCH_ON_DISABLED);
+    for (int i = 0; i < NLEGS; i++)  /* standing still since the stop */
+        ck_assert_double_eq(m->node[i].position_fb_mm, held[i]);
+    for (int i = 0; i < NLEGS; i++)  /* the others quick-stopped and holding; one in Fault */
+        ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_QUICK_STOP);
     /* reset: drives first, then the latch; all six come back to Operation enabled */
     ck_assert_int_eq(hal_sets(h, "drive-reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "0"), HAL_OK);

@@ -367,6 +367,47 @@ START_TEST(test_heartbeat_loss)
 }
 END_TEST
 
+/* Quick stop: an enabled drive goes to Quick stop active and holds its position whatever
+ * the command does; released, it passes Switch on disabled and climbs back to enabled. */
+START_TEST(test_quick_stop)
+{
+    struct rig r;
+    rig_init(&r, 2, 1000000);
+    rig_run_ms(&r, 80);
+    for (int i = 0; i < r.n; i++)
+        r.m.node[i].position_cmd_mm = r.m.node[i].position_fb_mm;
+    rig_enable(&r, true);
+    rig_run_ms(&r, 10);
+    ck_assert(canopen_master_all_enabled(&r.m));
+    r.m.node[0].quick_stop = true;
+    rig_run_ms(&r, 4);
+    ck_assert_int_eq(r.m.node[0].state, CIA402_QUICK_STOP);
+    ck_assert_uint_eq(r.m.node[0].controlword, 0x02);
+    int32_t held = r.sim[0].actual_counts;
+    for (int t = 0; t < 50; t++) {
+        r.m.node[0].position_cmd_mm += 0.01;
+        r.m.node[1].position_cmd_mm += 0.01;
+        rig_cycle(&r);
+    }
+    ck_assert_int_eq(r.sim[0].actual_counts, held);       /* held */
+    ck_assert_int_eq(r.sim[1].actual_counts, 1000 + 490); /* the other one followed */
+    ck_assert_int_eq(r.m.node[0].state, CIA402_QUICK_STOP);
+    ck_assert(!r.m.node[0].fault);
+    r.m.node[0].quick_stop = false;
+    r.m.node[0].position_cmd_mm = r.m.node[0].position_fb_mm;
+    enum cia402_state seen[8];
+    int nseen = 0;
+    for (int i = 0; i < 20; i++) {
+        rig_cycle(&r);
+        if (nseen == 0 || (seen[nseen - 1] != r.m.node[0].state && nseen < 8))
+            seen[nseen++] = r.m.node[0].state;
+    }
+    ck_assert_int_eq(nseen, 5);
+    ck_assert_int_eq(seen[1], CIA402_SWITCH_ON_DISABLED);
+    ck_assert_int_eq(seen[4], CIA402_OP_ENABLED);
+}
+END_TEST
+
 /* Bad configurations are refused with a message naming the value. */
 START_TEST(test_config_errors)
 {
@@ -411,6 +452,7 @@ static Suite *master_suite(void)
     tcase_add_test(tc, test_nmt_boot);
     tcase_add_test(tc, test_fault_and_reset);
     tcase_add_test(tc, test_heartbeat_loss);
+    tcase_add_test(tc, test_quick_stop);
     tcase_add_test(tc, test_config_errors);
     suite_add_tcase(s, tc);
     return s;

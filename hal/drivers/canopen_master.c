@@ -243,6 +243,9 @@ static void node_rpdo(struct canopen_master *m, struct canopen_node *n, struct c
         n->reset_stage = 2;
     } else if (n->reset_stage == 2) {
         cw = CIA402_CW_FAULT_RESET;
+    } else if (n->quick_stop &&
+               (n->state == CIA402_OP_ENABLED || n->state == CIA402_QUICK_STOP)) {
+        cw = CIA402_CW_QUICK_STOP;  /* transition 11, then held until released */
     } else {
         cw = cia402_next_controlword(n->state, n->enable);
     }

@@ -62,6 +62,8 @@ struct canopen_node {
     double position_cmd_mm;        /* commanded leg length, mm */
     bool enable;                   /* drive to Operation enabled while true */
     bool fault_reset;              /* rising edge: reset the latched fault */
+    bool quick_stop;               /* while true, an enabled drive gets quick stop (0x02):
+                                    * it brakes on its own ramp and holds (Quick stop active) */
     /* outputs */
     double position_fb_mm;         /* leg length from position actual value 0x6064, mm */
     bool fault;                    /* a latched fault; `message` says which */

@@ -17,6 +17,7 @@ struct cia402_chan {
     bool *enable;           /* in: drive to Operation enabled */
     bool *fault;            /* out: latched fault */
     bool *fault_reset;      /* in: rising edge resets the fault */
+    bool *quick_stop;       /* in: quick stop an enabled drive while true */
     int32_t *state;         /* out: enum cia402_state */
     uint32_t *statusword;   /* out: 0x6041 */
     uint32_t *emcy_code;    /* out: last EMCY error code */
@@ -53,6 +54,7 @@ static void cia402_update(void *arg, long period_ns)
         n->position_cmd_mm = *ch->pos_cmd;
         n->enable = *ch->enable;
         n->fault_reset = *ch->fault_reset;
+        n->quick_stop = *ch->quick_stop;
     }
     int ntx = canopen_master_step(m, c->now_ns, c->tx, (int)(sizeof c->tx / sizeof c->tx[0]));
     can_bus_send_batch(&c->bus, c->tx, ntx);
@@ -163,6 +165,7 @@ static int chan_new(struct hal *h, struct cia402_chan *ch, int i)
     st = st ? st : hal_pin_bit_newf(h, HAL_IN, &ch->enable, "cia402.%d.enable", i);
     st = st ? st : hal_pin_bit_newf(h, HAL_OUT, &ch->fault, "cia402.%d.fault", i);
     st = st ? st : hal_pin_bit_newf(h, HAL_IN, &ch->fault_reset, "cia402.%d.fault-reset", i);
+    st = st ? st : hal_pin_bit_newf(h, HAL_IN, &ch->quick_stop, "cia402.%d.quick-stop", i);
     st = st ? st : hal_pin_s32_newf(h, HAL_OUT, &ch->state, "cia402.%d.state", i);
     st = st ? st : hal_pin_u32_newf(h, HAL_OUT, &ch->statusword, "cia402.%d.statusword", i);
     st = st ? st : hal_pin_u32_newf(h, HAL_OUT, &ch->emcy_code, "cia402.%d.emcy-code", i);

@@ -12,6 +12,7 @@
  *   cia402.N.enable        bit in     drive to Operation enabled while true
  *   cia402.N.fault         bit out    a latched fault of this drive (message on stderr)
  *   cia402.N.fault-reset   bit in     rising edge: reset the fault, climb back to enabled
+ *   cia402.N.quick-stop    bit in     while true: quick stop (0x02) an enabled drive, hold it
  *   cia402.N.state         s32 out    CiA 402 state (enum cia402_state: 5 = Operation enabled)
  *   cia402.N.statusword    u32 out    last statusword 0x6041
  *   cia402.N.emcy-code     u32 out    last EMCY error code (0 after an error reset)
