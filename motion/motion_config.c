@@ -140,7 +140,7 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
     }
     st = st ? st : read_num(cfg, "TRAJ", "OPTIONAL_STOP", 1, 1, &opt, err, errlen);
     for (int i = 0; i < njoints && !st; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         struct motion_joint_config *j = &c->joint[i];
         st = read_num(cfg, sec, "MAX_VELOCITY", 1, 0, &j->max_vel_mm_s, err, errlen);

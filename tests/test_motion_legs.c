@@ -34,7 +34,7 @@ START_TEST(test_leg_limits_hold)
     struct tk_cfg *c = tm_hexapod_cfg();
     ck_assert_ptr_nonnull(c);
     for (int i = 0; i < 6; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         tk_set(c, sec, "MAX_VELOCITY", "20");
         tk_set(c, sec, "MAX_ACCELERATION", "200");

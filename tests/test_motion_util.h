@@ -29,7 +29,7 @@ static inline struct tk_cfg *tm_trivial_cfg(void)
     tk_set(c, "KINS", "KINEMATICS", "trivial");
     tk_set(c, "KINS", "JOINTS", "6");
     for (int i = 0; i < 6; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         tk_set(c, sec, "MIN_LIMIT", "-1000");
         tk_set(c, sec, "MAX_LIMIT", "1000");
@@ -224,7 +224,7 @@ static inline struct tk_cfg *tm_fast_hexapod_cfg(double period_s, double tol_mm)
     tk_setf(c, "TRAJ", "KINEMATIC_TOLERANCE", tol_mm);
     tk_setf(c, "EMCMOT", "SERVO_PERIOD", period_s * 1e9);
     for (int i = 0; i < 6; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         tk_set(c, sec, "MAX_VELOCITY", "1000");
         tk_set(c, sec, "MAX_ACCELERATION", "20000");
