@@ -104,6 +104,7 @@ static void rx_tpdo(struct canopen_node *n, const struct can_frame *f, int64_t n
     n->actual_valid = true;
     n->last_tpdo_ns = now_ns;
     n->position_fb_mm = canopen_counts_to_mm(&n->cfg, pos);
+    n->fb_valid = true;
     if (cia402_is_fault(n->state)) {
         if (n->emcy_code)
             node_fault(n, CANOPEN_ERR_DRIVE_FAULT, "the drive reports %s (statusword 0x%04X), "

@@ -66,6 +66,7 @@ struct canopen_node {
                                     * it brakes on its own ramp and holds (Quick stop active) */
     /* outputs */
     double position_fb_mm;         /* leg length from position actual value 0x6064, mm */
+    bool fb_valid;                 /* a position actual value has ever been received */
     bool fault;                    /* a latched fault; `message` says which */
     int fault_status;              /* enum canopen_status of the latched fault */
     enum cia402_state state;       /* decoded from the last statusword */

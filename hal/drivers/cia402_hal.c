@@ -61,7 +61,9 @@ static void cia402_update(void *arg, long period_ns)
     for (int i = 0; i < m->cfg.n_nodes; i++) {
         struct canopen_node *n = &m->node[i];
         struct cia402_chan *ch = &c->chan[i];
-        *ch->pos_fb = n->position_fb_mm;
+        /* Until the drive has reported once, echo the command (as a stepgen powers up at
+         * it): the forward kinematics then sees legs, not zeros. */
+        *ch->pos_fb = n->fb_valid ? n->position_fb_mm : *ch->pos_cmd;
         *ch->fault = n->fault;
         *ch->state = (int32_t)n->state;
         *ch->statusword = n->statusword;

@@ -9,6 +9,7 @@
  * [CAN_NODE_0..N-1] from the INI (see docs/can.md), opens the bus and creates per drive
  *   cia402.N.position-cmd  float in   commanded leg length, mm
  *   cia402.N.position-fb   float out  leg length from the drive's position actual value, mm
+ *                                     (position-cmd until the drive has reported once)
  *   cia402.N.enable        bit in     drive to Operation enabled while true
  *   cia402.N.fault         bit out    a latched fault of this drive (message on stderr)
  *   cia402.N.fault-reset   bit in     rising edge: reset the fault, climb back to enabled
