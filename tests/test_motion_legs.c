@@ -135,6 +135,57 @@ START_TEST(test_kinematic_deviation)
 }
 END_TEST
 
+/* Largest distance of the platform from the helix r = 50 about the Z axis rising 5 mm per
+ * half turn, measured as in tm_deviation (forward kinematics of interpolated legs). */
+static double helix_deviation(double T, double tol_mm)
+{
+    struct tk_cfg *c = tm_fast_hexapod_cfg(T, tol_mm);
+    ck_assert_ptr_nonnull(c);
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double S[6] = {50, 0, 645, 0, 0, 0}, E[6] = {-50, 0, 650, 6, -6, 10};
+    double C[3] = {0, 0, 645}, N[3] = {0, 0, 1};
+    memcpy(p.start, S, sizeof S);
+    tm_arc(&p, 3, E, C, N, 1, 30000);
+    char err[512] = "";
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct motion_out a, b;
+    double worst = 0;
+    motion_step(mc.m, T, &a);
+    while (a.state != MOTION_DONE) {
+        motion_step(mc.m, T, &b);
+        double g[6];
+        memcpy(g, a.pose, sizeof g);
+        for (int j = 1; j < 10; j++) {
+            double L[6], P[6];
+            for (int i = 0; i < 6; i++)
+                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+            memcpy(P, g, sizeof P);
+            ck_assert_int_eq(kins_forward(mc.kins, L, P, NULL), KINS_OK);
+            memcpy(g, P, sizeof g);
+            double ang = atan2(P[1], P[0]);
+            ang = ang < 0 ? ang + 2 * M_PI : ang;
+            worst = fmax(worst, hypot(hypot(P[0], P[1]) - 50, P[2] - (645 + 5 * ang / M_PI)));
+        }
+        a = b;
+    }
+    canon_prog_free(&p);
+    tm_close(&mc);
+    return worst;
+}
+
+/* The bound holds on a helix turning A B C too (100 Hz set points); without it, no. */
+START_TEST(test_kinematic_deviation_helix)
+{
+    double on = helix_deviation(0.01, 0.001), off = helix_deviation(0.01, 0);
+    ck_assert_msg(on <= 0.001, "100 Hz helix: %.6f mm", on);
+    ck_assert_msg(off > 0.003, "100 Hz helix without the bound: only %.6f mm", off);
+}
+END_TEST
+
 static Suite *legs_suite(void)
 {
     Suite *s = suite_create("motion_legs");
@@ -142,6 +193,7 @@ static Suite *legs_suite(void)
     tcase_add_test(tc, test_leg_limits_hold);
     tcase_add_test(tc, test_leg_limits_not_needless);
     tcase_add_test(tc, test_kinematic_deviation);
+    tcase_add_test(tc, test_kinematic_deviation_helix);
     suite_add_tcase(s, tc);
     return s;
 }
