@@ -4,7 +4,8 @@
 #include <stddef.h>
 #include <string.h>
 
-#define OBJ(idx, sub, size, flags, field) { idx, sub, size, flags, offsetof(struct cia402_sim, field) }
+#define OBJ(idx, sub, size, flags, field) \
+    { idx, sub, size, flags, offsetof(struct cia402_sim, field) }
 #define MAP CIA402_SIM_MAPPABLE
 #define RO CIA402_SIM_RO
 
@@ -81,7 +82,7 @@ void cia402_sim_od_set(struct cia402_sim *s, const struct cia402_sim_obj *o, uin
 }
 
 /* A mapping entry is valid if it names a mappable object with its exact length; an RPDO
- * cannot carry a read-only object (CiA 301 7.4.8: abort 0x06040041 otherwise). */
+ * cannot carry a read-only object (CiA 301: abort 0x06040041 otherwise). */
 static bool map_entry_ok(uint32_t entry, bool rpdo)
 {
     const struct cia402_sim_obj *o =
@@ -104,7 +105,8 @@ static uint32_t write_check(const struct cia402_sim *s, const struct cia402_sim_
 {
     if (o->index == 0x6060 && (int8_t)v != CIA402_MODE_CSP)
         return 0x06090030u;  /* this drive simulates CSP only */
-    if ((o->index == 0x1600 || o->index == 0x1A00) && o->sub >= 1 && !map_entry_ok(v, o->index == 0x1600))
+    bool map = o->index == 0x1600 || o->index == 0x1A00;
+    if (map && o->sub >= 1 && !map_entry_ok(v, o->index == 0x1600))
         return 0x06040041u;
     if (o->index == 0x1600 && o->sub == 0 && (v > 4 || map_bits(s->rpdo_map, v) > 64))
         return 0x06040042u;

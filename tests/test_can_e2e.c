@@ -46,7 +46,8 @@ static struct hal *machine_with_program(void)
     ck_assert_msg(hal_source(h, hal_file) == HAL_OK, "%s", hal_last_error(h));
     struct interp *in = interp_create();
     double factor, home[6];
-    ck_assert_int_eq(interp_feed_units_parse(hal_ini_get(h, "RS274NGC", "FEED_UNITS"), &factor), 0);
+    const char *units = hal_ini_get(h, "RS274NGC", "FEED_UNITS");
+    ck_assert_int_eq(interp_feed_units_parse(units, &factor), 0);
     interp_set_feed_factor(in, factor);
     ck_assert_int_eq(sscanf(hal_ini_get(h, "KINS", "HOME"), "%lf %lf %lf %lf %lf %lf", &home[0],
                             &home[1], &home[2], &home[3], &home[4], &home[5]), 6);

@@ -153,7 +153,7 @@ bool canopen_sdo_is_expedited_write(const struct canopen_sdo *s)
     return (s->cmd & 0xE0u) == 0x20u && (s->cmd & 0x02u);
 }
 
-/* SDO abort codes, CiA 301 table 22 (the ones a drive is likely to send). */
+/* The SDO abort codes of CiA 301 that a drive is likely to send. */
 static const struct { uint32_t code; const char *text; } abort_texts[] = {
     { 0x05030000u, "toggle bit not alternated" },
     { 0x05040000u, "SDO protocol timed out" },
@@ -192,7 +192,7 @@ const char *canopen_abort_text(uint32_t code)
     return "unknown abort code";
 }
 
-/* EMCY error code classes, CiA 301 table 21: the most specific prefix that matches wins. */
+/* Emergency error code classes of CiA 301; the most specific matching prefix wins. */
 static const struct { uint16_t code, mask; const char *text; } emcy_texts[] = {
     { 0x0000, 0xFFFF, "error reset or no error" },
     { 0x8110, 0xFFFF, "CAN overrun, frames lost" },

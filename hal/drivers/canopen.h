@@ -12,7 +12,7 @@
  * Every function here is pure (frames in, values out), so the master and the simulated node
  * share one encoding and the tests can check it byte by byte.
  *
- * Predefined connection set, CiA 301 section 7.3.5 (n = node-ID 1..127):
+ * The pre-defined connection set of CiA 301 (n = node-ID 1..127):
  *   0x000 NMT, 0x080 SYNC, 0x080+n EMCY, 0x180+n TPDO1, 0x200+n RPDO1,
  *   0x580+n SDO server -> client, 0x600+n SDO client -> server, 0x700+n NMT error control.
  */
@@ -28,7 +28,7 @@
 #define CANOPEN_NODE_MASK     0x07Fu  /* node-ID bits */
 #define CANOPEN_NODE_MAX      127
 
-/* NMT command specifiers (CiA 301 section 7.2.8.3.1): byte 0 of a COB-ID 0 frame. */
+/* NMT command specifiers (CiA 301, NMT node control): byte 0 of a COB-ID 0 frame. */
 enum canopen_nmt_cmd {
     CANOPEN_NMT_START = 0x01,          /* start remote node: -> Operational */
     CANOPEN_NMT_STOP = 0x02,           /* -> Stopped */
@@ -37,7 +37,7 @@ enum canopen_nmt_cmd {
     CANOPEN_NMT_RESET_COMM = 0x82,     /* reset communication: boot-up follows */
 };
 
-/* NMT states as a heartbeat carries them (CiA 301 section 7.2.8.3.2.1). */
+/* NMT states as a heartbeat carries them (CiA 301, NMT error control: heartbeat). */
 enum canopen_nmt_state {
     CANOPEN_STATE_BOOTUP = 0x00,
     CANOPEN_STATE_STOPPED = 0x04,
@@ -53,10 +53,10 @@ enum canopen_nmt_state {
 #define CANOPEN_OD_TPDO1_MAP          0x1A00u
 #define CANOPEN_PDO_COBID_INVALID     0x80000000u  /* bit 31 of a PDO COB-ID: PDO off */
 #define CANOPEN_PDO_TT_SYNC1          0x01u        /* synchronous, every SYNC */
-/* A PDO mapping entry: index << 16 | sub-index << 8 | length in bits (CiA 301 7.4.8.2). */
+/* A PDO mapping entry (CiA 301, objects 0x1600 / 0x1A00): index << 16, sub << 8, bits. */
 #define CANOPEN_PDO_MAP_ENTRY(idx, sub, bits) (((uint32_t)(idx) << 16) | ((uint32_t)(sub) << 8) | (bits))
 
-/* SDO command bytes (CiA 301 section 7.2.4.3), expedited transfers only. */
+/* SDO command bytes (CiA 301, SDO protocols), expedited transfers only. */
 #define CANOPEN_SDO_ABORT          0x80u
 #define CANOPEN_SDO_DOWNLOAD_RESP  0x60u  /* scs = 3 */
 #define CANOPEN_SDO_UPLOAD_REQ     0x40u  /* ccs = 2 */
@@ -103,9 +103,9 @@ bool canopen_sdo_decode(const struct can_frame *f, struct canopen_sdo *out);
 /* True for a client's expedited download request (ccs = 1, e = 1). */
 bool canopen_sdo_is_expedited_write(const struct canopen_sdo *s);
 
-/* The meaning of an SDO abort code (CiA 301 table 22) in words, "unknown abort code" else. */
+/* The meaning of an SDO abort code (CiA 301) in words, "unknown abort code" else. */
 const char *canopen_abort_text(uint32_t code);
-/* The class of an EMCY error code (CiA 301 table 21, CiA 402 for 0xFF00.. aside). */
+/* The class of an EMCY error code (CiA 301, emergency error codes). */
 const char *canopen_emcy_text(uint16_t code);
 
 /* EMCY payload: error code u16, error register u8 (object 0x1001), 5 manufacturer bytes. */

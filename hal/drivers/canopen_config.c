@@ -6,9 +6,10 @@
 #include <string.h>
 
 /*
- * The writes that put a node into CSP with the fixed PDO mapping, in order (CiA 301 7.4.8:
- * a PDO is switched off through bit 31 of its COB-ID before its mapping changes, the mapping
- * count goes to 0 while entries are written, then the count and the COB-ID are restored).
+ * The writes that put a node into CSP with the fixed PDO mapping, in order. CiA 301's PDO
+ * mapping rules: a PDO is switched off through bit 31 of its COB-ID before its mapping
+ * changes, the mapping count goes to 0 while entries are written, then the count and the
+ * COB-ID are restored.
  */
 enum { ADD_NODE = 1, INTERP_VALUE = 2, INTERP_INDEX = 3, HB_PERIOD = 4 };
 static const struct {
@@ -74,7 +75,7 @@ bool canopen_config_write(const struct canopen_master *m, const struct canopen_n
 
 /*
  * 0x60C2 gives the interpolation period as value * 10^index seconds with an 8-bit value
- * (CiA 402 section 8.4). Picks the largest power of ten that divides the period exactly.
+ * (CiA 402, object 0x60C2). Picks the largest power of ten that divides the period exactly.
  */
 static bool interp_period(long period_ns, uint8_t *value, int8_t *index)
 {

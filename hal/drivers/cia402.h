@@ -32,7 +32,7 @@ enum cia402_state {
 };
 
 /*
- * Statusword bits (CiA 402 section 6.2, object 0x6041): 0 ready to switch on, 1 switched on,
+ * Statusword bits (CiA 402, object 0x6041): 0 ready to switch on, 1 switched on,
  * 2 operation enabled, 3 fault, 4 voltage enabled, 5 quick stop (active low), 6 switch on
  * disabled, 7 warning, 9 remote, 10 target reached, 12 drive follows the command value (CSP).
  */
@@ -47,7 +47,7 @@ enum cia402_state {
 #define CIA402_SW_FOLLOWING   0x1000u
 
 /*
- * Controlword commands (CiA 402 section 6.2, object 0x6040): bits 0 switch on, 1 enable
+ * Controlword commands (CiA 402, object 0x6040): bits 0 switch on, 1 enable
  * voltage, 2 quick stop (active low), 3 enable operation, 7 fault reset (rising edge).
  */
 #define CIA402_CW_DISABLE_VOLTAGE 0x0000u  /* transitions 7, 9, 10, 12 */
