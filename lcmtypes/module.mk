@@ -25,3 +25,4 @@ $(LIBDIR)/libhexcnc.a: $(LCM_GEN_OBJS)
 # The status component, its publisher thread and the lock-free rings it uses.
 LIB_SRCS += hal/ring.c hal/components/lcm_status.c hal/components/lcm_status_pub.c
 HAL_COMPS += lcm_status
+TESTS += test_lcm_ring test_lcm_status

@@ -52,6 +52,10 @@ static void lcm_fill(const struct lcm_status *s, struct lcm_sample *p)
 static void lcm_push(struct lcm_status *s, int32_t kind, uint32_t faults, uint32_t changed,
                      int64_t t_ns, int64_t mono_ns)
 {
+    /* A sample's number is taken even when it is dropped, so gaps show the loss. */
+    int64_t seq = atomic_load_explicit(&s->seq, memory_order_relaxed);
+    if (kind == LCM_SLOT_SAMPLE)
+        atomic_store_explicit(&s->seq, seq + 1, memory_order_relaxed);
     struct lcm_sample *p = ring_spsc_claim(&s->samples);
     if (!p)
         return;
@@ -63,7 +67,7 @@ static void lcm_push(struct lcm_status *s, int32_t kind, uint32_t faults, uint32
     p->t_ns = t_ns;
     p->mono_ns = mono_ns;
     p->sim = mono_ns == 0;
-    p->seq = kind == LCM_SLOT_SAMPLE ? s->seq++ : s->seq;
+    p->seq = seq;
     lcm_fill(s, p);
     ring_spsc_commit(&s->samples);
 }
@@ -142,7 +146,7 @@ int lcm_status_get_stats(struct hal *h, struct lcm_status_stats *st)
     memset(st, 0, sizeof *st);
     if (!s)
         return LCM_STATUS_NOT_LOADED;
-    st->samples = ring_spsc_pushed(&s->samples);
+    st->samples = (uint64_t)atomic_load(&s->seq);
     st->samples_dropped = ring_spsc_dropped(&s->samples);
     st->status_sent = atomic_load(&s->status_sent);
     st->events_sent = atomic_load(&s->events_sent);

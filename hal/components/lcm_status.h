@@ -56,8 +56,8 @@ int lcm_status_post_event(struct hal *h, enum lcm_status_severity severity, int3
 
 /* What the component has done so far. */
 struct lcm_status_stats {
-    uint64_t samples;           /* samples taken by lcm-status.sample (pushed to the ring) */
-    uint64_t samples_dropped;   /* samples lost: the ring was full */
+    uint64_t samples;           /* status samples taken by lcm-status.sample, dropped ones too */
+    uint64_t samples_dropped;   /* ring slots lost because the ring was full */
     uint64_t status_sent;       /* hexcnc_status_t messages published */
     uint64_t events_sent;       /* hexcnc_event_t messages published */
     uint64_t events_dropped;    /* events lost: the event queue was full */

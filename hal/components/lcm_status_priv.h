@@ -83,7 +83,7 @@ struct lcm_status {
     int64_t period_ns;              /* publish period, 1 / rate */
     int64_t next_due_ns;            /* simulated clock: machine time of the next sample */
     int64_t last_t_ns;              /* machine time of the previous call */
-    int64_t seq;                    /* next sample number */
+    _Atomic int64_t seq;            /* next sample number (only this funct writes it) */
     uint32_t last_faults;           /* fault inputs in the previous period */
     _Atomic int32_t last_line;      /* line of the last call, for events posted with line < 0 */
 
