@@ -137,9 +137,6 @@ static int hal_cmd_graph(struct hal *h, int n, char **w)
 {
     const char *c = w[0];
     long v;
-    if (!strcmp(c, "loadrt"))
-        return n < 2 ? hal_error(h, HAL_ERR_SYNTAX, "loadrt: needs a component name")
-                     : hal_loadrt(h, w[1], n - 2, w + 2);
     if (!strcmp(c, "net")) {
         int k = 0;
         char *pins[HAL_WORDS_MAX];
@@ -223,6 +220,11 @@ static int hal_cmd_words(struct hal *h, int n, char **w, FILE *out)
     if (!strcmp(c, "loadusr"))
         return hal_error(h, HAL_ERR_SYNTAX, "loadusr: not supported; hexcnc runs every "
                          "component in one process with loadrt");
+    /* A new component touches nothing a running thread uses, and its load may be slow
+     * (a drive connecting): the threads keep running. */
+    if (!strcmp(c, "loadrt"))
+        return n < 2 ? hal_error(h, HAL_ERR_SYNTAX, "loadrt: needs a component name")
+                     : hal_loadrt(h, w[1], n - 2, w + 2);
     hal_lock_all(h);
     int st = hal_cmd_graph(h, n, w);
     hal_unlock_all(h);
