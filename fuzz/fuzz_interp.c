@@ -33,6 +33,7 @@ static void fill_tools(struct tooltable *tt)
     }
 }
 
+/* One input: a fresh interpreter runs it through the printer; errors are fine, crashes not. */
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static struct tooltable tt;  /* the harness's only state; rebuilt for every input */

@@ -20,6 +20,7 @@ struct plane_axes {
     char w1, w2, wn;
 };
 
+/* The axes and centre words of G17, G18 or G19. */
 static struct plane_axes plane_of(int plane)
 {
     if (plane == 18)
@@ -91,6 +92,7 @@ static int check_radii(struct interp *in, const double s[2], const double e[2], 
     return 0;
 }
 
+/* G2 (g = 20) or G3 (30): centre from R or I J K, checked, then one ARC command. */
 int interp_arc(struct interp *in, int g)
 {
     static const char letter[3] = {'x', 'y', 'z'};

@@ -30,6 +30,7 @@ static const char *code_str(int c10, char *buf)
     return buf;
 }
 
+/* Files G<v> in its modal group; refuses unknown codes, G41/G42 and a second code of a group. */
 int interp_add_g(struct interp *in, double v, int column)
 {
     struct interp_block *b = &in->blk;
@@ -65,6 +66,7 @@ int interp_add_g(struct interp *in, double v, int column)
                        code_str(c, s));
 }
 
+/* Files M<v> in its modal group, as interp_add_g. */
 int interp_add_m(struct interp *in, double v, int column)
 {
     struct interp_block *b = &in->blk;
@@ -98,12 +100,14 @@ static int block_motion(const struct interp *in)
     return in->blk.g[1] >= 0 ? in->blk.g[1] : in->motion;
 }
 
+/* Whether the block has any of X Y Z A B C. */
 static int has_axis(const struct interp_block *b)
 {
     return b->col['x' - 'a'] || b->col['y' - 'a'] || b->col['z' - 'a'] || b->col['a' - 'a'] ||
            b->col['b' - 'a'] || b->col['c' - 'a'];
 }
 
+/* Column of the first axis word, to point at it in errors. */
 static int first_axis_col(const struct interp_block *b)
 {
     static const char ax[] = "xyzabc";
@@ -113,6 +117,7 @@ static int first_axis_col(const struct interp_block *b)
     return 0;
 }
 
+/* G73 and G81..G89 (x10). */
 static int is_cycle(int g)
 {
     return g == 730 || (g >= 810 && g <= 890);
@@ -173,6 +178,7 @@ static int word_used(const struct interp *in, char w)
     }
 }
 
+/* Refuses I J K R P Q L H D W when nothing in the block uses them. */
 static int check_unused(struct interp *in)
 {
     static const char words[] = "ijkrpqlhdw";
@@ -198,6 +204,7 @@ static int check_unused(struct interp *in)
     return 0;
 }
 
+/* The checks on a block as a whole, before anything of it runs. */
 int interp_check_block(struct interp *in)
 {
     CHP(check_axis_users(in));

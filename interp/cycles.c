@@ -34,6 +34,7 @@ static int cyc_move(struct interp *in, enum canon_type t, double x, double y, do
     return interp_straight(in, t, m);
 }
 
+/* A dwell of s seconds inside a cycle. */
 static int dwell(struct interp *in, double s)
 {
     struct canon_cmd c;
@@ -111,6 +112,7 @@ static int cycle_words(struct interp *in, int g, int first)
     return 0;
 }
 
+/* A drilling cycle block: LinuxCNC's CYCLE_MACRO, one hole per repeat. */
 int interp_cycle(struct interp *in, int g)
 {
     if (in->plane != 17)

@@ -8,6 +8,7 @@
 #define W(c) (in->blk.col[(c) - 'a'])    /* column of word c, 0 if absent */
 #define V(c) (in->blk.val[(c) - 'a'])    /* value of word c */
 
+/* A command of type t stamped with the current file, line and N number. */
 void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
 {
     memset(c, 0, sizeof *c);
@@ -18,6 +19,7 @@ void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
     c->n_number = in->blk.n_number;
 }
 
+/* Hands a command to the sink; a refusal stops the run. */
 int interp_emit(struct interp *in, struct canon_cmd *c)
 {
     if (in->sink(in->sink_ctx, c))
@@ -36,11 +38,13 @@ static int emit_simple(struct interp *in, enum canon_type t, double value, int i
     return interp_emit(in, &c);
 }
 
+/* A length in program units (mm or inch) to mm. */
 double interp_len_mm(const struct interp *in, double v)
 {
     return in->inch ? v * MM_PER_INCH : v;
 }
 
+/* The current pose in program coordinates: offsets removed, program units. */
 void interp_prog_pos(const struct interp *in, double prog[6])
 {
     for (int i = 0; i < 6; i++) {
@@ -50,6 +54,7 @@ void interp_prog_pos(const struct interp *in, double prog[6])
     }
 }
 
+/* Axis words to a machine target: absent axes stay, G91 adds, G90 adds the offsets. */
 void interp_target(struct interp *in, int machine, double t[6])
 {
     static const char ax[6] = {'x', 'y', 'z', 'a', 'b', 'c'};
@@ -68,6 +73,7 @@ void interp_target(struct interp *in, int machine, double t[6])
     }
 }
 
+/* Emits a straight move (traverse or feed) to end and makes it the current pose. */
 int interp_straight(struct interp *in, enum canon_type t, const double end[6])
 {
     struct canon_cmd c;
@@ -307,6 +313,7 @@ static int block_empty(const struct interp_block *b)
     return b->nassign == 0;
 }
 
+/* Runs the block read last: checks, #settings, then LinuxCNC's order of execution. */
 int interp_execute(struct interp *in)
 {
     struct interp_block *b = &in->blk;

@@ -217,6 +217,7 @@ static int read_parameter(struct interp *in, int *pos, double *out)
     return 0;
 }
 
+/* A real value: number, [expression], #parameter, unary sign or function call. */
 int interp_read_value(struct interp *in, int *pos, double *out)
 {
     char c = in->norm[*pos];

@@ -25,6 +25,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_SINK] = "stopped by the command consumer",
 };
 
+/* The fixed text of a status (the message of a run is in struct interp_error). */
 const char *interp_strerror(int status)
 {
     if (status < 0 || status >= INTERP_STATUS_COUNT)
@@ -32,6 +33,7 @@ const char *interp_strerror(int status)
     return status_text[status];
 }
 
+/* Records the first error of the run at the current line; later ones are ignored. */
 int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
 {
     if (in->err.status)
@@ -47,6 +49,7 @@ int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
     return status;
 }
 
+/* "file:line:col: error: message", the form compilers use, so editors can jump to it. */
 char *interp_error_format(const struct interp_error *e, char *buf, size_t len)
 {
     if (e->line > 0 && e->column > 0)
@@ -73,6 +76,7 @@ static void modal_defaults(struct interp *in)
     interp_select_coord(in, 1);
 }
 
+/* A new interpreter in LinuxCNC's start-up modes, at the origin. */
 struct interp *interp_create(void)
 {
     struct interp *in = calloc(1, sizeof *in);
@@ -84,6 +88,7 @@ struct interp *interp_create(void)
     return in;
 }
 
+/* Frees the interpreter (the tool table is the caller's). */
 void interp_destroy(struct interp *in)
 {
     if (!in)
@@ -92,12 +97,14 @@ void interp_destroy(struct interp *in)
     free(in);
 }
 
+/* Where the machine is before the first move (machine frame, mm/deg). */
 void interp_set_start(struct interp *in, const double pose[6])
 {
     memcpy(in->start, pose, sizeof in->start);
     memcpy(in->pos, pose, sizeof in->pos);
 }
 
+/* Names the parameter file and loads it, restoring the saved coordinate system and G92. */
 int interp_set_param_file(struct interp *in, const char *path)
 {
     free(in->param_path);
@@ -119,21 +126,25 @@ int interp_set_param_file(struct interp *in, const char *path)
     return 0;
 }
 
+/* Tool table used by T, G43 H, G10 L1 and G141/G142 D. */
 void interp_set_tooltable(struct interp *in, struct tooltable *tt)
 {
     in->tt = tt;
 }
 
+/* mm/min per unit of F in metric programs (FEED_UNITS). */
 void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit)
 {
     in->feed_factor = mm_min_per_f_unit;
 }
 
+/* The block delete switch ('/' lines skipped when on). */
 void interp_set_block_delete(struct interp *in, int on)
 {
     in->block_delete = on != 0;
 }
 
+/* FEED_UNITS text to the F multiplier. */
 int interp_feed_units_parse(const char *name, double *factor)
 {
     if (strcmp(name, "mm/min") == 0)
@@ -145,11 +156,13 @@ int interp_feed_units_parse(const char *name, double *factor)
     return 0;
 }
 
+/* The error of the last failed call. */
 const struct interp_error *interp_last_error(const struct interp *in)
 {
     return &in->err;
 }
 
+/* Copies the modal state a printer needs to show program coordinates. */
 void interp_get_view(const struct interp *in, struct interp_view *v)
 {
     v->inch = in->inch;
@@ -162,6 +175,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     v->current_tool = in->current_tool;
 }
 
+/* Reads numbered parameter #n. */
 double interp_param(const struct interp *in, int n)
 {
     return n >= 1 && n < INTERP_NPARAMS ? in->params[n] : 0.0;
@@ -228,6 +242,7 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     return rc ? rc : save;
 }
 
+/* Reads the whole file into memory, then runs it as text. */
 int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, void *ctx)
 {
     memset(&in->err, 0, sizeof in->err);

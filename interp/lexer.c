@@ -152,6 +152,7 @@ static int read_word(struct interp *in, int *pos)
     return 0;
 }
 
+/* One line to in->blk: block delete, normalising, '%', then words and settings in order. */
 int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind)
 {
     block_reset(&in->blk);

@@ -16,6 +16,7 @@ static double axis_mm(const struct interp *in, int i)
     return i < 3 ? interp_len_mm(in, V(axis_letter[i])) : V(axis_letter[i]);
 }
 
+/* Whether the block has any axis word. */
 static int any_axis(const struct interp *in)
 {
     for (int i = 0; i < 6; i++)
@@ -66,6 +67,7 @@ static int g10_coord(struct interp *in, int l, int p)
     return 0;
 }
 
+/* G10: L1 to the tool table, L2/L20 to a work offset. */
 int interp_g10(struct interp *in)
 {
     int l, p;

@@ -23,6 +23,7 @@ static void put(struct interp_printer *p, const char *s, size_t n)
     p->len += n;
 }
 
+/* Appends a C string. */
 static void puts_(struct interp_printer *p, const char *s)
 {
     put(p, s, strlen(s));
@@ -225,6 +226,7 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
     puts_(p, tmp);
 }
 
+/* Prints one command (and a units or offsets line first when they changed). */
 int interp_printer_sink(void *ctx, const struct canon_cmd *c)
 {
     struct interp_printer *p = ctx;
@@ -268,6 +270,7 @@ void interp_printer_init(struct interp_printer *p, const struct interp *in, int 
     p->inch = v.inch;
 }
 
+/* The set-up lines rs274 prints before the program. */
 int interp_printer_preamble(struct interp_printer *p)
 {
     struct interp_view v;
@@ -282,6 +285,7 @@ int interp_printer_preamble(struct interp_printer *p)
     return p->failed ? -1 : 0;
 }
 
+/* Writes what is buffered. */
 int interp_printer_flush(struct interp_printer *p)
 {
     if (p->len && p->write(p->write_ctx, p->buf, p->len))

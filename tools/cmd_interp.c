@@ -47,6 +47,7 @@ static void ini_path(const char *ini, const char *p, char *out, size_t len)
     free(copy);
 }
 
+/* The printer's output: a stdio stream. */
 static int write_stdout(void *ctx, const char *buf, size_t len)
 {
     return fwrite(buf, 1, len, ctx) == len ? 0 : -1;
@@ -90,6 +91,7 @@ static int apply_ini(struct interp *in, const char *ini, struct tooltable *tt, c
     return 0;
 }
 
+/* hexcnc interp: options, INI, tool table, then the program through the printer. */
 int cmd_interp(int argc, char **argv)
 {
     const char *ttpath = NULL, *ini = NULL, *prog = NULL;
