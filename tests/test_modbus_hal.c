@@ -296,6 +296,50 @@ START_TEST(test_bad_ini_value_names_key)
 }
 END_TEST
 
+/* One drive over Modbus RTU: the INI's TRANSPORT = rtu and DEVICE reach libmodbus's RTU
+ * backend; the simulated drive answers on the other side of a pseudo-terminal. */
+START_TEST(test_rtu_drive_through_hal)
+{
+    struct modbus_sim_opts o;
+    modbus_sim_opts_default(&o);
+    o.step_ns = SETPOINT_NS;
+    o.tau_s = 0.0;
+    o.unit = 3;
+    struct modbus_sim *s;
+    ck_assert_int_eq(modbus_sim_create(&s, 1, &o), MODBUS_SIM_OK);
+    char dev[64], ini[64];
+    ck_assert_int_eq(modbus_sim_start_rtu_pty(s, 0, dev, sizeof(dev)), MODBUS_SIM_OK);
+    snprintf(ini, sizeof(ini), "/tmp/test_modbus_rtu_XXXXXX");
+    int fd = mkstemp(ini);
+    ck_assert_int_ge(fd, 0);
+    FILE *f = fdopen(fd, "w");
+    fprintf(f, "[MODBUS]\nDRIVES = 1\nTRANSPORT = rtu\nDEVICE = %s\nBAUD = 115200\n"
+            "PARITY = E\nUNIT = 3\nSETPOINT_PERIOD = %ld\nCOUNTS_PER_MM = 500\nTIMEOUT = 50\n",
+            dev, SETPOINT_NS);
+    fclose(f);
+    struct hal *h = hal_create();
+    hal_set_sim_clock(h, true);
+    ck_assert_msg(hal_load_ini(h, ini) == HAL_OK, "%s", hal_last_error(h));
+    unlink(ini);
+    cmd(h, "newthread servo-thread 1000000");
+    cmd(h, "loadrt modbus");
+    cmd(h, "addf modbus.update servo-thread");
+    cmd(h, "setp modbus.0.enable 1");
+    cmd(h, "setp modbus.0.position-cmd 612.346");
+    ck_assert_int_eq(hal_start(h), HAL_OK);
+    for (int k = 0; k < 12; k++)
+        ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
+    ck_assert(!*(bool *)pin(h, "modbus.0.fault", HAL_BIT));
+    ck_assert_double_eq(*(double *)pin(h, "modbus.0.position-fb", HAL_FLOAT), 612.346);
+    struct modbus_sim_drive_state st;
+    modbus_sim_state(s, 0, &st);
+    ck_assert_int_eq(st.target_counts, 306173);
+    ck_assert_uint_eq(st.requests, 3);             /* 12 periods, one exchange per 4 */
+    hal_destroy(h);
+    modbus_sim_destroy(s);
+}
+END_TEST
+
 static Suite *modbus_hal_suite(void)
 {
     Suite *s = suite_create("modbus_hal");
@@ -305,6 +349,7 @@ static Suite *modbus_hal_suite(void)
     tcase_add_test(tc, test_server_component_end_to_end);
     tcase_add_test(tc, test_drive_fault_trips_estop_and_resets);
     tcase_add_test(tc, test_bad_ini_value_names_key);
+    tcase_add_test(tc, test_rtu_drive_through_hal);
     suite_add_tcase(s, tc);
     return s;
 }
