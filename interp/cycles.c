@@ -10,7 +10,7 @@
 #define PECK_CLEAR_MM 0.254      /* G83 rapid stop above the last depth, G73 chip-break lift */
 #define PECK_CLEAR_IN 0.010
 #define CYCLE_MAX_REPEATS 100000 /* L: more would only be a typing error */
-#define CYCLE_MAX_PECKS 100000   /* depth / Q */
+#define CYCLE_MAX_PECKS 1000000  /* depth / Q, all repeats together */
 
 /* One cycle in program units (X Y Z only), with the words it uses. */
 struct cycle {
@@ -150,9 +150,10 @@ int interp_cycle(struct interp *in, int g)
     if (c.r < c.bottom)
         return interp_fail(in, INTERP_ERR_CYCLE, W('r') ? W('r') : in->blk.gcol[1], "R (retract "
                            "plane, %g) is below Z (hole bottom, %g)", c.r, c.bottom);
-    if ((g == 730 || g == 830) && (c.r - c.bottom) / c.q > CYCLE_MAX_PECKS)
-        return interp_fail(in, INTERP_ERR_CYCLE, W('q'), "Q (peck depth) %g is too small for a "
-                           "hole %g deep", c.q, c.r - c.bottom);
+    if ((g == 730 || g == 830) && (c.r - c.bottom) / c.q * reps > CYCLE_MAX_PECKS)
+        return interp_fail(in, INTERP_ERR_CYCLE, W('q'), "Q (peck depth) %g is too small for "
+                           "%d hole(s) %g deep (more than %d pecks)", c.q, reps, c.r - c.bottom,
+                           CYCLE_MAX_PECKS);
     in->cycle_mode = g;
     int restore = in->path_mode != 610;
     if (old_z < c.r) {
