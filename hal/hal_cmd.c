@@ -251,6 +251,9 @@ int hal_cmd(struct hal *h, const char *line, const char *file, int lineno, FILE 
     char stripped[HAL_LINE_MAX], subst[HAL_LINE_MAX];
     char *words[HAL_WORDS_MAX];
     h->err_located = false;
+    if (strlen(line) >= HAL_LINE_MAX)
+        return hal_locate_error(h, hal_error(h, HAL_ERR_SYNTAX, "line longer than %d "
+                                             "characters", HAL_LINE_MAX - 1), file, lineno);
     hal_strip_comment(line, stripped, sizeof stripped);
     int st = hal_substitute(h, stripped, subst, sizeof subst);
     if (st != HAL_OK)

@@ -208,7 +208,7 @@ static int hal_net_check(struct hal *h, const char *signal, struct hal_sig *s, i
         if (p->type != *type)
             return hal_error(h, HAL_ERR_TYPE, "net: signal '%s' is %s but pin '%s' is %s",
                              signal, hal_type_name(*type), p->name, hal_type_name(p->type));
-        if (p->sig)
+        if (p->sig || p == writer)       /* linked already, or named twice */
             continue;
         if (p->dir == HAL_OUT) {
             if (writer)

@@ -209,6 +209,13 @@ START_TEST(command_errors)
         ck_assert_int_ne(hal_cmd(h, cases[i].line, "t.hal", 1, NULL), HAL_OK);
         ck_assert_str_eq(hal_last_error(h), cases[i].msg);
     }
+    char *longline = malloc(5000);
+    ck_assert_ptr_nonnull(longline);
+    memset(longline, 'x', 4999);
+    longline[4999] = '\0';
+    ck_assert_int_eq(hal_cmd(h, longline, "t.hal", 9, NULL), HAL_ERR_SYNTAX);
+    ck_assert_str_eq(hal_last_error(h), "t.hal:9: line longer than 4095 characters");
+    free(longline);
     /* the failed streamer loads left nothing behind */
     ck_assert_ptr_null(hal_data_ptr(h, "streamer.0.pin.0", NULL));
     ck_assert_int_eq(hal_cmd(h, "loadrt streamer cfg=fb data=1,0;2,1", "t.hal", 1, NULL),

@@ -90,7 +90,7 @@ START_TEST(second_writer_and_type_mismatch_are_refused)
     struct tcomp c, d;
     make_pins(h, &c);
     ck_assert_int_eq(hal_pin_float_newf(h, HAL_OUT, &d.fout, "u.0.out"), HAL_OK);
-    ck_assert_int_eq(net(h, "x", "t.0.out t.0.in1"), HAL_OK);
+    ck_assert_int_eq(net(h, "x", "t.0.out t.0.in1 t.0.out"), HAL_OK);   /* named twice */
     ck_assert_int_eq(net(h, "x", "u.0.out"), HAL_ERR_DIR);
     ck_assert_str_eq(hal_last_error(h), "net: signal 'x' already has a writer 't.0.out'; "
                      "'u.0.out' cannot also write it");
