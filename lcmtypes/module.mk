@@ -26,3 +26,12 @@ $(LIBDIR)/libhexcnc.a: $(LCM_GEN_OBJS)
 LIB_SRCS += hal/ring.c hal/components/lcm_status.c hal/components/lcm_status_pub.c
 HAL_COMPS += lcm_status
 TESTS += test_lcm_ring test_lcm_status
+
+# UDP multicast in a network namespace: tests/lcm/udpm.sh with its checker program.
+SCRIPT_TESTS += tests/lcm/udpm.sh
+LCM_CHECK := $(BUILD)/tests/lcm/lcm_check
+$(LCM_CHECK): tests/lcm/lcm_check.c $(LIBDIR)/libhexcnc.a | $(GEN_HDRS)
+	@mkdir -p $(@D)
+	$(call say,TEST,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) $< $(LIBDIR)/libhexcnc.a $(LDLIBS) -o $@
+test: $(LCM_CHECK)

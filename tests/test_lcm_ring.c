@@ -8,7 +8,7 @@
 
 #include "hal/ring.h"
 
-#define N_ITEMS 200000u             /* items per producer in the threaded tests */
+#define N_ITEMS 50000u              /* items per producer in the threaded tests */
 
 /* An item whose words all derive from its sequence number, so a torn copy shows. */
 struct item {
@@ -243,6 +243,7 @@ int main(void)
 {
     Suite *s = suite_create("lcm_ring");
     TCase *tc = tcase_create("ring");
+    tcase_set_timeout(tc, 60);      /* two threads on a loaded machine: never a tight limit */
     tcase_add_test(tc, test_spsc_sizes);
     tcase_add_test(tc, test_spsc_full_drops_and_order);
     tcase_add_test(tc, test_spsc_threads_no_loss);
