@@ -4,6 +4,7 @@ LIB_SRCS += hal/drivers/modbus_drive.c hal/drivers/modbus_link.c hal/drivers/mod
             hal/drivers/modbus_hal.c
 HAL_COMPS += modbus
 BENCHES += bench_modbus
+SCRIPT_TESTS += tests/test_modbus_cli.sh
 # CiA 402 over CAN: CiA 301 codec, master core, SocketCAN transport, bus-load arithmetic.
 LIB_SRCS += hal/drivers/canopen.c hal/drivers/canopen_config.c hal/drivers/canopen_master.c \
             hal/drivers/cia402.c hal/drivers/can_bus.c hal/drivers/can_load.c hal/drivers/cia402_hal.c
