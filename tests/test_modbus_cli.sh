@@ -5,6 +5,7 @@ fail=0
 tmp=$(mktemp -d /tmp/test_modbus_cli.XXXXXX) || exit 1
 base=$((20000 + $$ % 20000))
 mkfifo "$tmp/in"
+: > "$tmp/sim.out"
 "$HEXCNC_BIN" modbus_sim --drives 2 --base-port $base --seconds 20 < "$tmp/in" > "$tmp/sim.out" 2>&1 &
 sim=$!
 exec 3> "$tmp/in"                      # keeps the simulator's stdin open
