@@ -137,7 +137,7 @@ static void press_reset(struct hal *h, int *k)
 }
 
 /* Six drives follow a motion; one exchange per 4 servo periods; feedback within the lag. */
-static void follow_motion(struct hal *h, struct modbus_sim *s)
+static void follow_motion(struct hal *h, struct modbus_sim *s, const int *ticks)
 {
     double *fb[NDRIVES];
     char name[64];
@@ -164,10 +164,10 @@ static void follow_motion(struct hal *h, struct modbus_sim *s)
     for (int i = 0; i < NDRIVES; i++) {
         struct modbus_sim_drive_state st;
         modbus_sim_state(s, i, &st);
-        ck_assert_uint_eq(st.requests - st0[i].requests, 250);   /* 1000 periods / 4 */
-        /* Exchanges fall on every 4th call of modbus.update (calls 0, 4, 8, ...): the
-         * command of the last one is the drive's target. */
-        int last = (k - 1) / 4 * 4;
+        ck_assert_uint_eq(st.requests - st0[i].requests, 1000 / ticks[i]);
+        /* Exchanges fall on every ticks-th call of modbus.update (calls 0, 4, 8, ...):
+         * the command of the last one is the drive's target. */
+        int last = (k - 1) / ticks[i] * ticks[i];
         ck_assert(lround(leg_cmd(i, last) * CPM) != lround(leg_cmd(i, k - 1) * CPM));
         ck_assert_int_eq(st.target_counts, (int32_t)lround(leg_cmd(i, last) * CPM));
         ck_assert_double_eq(*fb[i], lround(st.actual_counts) / CPM);
@@ -204,9 +204,11 @@ START_TEST(test_six_drives_follow_slower_setpoints)
     int ports[NDRIVES];
     struct modbus_sim *s = api_sim(ports);
     char ini[64];
-    write_ini(ini, sizeof(ini), ports, "");
+    /* Drive 5 takes set points every 2 ms, the others every 4 ms. */
+    write_ini(ini, sizeof(ini), ports, "[MODBUS_DRIVE_5]\nSETPOINT_PERIOD = 2000000\n");
     struct hal *h = make_graph(ini, false);
-    follow_motion(h, s);
+    const int ticks[NDRIVES] = { 4, 4, 4, 4, 4, 2 };
+    follow_motion(h, s, ticks);
     hal_destroy(h);
     modbus_sim_destroy(s);
     unlink(ini);
@@ -225,7 +227,8 @@ START_TEST(test_server_component_end_to_end)
     ck_assert_ptr_nonnull(s);
     for (int i = 0; i < NDRIVES; i++)
         modbus_sim_set_position(s, i, (int32_t)lround(leg_cmd(i, 0) * CPM));
-    follow_motion(h, s);
+    const int ticks[NDRIVES] = { 4, 4, 4, 4, 4, 4 };
+    follow_motion(h, s, ticks);
     hal_destroy(h);                 /* stops the client links, then the servers */
     unlink(ini);
 }

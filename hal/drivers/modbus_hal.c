@@ -32,6 +32,8 @@ struct modbus_hal_drive {
     uint32_t *errors;         /* out: failed connects and exchanges */
     uint32_t *status_word;    /* out: the drive's status word */
     bool reset_last;          /* fault-reset in the previous period (edge detection) */
+    long setpoint_ticks;      /* inline: servo periods per set-point period (0 = not yet) */
+    long tick;                /* inline: servo periods since the last exchange */
     bool linked;              /* link initialised (needs fini) */
     struct modbus_link link;
 };
@@ -40,8 +42,6 @@ struct modbus_hal_drive {
 struct modbus_hal {
     int count;                /* drives */
     bool inline_io;           /* exchanges in modbus.update instead of I/O threads */
-    long setpoint_ticks;      /* inline: servo periods per set-point period (0 = not yet) */
-    long tick;                /* inline: servo periods since the last exchange */
     bool *fault_any;          /* out: any drive faulted (to the e-stop chain) */
     struct modbus_hal_drive d[MODBUS_HAL_MAX_DRIVES];
 };
@@ -59,21 +59,25 @@ static void modbus_hal_report(void *arg, const char *msg)
     fprintf(stderr, "hexcnc: %s\n", msg);
 }
 
+/* Inline mode: true on the servo periods where drive d exchanges (the first, then every
+ * SETPOINT_PERIOD / servo period, rounded, at least every period). */
+static bool modbus_hal_due(struct modbus_hal_drive *d, long period_ns)
+{
+    if (!d->setpoint_ticks) {
+        long sp = d->link.drive.cfg.period_ns;
+        d->setpoint_ticks = period_ns > 0 ? (sp + period_ns / 2) / period_ns : 1;
+        if (d->setpoint_ticks < 1)
+            d->setpoint_ticks = 1;
+    }
+    bool due = d->tick == 0;
+    d->tick = (d->tick + 1) % d->setpoint_ticks;
+    return due;
+}
+
 /* The servo-thread function: commands in, feedback out, inline exchanges when configured. */
 static void modbus_hal_update(void *arg, long period_ns)
 {
     struct modbus_hal *c = arg;
-    bool exchange_now = false;
-    if (c->inline_io) {
-        if (!c->setpoint_ticks) {
-            long sp = c->d[0].link.drive.cfg.period_ns;
-            c->setpoint_ticks = period_ns > 0 ? (sp + period_ns / 2) / period_ns : 1;
-            if (c->setpoint_ticks < 1)
-                c->setpoint_ticks = 1;
-        }
-        exchange_now = c->tick == 0;
-        c->tick = (c->tick + 1) % c->setpoint_ticks;
-    }
     bool any = false;
     for (int i = 0; i < c->count; i++) {
         struct modbus_hal_drive *d = &c->d[i];
@@ -81,7 +85,7 @@ static void modbus_hal_update(void *arg, long period_ns)
             modbus_link_reset(&d->link);
         d->reset_last = *d->fault_reset;
         modbus_link_command(&d->link, *d->pos_cmd, *d->enable);
-        if (exchange_now)
+        if (c->inline_io && modbus_hal_due(d, period_ns))
             modbus_link_cycle(&d->link);
         struct modbus_feedback fb;
         modbus_link_feedback(&d->link, &fb);
