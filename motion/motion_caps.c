@@ -11,7 +11,8 @@
 #define KIN_TOL_SHARE 0.9      /* the d^2 estimate is first order: keep 10 % in hand */
 
 /* Samples segment sg at s; returns the inverse kinematics status at s itself. */
-static int sample_at(struct motion *m, const struct motion_seg *sg, double s, struct motion_sample *o)
+static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
+                     struct motion_sample *o)
 {
     double h = FD_H, pm[KINS_POSE_DIM], pp[KINS_POSE_DIM];
     double Lm[KINS_MAX_JOINTS], Lp[KINS_MAX_JOINTS];
@@ -91,7 +92,8 @@ static void jacobian_near(struct motion *m, const struct motion_sample *S, doubl
  * deviation q d^2 / 8 with J q = d2L. Its part across the path (the part along the path is
  * only a timing shift) must stay within KINEMATIC_TOLERANCE: d <= sqrt(8 tol / |q_perp|),
  * v <= d / T. Returns HUGE_VAL when no cap applies, -1 when J is singular. */
-static double kin_tol_cap(struct motion *m, const struct motion_seg *sg, const struct motion_sample *S)
+static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
+                          const struct motion_sample *S)
 {
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0 || m->nj != 6)
@@ -125,7 +127,8 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg, const s
 }
 
 /* Reports a leg out of range at a sample, naming file, line, leg, amount and pose. */
-static int unreachable(struct motion *m, const struct motion_seg *sg, const struct motion_sample *S,
+static int unreachable(struct motion *m, const struct motion_seg *sg,
+                       const struct motion_sample *S,
                        int st, char *err, size_t errlen)
 {
     const struct kins *k = m->kins;
@@ -149,56 +152,82 @@ static int unreachable(struct motion *m, const struct motion_seg *sg, const stru
                                                                   : MOTION_ERR_KINS;
 }
 
-/* Speed caps of one knot: hard (machine, legs, kinematic error) into *hard, with the feed
- * into *cap, and the path acceleration limit into *acc. */
-int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
-                     struct motion_sample *Sp, double *hard, double *cap, double *acc, char *err,
-                     size_t errlen)
+/* Reachability at a knot, with the overshoot a leg can have before the next knot
+ * (|d2L/ds2| hs^2 / 8) counted in, so a leg leaving its range mid-move is caught. */
+static int reach_check(struct motion *m, const struct motion_seg *sg, struct motion_sample *S,
+                       double hs, int st, char *err, size_t errlen)
+{
+    const struct kins *k = m->kins;
+    for (int i = 0; i < m->nj && st == KINS_OK; i++) {
+        double bulge = fabs(S->d2L[i]) * hs * hs / 8;
+        if (S->L[i] + bulge > k->joint_max[i])
+            st = KINS_ERR_UNREACHABLE, S->L[i] += bulge;
+        else if (S->L[i] - bulge < k->joint_min[i])
+            st = KINS_ERR_UNREACHABLE, S->L[i] -= bulge;
+    }
+    return st == KINS_OK ? MOTION_OK : unreachable(m, sg, S, st, err, errlen);
+}
+
+/* Leg caps at a knot: path speed into *vl, path acceleration into *am (lowered). The leg's
+ * rate is L' v and its acceleration L'' v^2 + L' a; L' may grow by L'' hs before the next
+ * knot. Half the leg's acceleration goes to each term, the curvature term with 20 % in hand. */
+static void leg_caps(const struct motion *m, const struct motion_sample *S, double hs,
+                     double *vl, double *am)
 {
     const struct motion_config *c = &m->cfg;
-    const struct kins *k = m->kins;
-    struct motion_sample S;
-    int st = sample_at(m, sg, s, &S);
-    *Sp = S;
-    for (int i = 0; i < m->nj && st == KINS_OK; i++)  /* catches a leg peaking between knots */
-        if (S.L[i] + fabs(S.d2L[i]) * hs * hs / 8 > k->joint_max[i] ||
-            S.L[i] - fabs(S.d2L[i]) * hs * hs / 8 < k->joint_min[i])
-            st = KINS_ERR_UNREACHABLE, S.L[i] += S.L[i] > 0.5 * (k->joint_max[i] + k->joint_min[i])
-                                       ? fabs(S.d2L[i]) * hs * hs / 8 : -fabs(S.d2L[i]) * hs * hs / 8;
-    if (st != KINS_OK)
-        return unreachable(m, sg, &S, st, err, errlen);
-    double vm = HUGE_VAL, am = HUGE_VAL, w = 0;
-    if (!sg->rotary) {
-        vm = c->max_lin_vel_mm_s;
-        am = c->max_lin_acc_mm_s2;
+    *vl = HUGE_VAL;
+    for (int i = 0; i < m->nj; i++) {
+        double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
+        if (d1 > 1e-12) {
+            *vl = fmin(*vl, c->joint[i].max_vel_mm_s / d1);
+            *am = fmin(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
+        }
+        if (d2 > 1e-12)
+            *vl = fmin(*vl, sqrt((1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2)));
     }
+}
+
+/* Machine caps at a knot: path speed into *vm and acceleration into *am from the linear and
+ * angular limits, and the centripetal share on arcs. */
+static void machine_caps(const struct motion *m, const struct motion_seg *sg,
+                         const struct motion_sample *S, double *vm, double *am)
+{
+    const struct motion_config *c = &m->cfg;
+    double w = 0;
+    *vm = sg->rotary ? HUGE_VAL : c->max_lin_vel_mm_s;
+    *am = sg->rotary ? HUGE_VAL : c->max_lin_acc_mm_s2;
     for (int i = 3; i < 6; i++)
-        w = fmax(w, fabs(S.dp[i]));
+        w = fmax(w, fabs(S->dp[i]));
     if (w > 1e-12) {
-        vm = fmin(vm, c->max_ang_vel_deg_s / w);
-        am = fmin(am, c->max_ang_acc_deg_s2 / w);
+        *vm = fmin(*vm, c->max_ang_vel_deg_s / w);
+        *am = fmin(*am, c->max_ang_acc_deg_s2 / w);
     }
     if (sg->kind == SEG_ARC) {
         const struct motion_arc *a = &m->plan.arcs[sg->arc];
         double r = fmin(a->r0_mm, a->r0_mm + a->dr_mm);
-        vm = fmin(vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
-        am *= sqrt(1 - ARC_NORMAL_SHARE * ARC_NORMAL_SHARE);
+        *vm = fmin(*vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
+        *am *= sqrt(1 - ARC_NORMAL_SHARE * ARC_NORMAL_SHARE);
     }
-    double vl = HUGE_VAL;
-    for (int i = 0; i < m->nj; i++) {
-        double d1 = fabs(S.dL[i]) + fabs(S.d2L[i]) * hs, d2 = fabs(S.d2L[i]);
-        if (d1 > 1e-12) {
-            vl = fmin(vl, c->joint[i].max_vel_mm_s / d1);
-            am = fmin(am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
-        }
-        if (d2 > 1e-12)
-            vl = fmin(vl, sqrt((1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2)));
-    }
-    double vk = kin_tol_cap(m, sg, &S);
+}
+
+/* Speed caps of one knot: hard (machine, legs, kinematic error) into *hard, with the feed
+ * into *cap, and the path acceleration limit into *acc. */
+int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
+                     struct motion_sample *S, double *hard, double *cap, double *acc, char *err,
+                     size_t errlen)
+{
+    int st = reach_check(m, sg, S, hs, sample_at(m, sg, s, S), err, errlen);
+    if (st)
+        return st;
+    double vm, am, vl;
+    machine_caps(m, sg, S, &vm, &am);
+    leg_caps(m, S, hs, &vl, &am);
+    double vk = kin_tol_cap(m, sg, S);
     if (vk < 0) {
         snprintf(err, errlen, "%s:%d: the move passes through a singular pose of the machine "
                  "at X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f", sg->file ? sg->file : "program",
-                 sg->line, S.pose[0], S.pose[1], S.pose[2], S.pose[3], S.pose[4], S.pose[5]);
+                 sg->line, S->pose[0], S->pose[1], S->pose[2], S->pose[3], S->pose[4],
+                 S->pose[5]);
         return MOTION_ERR_KINS;
     }
     double feed = sg->feed > 0 ? sg->feed : HUGE_VAL;
@@ -212,7 +241,6 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     *acc = am;
     return MOTION_OK;
 }
-
 /* The speed at which the joint from segment a into b may be passed (G64): the velocity
  * changes direction within one servo period there, so its jump may use JUMP_SHARE of one
  * period's acceleration on every axis (a quarter on every leg) while the moves on either
