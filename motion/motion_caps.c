@@ -33,9 +33,13 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     return st;
 }
 
-/* Solves a x = b in place (b becomes x) for 6x6 a, partial pivoting; -1 when singular. */
-int motion_solve6(double a[6][6], double b[6])
+/* Inverts a 6x6 matrix by Gauss-Jordan elimination with partial pivoting (a is destroyed);
+ * -1 when it is singular. */
+int motion_invert6(double a[6][6], double inv[6][6])
 {
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++)
+            inv[i][j] = i == j;
     for (int c = 0; c < 6; c++) {
         int p = c;
         for (int r = c + 1; r < 6; r++)
@@ -43,47 +47,47 @@ int motion_solve6(double a[6][6], double b[6])
                 p = r;
         if (!(fabs(a[p][c]) > 1e-12))
             return -1;
-        if (p != c) {
-            for (int k = 0; k < 6; k++) {
-                double t = a[c][k]; a[c][k] = a[p][k]; a[p][k] = t;
-            }
-            double t = b[c]; b[c] = b[p]; b[p] = t;
+        for (int k = 0; k < 6 && p != c; k++) {
+            double t = a[c][k]; a[c][k] = a[p][k]; a[p][k] = t;
+            t = inv[c][k]; inv[c][k] = inv[p][k]; inv[p][k] = t;
         }
-        for (int r = c + 1; r < 6; r++) {
-            double f = a[r][c] / a[c][c];
-            for (int k = c; k < 6; k++)
-                a[r][k] -= f * a[c][k];
-            b[r] -= f * b[c];
+        double f = 1 / a[c][c];
+        for (int k = 0; k < 6; k++)
+            a[c][k] *= f, inv[c][k] *= f;
+        for (int r = 0; r < 6; r++) {
+            if (r == c || a[r][c] == 0)
+                continue;
+            double g = a[r][c];
+            for (int k = 0; k < 6; k++)
+                a[r][k] -= g * a[c][k], inv[r][k] -= g * inv[c][k];
         }
-    }
-    for (int c = 5; c >= 0; c--) {
-        for (int k = c + 1; k < 6; k++)
-            b[c] -= a[c][k] * b[k];
-        b[c] /= a[c][c];
     }
     return 0;
 }
 
-/* The Jacobian dL/dpose (mm/mm, mm/deg) at S's pose by finite differences of the inverse,
- * or the cached one when S lies within 2 mm and 1 deg of where that was taken. */
-static void jacobian_near(struct motion *m, const struct motion_sample *S, double J[6][6])
+/* The inverse of the Jacobian dL/dpose (mm/mm, mm/deg) at S's pose, by finite differences
+ * of the inverse kinematics, or the cached one when S lies within 2 mm and 1 deg of where it
+ * was taken (it changes by well under 1 % there). -1 when the Jacobian is singular. */
+static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S)
 {
     int near = m->jc_valid;
     for (int i = 0; i < 6 && near; i++)
         near = fabs(S->pose[i] - m->jc_pose[i]) <= (i < 3 ? 2.0 : 1.0);
-    if (!near) {
-        double L1[KINS_MAX_JOINTS], p1[KINS_POSE_DIM], d = 1e-4;
-        for (int j = 0; j < 6; j++) {
-            memcpy(p1, S->pose, sizeof p1);
-            p1[j] += d;
-            kins_inverse(m->kins, p1, L1);
-            for (int i = 0; i < 6; i++)
-                m->jc_J[i][j] = (L1[i] - S->L[i]) / d;
-        }
-        memcpy(m->jc_pose, S->pose, sizeof m->jc_pose);
-        m->jc_valid = 1;
+    if (near)
+        return 0;
+    double J[6][6], L1[KINS_MAX_JOINTS], p1[KINS_POSE_DIM], d = 1e-4;
+    for (int j = 0; j < 6; j++) {
+        memcpy(p1, S->pose, sizeof p1);
+        p1[j] += d;
+        kins_inverse(m->kins, p1, L1);
+        for (int i = 0; i < 6; i++)
+            J[i][j] = (L1[i] - S->L[i]) / d;
     }
-    memcpy(J, m->jc_J, sizeof m->jc_J);
+    if (motion_invert6(J, m->jc_Jinv) < 0)
+        return -1;
+    memcpy(m->jc_pose, S->pose, sizeof m->jc_pose);
+    m->jc_valid = 1;
+    return 0;
 }
 
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
@@ -98,12 +102,14 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0 || m->nj != 6)
         return HUGE_VAL;
-    double J[6][6], q[6];
-    jacobian_near(m, S, J);
-    for (int j = 0; j < 6; j++)
-        q[j] = S->d2L[j];
-    if (motion_solve6(J, q) < 0)
+    double q[6];
+    if (jacobian_inverse_near(m, S) < 0)
         return -1;
+    for (int i = 0; i < 6; i++) {
+        q[i] = 0;
+        for (int j = 0; j < 6; j++)
+            q[i] += m->jc_Jinv[i][j] * S->d2L[j];
+    }
     double shift, w2 = 0;      /* shift: the along-path part of q, in s units */
     int base = sg->rotary ? 3 : 0;
     for (int i = base; i < base + 3; i++)

@@ -75,10 +75,10 @@ struct motion {
     int fault_status;
     char msg[320];           /* last error / fault text */
     double start_pose[KINS_POSE_DIM];
-    /* planning scratch: the Jacobian dL/dpose near jc_pose, reused while the path stays
-     * within a few mm and a degree of it (it changes by well under 1 % there) */
+    /* planning scratch: the inverse Jacobian dpose/dL near jc_pose, reused while the path
+     * stays within 2 mm and 1 deg of it */
     double jc_pose[KINS_POSE_DIM];
-    double jc_J[6][6];
+    double jc_Jinv[6][6];
     int jc_valid;
     /* run state */
     double tau_s;            /* position on the plan's time axis, s */
@@ -152,7 +152,7 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
 double motion_junction_speed(struct motion *m, const struct motion_seg *a,
                              const struct motion_seg *b, const struct motion_sample *A,
                              const struct motion_sample *B);
-/* 6x6 solve with partial pivoting; 0 on success, -1 when singular. */
-int motion_solve6(double a[6][6], double b[6]);
+/* 6x6 inverse with partial pivoting (a is destroyed); 0 on success, -1 when singular. */
+int motion_invert6(double a[6][6], double inv[6][6]);
 
 #endif
