@@ -24,8 +24,8 @@ const char *check_kind_name(enum check_kind k)
 void check_opts_default(struct check_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->deviation_every_s = 0.010;
-    o->condition_every_s = 0.050;
+    o->deviation_every_s = 0.050;
+    o->condition_every_s = 0.500;
 }
 
 void check_result_init(struct check_result *r)
@@ -114,7 +114,7 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
     }
     if (motion_start(mc->motion) != MOTION_OK)
         return CHECK_ERR_CONFIG;
-    int st = check_simulate(mc, opts, r);
+    int st = check_simulate(mc, prog->start, opts, r);
     r->simulated = 1;
     if (st != CHECK_OK) {
         struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = r->machining_time_s,

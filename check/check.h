@@ -68,6 +68,8 @@ struct check_leg {
     double peak_vel_mm_s;            /* largest |rate| from successive set points, mm/s */
     double peak_acc_mm_s2;           /* largest |change of rate| per period, mm/s^2 */
     double limit_min_mm, limit_max_mm, limit_vel_mm_s, limit_acc_mm_s2; /* from the INI */
+    const char *vel_key, *acc_key;   /* the INI keys of the rate limits: MAX_VELOCITY, or
+                                      * STEPGEN_MAXVEL when the drive's limit is lower */
 };
 
 /* How and how often the costly measures are taken. */
@@ -80,8 +82,8 @@ struct check_opts {
                                       * (for comparison; the default warm start is faster) */
     struct check_trace *trace;       /* optional: filled with samples for plots */
 };
-/* The defaults: deviation every 10 ms, condition number every 50 ms, and both at every change
- * of program line. */
+/* The defaults: deviation every 50 ms, condition number every 500 ms, and both at every change
+ * of program line (docs/verification.md says why that is enough). */
 void check_opts_default(struct check_opts *o);
 
 /* Everything the check found. */

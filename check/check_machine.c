@@ -75,7 +75,11 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         char sec[16];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
-        if (hal_ini_double(mc->hal, sec, "SCALE", 0, &mc->scale[i]) == HAL_ERR_SYNTAX)
+        if (hal_ini_double(mc->hal, sec, "SCALE", 0, &mc->scale[i]) == HAL_ERR_SYNTAX ||
+            hal_ini_double(mc->hal, sec, "STEPGEN_MAXVEL", 0, &mc->drive_vel[i]) ==
+                HAL_ERR_SYNTAX ||
+            hal_ini_double(mc->hal, sec, "STEPGEN_MAXACCEL", 0, &mc->drive_acc[i]) ==
+                HAL_ERR_SYNTAX)
             return fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
     }
     return CHECK_OK;
@@ -135,6 +139,9 @@ void check_machine_close(struct check_machine *mc)
         return;
     motion_destroy(mc->motion);
     kins_free(mc->kins);
+    for (size_t i = 0; i < mc->ninterps; i++)
+        interp_destroy(mc->interps[i]);
+    free(mc->interps);
     hal_destroy(mc->hal);
     free(mc->tt);
     free(mc);
@@ -165,9 +172,13 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
                      struct canon_prog *prog, struct check_problem *pb)
 {
     struct interp *in = interp_create();
+    struct interp **list = realloc(mc->interps, (mc->ninterps + 1) * sizeof *list);
     memset(pb, 0, sizeof *pb);
     pb->kind = CHECK_INTERP, pb->leg = -1, pb->time_s = -1, pb->count = 1;
-    if (!in) {
+    if (list)
+        mc->interps = list;
+    if (!in || !list) {
+        interp_destroy(in);
         snprintf(pb->message, sizeof pb->message, "out of memory");
         return CHECK_ERR_NOMEM;
     }
@@ -186,7 +197,7 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
         interp_error_format(e, pb->message, sizeof pb->message);
         st = CHECK_ERR_VIOLATION;
     }
-    interp_destroy(in);
+    mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
     return st;
 }
 

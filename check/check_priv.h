@@ -6,6 +6,7 @@
 
 struct hal;
 struct tooltable;
+struct interp;
 
 /* The machine of one INI: its reader, kinematics, motion and interpreter settings. */
 struct check_machine {
@@ -18,7 +19,12 @@ struct check_machine {
     double feed_factor;              /* mm/min per F unit ([RS274NGC] FEED_UNITS) */
     double cond_limit;               /* [KINS] SINGULAR_CONDITION */
     double scale[KINS_MAX_JOINTS];   /* [JOINT_n] SCALE, steps per mm (0 = none) */
+    double drive_vel[KINS_MAX_JOINTS]; /* [JOINT_n] STEPGEN_MAXVEL, mm/s (0 = none) */
+    double drive_acc[KINS_MAX_JOINTS]; /* [JOINT_n] STEPGEN_MAXACCEL, mm/s^2 (0 = none) */
     char ini[256];
+    struct interp **interps;         /* every interpreter used: the canonical commands point
+                                      * at their file name, so they live as long as mc */
+    size_t ninterps;
 };
 
 /* Whether a canonical command moves the machine. */
@@ -37,6 +43,7 @@ int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r);
 
 /* Servo-rate pass through motion_step (the program must be loaded and started). */
-int check_simulate(struct check_machine *mc, const struct check_opts *o, struct check_result *r);
+int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
+                   const struct check_opts *o, struct check_result *r);
 
 #endif

@@ -115,9 +115,9 @@ void check_print_table(const struct check_result *r, FILE *f)
         print_duration(f, r->machining_time_s);
         fprintf(f, " (%ld servo periods of %.3f ms), path %.3f mm\n", r->periods,
                 r->servo_period_s * 1e3, r->length_mm);
-        fprintf(f, "deviation       %.6f mm max (line %d), %.6f deg; tolerance %.6f mm; "
-                "measured every %.0f ms and at each line change\n", r->max_deviation_mm,
-                r->max_deviation_line, r->max_deviation_deg, r->kin_tol_mm,
+        fprintf(f, "deviation       %.4g um max (line %d), %.3g deg; tolerance %g um; "
+                "measured every %g ms and at each line change\n", r->max_deviation_mm * 1e3,
+                r->max_deviation_line, r->max_deviation_deg, r->kin_tol_mm * 1e3,
                 r->deviation_every_s * 1e3);
         fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured every %.0f ms and "
                 "at each line change\n\n", r->max_condition, r->max_condition_line,

@@ -16,10 +16,10 @@ struct sim {
     struct check_result *r;
     int nj;
     double T;                          /* servo period, s */
+    double inv_T;                      /* 1 / T, 1/s */
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
     double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s */
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
-    double fwd[KINS_POSE_DIM];         /* last forward solution (the warm start) */
     int have_v;                        /* v0 valid (two set points seen) */
     int line;                          /* program line of the previous period */
     const char *file;
@@ -36,43 +36,52 @@ static void leg_limit(struct sim *s, enum check_kind k, int leg, double value, d
     snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
     const char *what = k == CHECK_LEG_VELOCITY ? "moves at" : "accelerates at";
     const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : "mm/s^2";
+    const struct check_leg *lg = &s->r->leg[leg];
     snprintf(p.message, sizeof p.message, "leg %d %s %.3f %s, over its limit of %.3f %s "
              "([JOINT_%d] %s) at %.3f s", leg + 1, what, value, unit, limit, unit, leg,
-             k == CHECK_LEG_VELOCITY ? "MAX_VELOCITY" : "MAX_ACCELERATION", t_s);
+             k == CHECK_LEG_VELOCITY ? lg->vel_key : lg->acc_key, t_s);
     check_add_problem(s->r, &p);
 }
 
-/* Leg lengths, rates from successive set points and accelerations from successive rates. */
+/* A leg beyond its length range at this period. */
+static void leg_out_of_range(struct sim *s, int i, double L, double t_s)
+{
+    const struct check_leg *lg = &s->r->leg[i];
+    struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = s->line, .leg = i, .value = L,
+                               .time_s = t_s, .count = 1 };
+    p.limit = L > lg->limit_max_mm ? lg->limit_max_mm : lg->limit_min_mm;
+    snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
+    snprintf(p.message, sizeof p.message, "leg %d reaches %.3f mm, beyond its limit %.3f mm",
+             i + 1, L, p.limit);
+    check_add_problem(s->r, &p);
+}
+
+/* Leg lengths, rates from successive set points and accelerations from successive rates.
+ * This runs every period: comparisons only, the reports are out of line. */
 static void legs_period(struct sim *s, const struct motion_out *out)
 {
-    struct check_result *r = s->r;
+    double t = out->time_elapsed_s;
     for (int i = 0; i < s->nj; i++) {
-        struct check_leg *lg = &r->leg[i];
-        double L = out->joint_pos[i], v = (L - s->L0[i]) / s->T;
-        lg->min_mm = fmin(lg->min_mm, L);
-        lg->max_mm = fmax(lg->max_mm, L);
-        if (L > lg->limit_max_mm || L < lg->limit_min_mm) {
-            struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = s->line, .leg = i,
-                                       .value = L, .time_s = out->time_elapsed_s, .count = 1 };
-            p.limit = L > lg->limit_max_mm ? lg->limit_max_mm : lg->limit_min_mm;
-            snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
-            snprintf(p.message, sizeof p.message, "leg %d reaches %.3f mm, beyond its limit "
-                     "%.3f mm", i + 1, L, p.limit);
-            check_add_problem(r, &p);
+        struct check_leg *lg = &s->r->leg[i];
+        double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
+        double av = fabs(v), aa = fabs(v - s->v0[i]) * s->inv_T;
+        if (L < lg->min_mm)
+            lg->min_mm = L;
+        if (L > lg->max_mm)
+            lg->max_mm = L;
+        if (L > lg->limit_max_mm || L < lg->limit_min_mm)
+            leg_out_of_range(s, i, L, t);
+        if (av > lg->peak_vel_mm_s) {
+            lg->peak_vel_mm_s = av;
+            if (av > lg->limit_vel_mm_s * (1 + LIMIT_SLACK))
+                leg_limit(s, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s, t);
+        } else if (av > lg->limit_vel_mm_s * (1 + LIMIT_SLACK)) {
+            leg_limit(s, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s, t);
         }
-        if (fabs(v) > lg->peak_vel_mm_s)
-            lg->peak_vel_mm_s = fabs(v);
-        if (fabs(v) > lg->limit_vel_mm_s * (1 + LIMIT_SLACK))
-            leg_limit(s, CHECK_LEG_VELOCITY, i, fabs(v), lg->limit_vel_mm_s,
-                      out->time_elapsed_s);
-        if (s->have_v) {
-            double a = fabs(v - s->v0[i]) / s->T;
-            if (a > lg->peak_acc_mm_s2)
-                lg->peak_acc_mm_s2 = a;
-            if (a > lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK))
-                leg_limit(s, CHECK_LEG_ACCELERATION, i, a, lg->limit_acc_mm_s2,
-                          out->time_elapsed_s);
-        }
+        if (s->have_v && aa > lg->peak_acc_mm_s2)
+            lg->peak_acc_mm_s2 = aa;
+        if (s->have_v && aa > lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK))
+            leg_limit(s, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2, t);
         s->v0[i] = v;
     }
 }
@@ -85,13 +94,14 @@ static double deviation(struct sim *s, const struct motion_out *out, double *ang
     double Lm[KINS_MAX_JOINTS], P[KINS_POSE_DIM], d[3], n2 = 0, u = 0, e2 = 0;
     for (int i = 0; i < s->nj; i++)
         Lm[i] = 0.5 * (s->L0[i] + out->joint_pos[i]);
-    if (s->o->cold_forward)
+    if (s->o->cold_forward)    /* the baseline: every solve from the home pose */
         memcpy(P, s->mc->kins->home, sizeof P);
-    else
-        memcpy(P, s->fwd, sizeof P);
+    else                       /* warm: the commanded chord's midpoint is within the
+                                * deviation (um) of the answer, so one Newton step does */
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            P[i] = 0.5 * (s->p0[i] + out->pose[i]);
     if (kins_forward(s->mc->kins, Lm, P, NULL) != KINS_OK)
         return -1;
-    memcpy(s->fwd, P, sizeof P);
     s->r->deviation_evals++;
     for (int i = 0; i < 3; i++)
         d[i] = out->pose[i] - s->p0[i], n2 += d[i] * d[i];
@@ -161,26 +171,31 @@ static void leg_limits(struct sim *s)
         lg->limit_min_mm = k->joint_min[i], lg->limit_max_mm = k->joint_max[i];
         lg->limit_vel_mm_s = s->mc->mcfg.joint[i].max_vel_mm_s;
         lg->limit_acc_mm_s2 = s->mc->mcfg.joint[i].max_acc_mm_s2;
+        lg->vel_key = "MAX_VELOCITY", lg->acc_key = "MAX_ACCELERATION";
+        /* a step generator slower than the planner's limit cannot follow: check against it */
+        if (s->mc->drive_vel[i] > 0 && s->mc->drive_vel[i] < lg->limit_vel_mm_s)
+            lg->limit_vel_mm_s = s->mc->drive_vel[i], lg->vel_key = "STEPGEN_MAXVEL";
+        if (s->mc->drive_acc[i] > 0 && s->mc->drive_acc[i] < lg->limit_acc_mm_s2)
+            lg->limit_acc_mm_s2 = s->mc->drive_acc[i], lg->acc_key = "STEPGEN_MAXACCEL";
         lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
     }
 }
 
-int check_simulate(struct check_machine *mc, const struct check_opts *o, struct check_result *r)
+int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
+                   const struct check_opts *o, struct check_result *r)
 {
     struct sim s = { .mc = mc, .o = o, .r = r, .nj = mc->kins->njoints,
-                     .T = mc->mcfg.servo_period_s };
+                     .T = mc->mcfg.servo_period_s, .inv_T = 1 / mc->mcfg.servo_period_s };
     struct motion_out out;
     struct motion_plan_info info;
     motion_plan_info(mc->motion, &info);
     r->planned_time_s = info.time_s;
     r->njoints = s.nj;
     leg_limits(&s);
-    if (kins_inverse(mc->kins, mc->kins->home, s.L0) != KINS_OK)
+    if (kins_inverse(mc->kins, start, s.L0) != KINS_OK)   /* motion starts here */
         return CHECK_ERR_KINS;
-    int st = motion_step(mc->motion, 0.0, &out);   /* the start pose, without advancing */
-    memcpy(s.L0, out.joint_pos, sizeof s.L0);
-    memcpy(s.p0, out.pose, sizeof s.p0);
-    memcpy(s.fwd, out.pose, sizeof s.fwd);
+    memcpy(s.p0, start, sizeof s.p0);
+    int st = MOTION_OK;
     long max_periods = (long)(MAX_PERIODS_FACTOR * info.time_s / s.T) + 1000;
     if (o->trace)
         s.trace_every = check_trace_begin(o->trace, info.time_s, s.T);
