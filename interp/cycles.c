@@ -134,6 +134,9 @@ int interp_cycle(struct interp *in, int g)
     interp_prog_pos(in, cur);
     struct cycle c = {.g = g, .q = in->cycle_q, .p_s = in->cycle_p};
     double old_z = cur[AX_Z];
+    /* cur comes back from machine coordinates: within rounding of R is at R */
+    if (fabs(old_z - in->cycle_r) <= 1e-9 * fmax(1.0, fabs(in->cycle_r)) && !in->incremental)
+        old_z = in->cycle_r;
     if (in->incremental) {
         ai = W('x') ? V('x') : 0;
         bi = W('y') ? V('y') : 0;

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""gen_mix.py: writes random programs mixing moves, arcs, offsets, units and cycles (mixSEED.ngc).
+
+Used once to make the mix*.ngc programs of this folder, whose .out files LinuxCNC's rs274 -g
+printed; with rs274 installed it serves to compare many more: python3 gen_mix.py 1000 1200
+then run tests/interp_expected.sh with REGEN=1 in a scratch copy of the folder."""
+import random
+import sys
+
+
+def num(lo, hi, d=3):
+    """A value as a CAM post prints it: up to d decimals, no trailing zeros."""
+    return ('%.*f' % (d, round(random.uniform(lo, hi), d))).rstrip('0').rstrip('.') or '0'
+
+
+def axes():
+    return ' '.join('%s%s' % (a, num(-50, 50)) for a in random.sample('XYZABC', random.randint(1, 4)))
+
+
+def block():
+    """One or a few lines of a random kind."""
+    r = random.random()
+    if r < 0.25:
+        return ['G1 ' + axes()]
+    if r < 0.35:
+        return ['G0 ' + axes()]
+    if r < 0.5:
+        p = random.choice([17, 18, 19])
+        a = {17: 'XY', 18: 'XZ', 19: 'YZ'}[p]
+        return ['G%d G%d %s%s %s%s R%s' % (p, random.choice([2, 3]), a[0], num(-20, 20), a[1],
+                                          num(-20, 20), num(60, 120)), 'G17']
+    if r < 0.55:
+        return [random.choice(['G90', 'G91'])]
+    if r < 0.6:
+        return [random.choice(['G20', 'G21'])]
+    if r < 0.65:
+        return ['G10 L2 P%d %s' % (random.randint(1, 6), axes())]
+    if r < 0.7:
+        return ['G' + random.choice(['54', '55', '56', '57', '58', '59'])]
+    if r < 0.75:
+        return ['G92 ' + axes()]
+    if r < 0.78:
+        return [random.choice(['G92.1', 'G92.2', 'G92.3'])]
+    if r < 0.81:
+        return ['G10 L20 P%d %s' % (random.randint(0, 6), axes())]
+    if r < 0.84:
+        return ['G53 G0 ' + axes()]
+    if r < 0.87:
+        return ['G4 P%s' % num(0, 2)]
+    if r < 0.9:
+        return [random.choice(['G28.1', 'G30.1'])]
+    if r < 0.93:
+        return [random.choice(['G28', 'G30']) + (' ' + axes() if random.random() < .5 else '')]
+    if r < 0.96:
+        p = random.choice([17, 18, 19])
+        w = {17: 'IJ', 18: 'IK', 19: 'JK'}[p]
+        helix = random.choice(['', 'Z1', 'A5']) if p == 17 else ''
+        return ['G%d G%d %s%s %s%s %s P%d' % (p, random.choice([2, 3]), w[0], num(-9, 9), w[1],
+                                             num(-9, 9), helix, random.randint(1, 3)), 'G17']
+    cyc = random.choice(['G81', 'G82 P0.5', 'G83 Q%s' % num(0.5, 3), 'G73 Q%s' % num(0.5, 3),
+                         'G85', 'G89 P1'])
+    return ['G90 G0 Z%s' % num(20, 30),
+            'G%d %s X%s Y%s Z%s R%s L%d' % (random.choice([98, 99]), cyc, num(-20, 20),
+                                            num(-20, 20), num(-10, -1), num(1, 5),
+                                            random.randint(1, 3)),
+            'X%s' % num(-20, 20), 'G80']
+
+
+def program(seed):
+    random.seed(seed)
+    lines = ['(generated mix of moves, arcs, offsets, units and cycles, seed %d)' % seed,
+             'G21 G90 G17 G94', 'G0 X0 Y0 Z10 F300']
+    for _ in range(40):
+        lines += block()
+    return '\n'.join(lines + ['M2']) + '\n'
+
+
+if __name__ == '__main__':
+    first, last = int(sys.argv[1]), int(sys.argv[2])
+    for seed in range(first, last):
+        with open('mix%d.ngc' % seed, 'w') as f:
+            f.write(program(seed))
