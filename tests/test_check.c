@@ -1,0 +1,263 @@
+/* test_check.c: hexcnc check on good and faulty programs: problems, lines, figures, JSON, plots, exit status. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "check/check.h"
+#include "check/plot.h"
+#include "tests/test_check_util.h"
+
+#define TMU_INI "configs/sim/tmu-hexapod.ini"
+#define PAPER_PROG "examples/paper/prog10_g141_d20.ngc"
+
+/* Runs the check of program on ini; returns the status, res filled (caller frees). */
+static int run(const char *ini, const char *prog, const struct check_opts *o,
+               struct check_result *res)
+{
+    char ip[1024], pp[1024], err[1024];
+    struct check_machine *mc;
+    ck_assert_msg(check_machine_open(tc_path(ini, ip, sizeof ip), &mc, err, sizeof err) == 0,
+                  "%s", err);
+    check_result_init(res);
+    int st = check_program(mc, tc_path(prog, pp, sizeof pp), o, res);
+    check_machine_close(mc);
+    return st;
+}
+
+/* The one problem of a kind (fails when there is none). */
+static const struct check_problem *find(const struct check_result *r, enum check_kind k)
+{
+    for (size_t i = 0; i < r->nproblems; i++)
+        if (r->problems[i].kind == k)
+            return &r->problems[i];
+    ck_abort_msg("no problem of kind %s", check_kind_name(k));
+    return NULL;
+}
+
+START_TEST(test_good_program)
+{
+    struct check_result r;
+    ck_assert_int_eq(run(TMU_INI, PAPER_PROG, NULL, &r), CHECK_OK);
+    ck_assert_uint_eq(r.nproblems, 0);
+    ck_assert(r.simulated);
+    ck_assert_int_eq(r.njoints, 6);
+    /* home to the start (~100 mm) and the 60 mm cut at 2 m/min: a few seconds */
+    ck_assert(r.machining_time_s > 3 && r.machining_time_s < 10);
+    ck_assert(fabs(r.machining_time_s - r.planned_time_s) < 0.01);
+    ck_assert(fabs(r.periods * r.servo_period_s - r.machining_time_s) < 1e-6);
+    for (int i = 0; i < 6; i++) {
+        const struct check_leg *l = &r.leg[i];
+        ck_assert(l->min_mm >= l->limit_min_mm && l->max_mm <= l->limit_max_mm);
+        ck_assert(l->min_mm < l->max_mm);
+        ck_assert(l->peak_vel_mm_s > 1 && l->peak_vel_mm_s <= l->limit_vel_mm_s);
+        ck_assert(l->peak_acc_mm_s2 > 1 && l->peak_acc_mm_s2 <= l->limit_acc_mm_s2);
+    }
+    ck_assert(r.max_deviation_mm >= 0 && r.max_deviation_mm <= r.kin_tol_mm);
+    ck_assert(r.max_condition > 2 && r.max_condition < r.condition_limit);
+    ck_assert(r.deviation_evals > 50 && r.condition_evals > 5);
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_planner_keeps_tight_leg_limit)
+{
+    struct check_result r;   /* MAX_VELOCITY 5 mm/s: the planner slows, the check agrees */
+    ck_assert_int_eq(run("tests/check/tmu-slow-legs.ini", PAPER_PROG, NULL, &r), CHECK_OK);
+    for (int i = 0; i < 6; i++)
+        ck_assert(r.leg[i].peak_vel_mm_s <= 5.0 + 1e-9);
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_unreachable_point)
+{
+    struct check_result r;
+    ck_assert_int_eq(run(TMU_INI, "tests/check/unreachable.ngc", NULL, &r), CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_UNREACHABLE);
+    ck_assert_int_eq(p->line, 4);
+    ck_assert(strstr(p->file, "unreachable.ngc"));
+    ck_assert(p->value > p->limit && fabs(p->value - 1024.611) < 0.01);
+    ck_assert(strstr(p->message, "MAX_LIMIT"));
+    ck_assert(!r.simulated);
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_leg_too_long_along_move)
+{
+    struct check_result r;
+    ck_assert_int_eq(run("tests/check/tmu-short-legs.ini", "tests/check/leg_range.ngc", NULL, &r),
+                     CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_LEG_RANGE);
+    ck_assert_int_eq(p->line, 5);
+    ck_assert(p->value > 830 && p->limit == 830);
+    for (size_t i = 0; i < r.nproblems; i++)   /* both ends are reachable */
+        ck_assert_int_ne(r.problems[i].kind, CHECK_UNREACHABLE);
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_leg_speed_over_drive_limit)
+{
+    struct check_result r;
+    ck_assert_int_eq(run("tests/check/tmu-slow-drive.ini", PAPER_PROG, NULL, &r),
+                     CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_LEG_VELOCITY);
+    ck_assert(p->line == 10 || p->line == 11);
+    ck_assert(p->value > 5.0 && p->limit == 5.0);
+    ck_assert(strstr(p->message, "STEPGEN_MAXVEL"));
+    int lines[12] = { 0 };
+    for (size_t i = 0; i < r.nproblems; i++)
+        if (r.problems[i].kind == CHECK_LEG_VELOCITY && r.problems[i].line < 12)
+            lines[r.problems[i].line]++;
+    ck_assert(lines[10] > 0 && lines[11] > 0);   /* positioning (line 10) and cut (line 11) */
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_near_singular_pose)
+{
+    struct check_result r;
+    ck_assert_int_eq(run("tests/check/tmu-singular.ini", PAPER_PROG, NULL, &r),
+                     CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_SINGULAR);
+    ck_assert(p->line == 10 || p->line == 11);
+    ck_assert(p->value > 2.5 && p->limit == 2.5);
+    check_result_free(&r);
+}
+END_TEST
+
+START_TEST(test_interpreter_error)
+{
+    struct check_result r;
+    ck_assert_int_eq(run(TMU_INI, "tests/check/interp_error.ngc", NULL, &r),
+                     CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_INTERP);
+    ck_assert_int_eq(p->line, 4);
+    ck_assert_int_eq(p->column, 16);
+    ck_assert(strstr(p->message, "interp_error.ngc:4:16:"));
+    check_result_free(&r);
+}
+END_TEST
+
+/* Runs bin/hexcnc check and returns its exit status (output to out_path). */
+static int run_binary(const char *args, const char *out_path)
+{
+    const char *bin = getenv("HEXCNC_BIN");
+    char cmd[2048], root[1024];
+    if (!bin)
+        bin = "bin/hexcnc";
+    snprintf(cmd, sizeof cmd, "cd %s && %s check %s > %s 2>&1", tc_path("", root, sizeof root),
+             bin, args, out_path);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+START_TEST(test_json_and_exit_status)
+{
+    char out[] = "/tmp/hexcnc_check_jsonXXXXXX";
+    int fd = mkstemp(out);
+    ck_assert(fd >= 0);
+    close(fd);
+    ck_assert_int_eq(run_binary("--json " TMU_INI " " PAPER_PROG, out), 0);
+    char *j = tc_read(out);
+    ck_assert(j && tj_valid(j));
+    const char *keys[] = { "\"ok\":true", "\"machining_time_s\":", "\"deviation\":{",
+                           "\"max_mm\":", "\"condition\":{", "\"legs\":[{\"leg\":1",
+                           "\"peak_vel_mm_s\":", "\"peak_acc_mm_s2\":", "\"problems\":[]" };
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        ck_assert_msg(strstr(j, keys[i]), "missing %s", keys[i]);
+    free(j);
+    ck_assert_int_eq(run_binary("--json " TMU_INI " tests/check/unreachable.ngc", out), 1);
+    j = tc_read(out);
+    ck_assert(j && tj_valid(j));
+    ck_assert(strstr(j, "\"kind\":\"unreachable\"") && strstr(j, "\"line\":4"));
+    free(j);
+    ck_assert_int_eq(run_binary(TMU_INI " tests/check/interp_error.ngc", out), 1);
+    ck_assert_int_eq(run_binary("missing.ini " PAPER_PROG, out), 2);
+    unlink(out);
+}
+END_TEST
+
+START_TEST(test_json_reader_rejects_bad_text)
+{   /* the reader the test above relies on does tell good from bad */
+    ck_assert(tj_valid("{\"a\":[1,2.5e-3,null,true,\"x\\n\"]}"));
+    ck_assert(!tj_valid("{\"a\":[1,2,]}"));
+    ck_assert(!tj_valid("{\"a\":nan}"));
+    ck_assert(!tj_valid("{\"a\":1} x"));
+    ck_assert(tx_balanced("<svg><g><line/></g><text>a</text></svg>"));
+    ck_assert(!tx_balanced("<svg><g></svg></g>"));
+}
+END_TEST
+
+START_TEST(test_plots_written)
+{
+    char dir[] = "/tmp/hexcnc_check_plotXXXXXX", out[] = "/tmp/hexcnc_check_outXXXXXX";
+    ck_assert(mkdtemp(dir));
+    int fd = mkstemp(out);
+    close(fd);
+    char args[1200];
+    snprintf(args, sizeof args, "--plot %s " TMU_INI " " PAPER_PROG, dir);
+    ck_assert_int_eq(run_binary(args, out), 0);
+    const char *files[] = { "toolpath_top.svg", "toolpath_3d.svg", "legs.svg", "leg_rates.svg",
+                            "deviation.svg" };
+    const char *expect[] = { "programmed contour", "compensated tool path", "leg 6", "leg 1",
+                             "deviation between set points" };
+    for (int i = 0; i < 5; i++) {
+        char p[1300];
+        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+        char *s = tc_read(p);
+        ck_assert_msg(s, "%s not written", p);
+        ck_assert_msg(tx_balanced(s), "%s: unbalanced tags", p);
+        ck_assert(strstr(s, "<polyline") || strstr(s, "<circle"));
+        ck_assert_msg(strstr(s, expect[i]), "%s: no series '%s'", p, expect[i]);
+        ck_assert(strstr(s, "(mm)") || strstr(s, "(um)") || strstr(s, "(mm/s)"));
+        free(s);
+        unlink(p);
+    }
+    rmdir(dir);
+    unlink(out);
+}
+END_TEST
+
+START_TEST(test_strip_compensation)
+{
+    const char in[] = "G141 X50 Y-80 Z630 A0 B-4 W10 F2;\ng142 x1 D3\nG1 X1 (G1410)\n";
+    char *o = check_strip_compensation(in, strlen(in));
+    ck_assert_str_eq(o, "G1   X50 Y-80 Z630 A0 B-4     F2;\ng1   x1   \nG1 X1 (G1410)\n");
+    free(o);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("check");
+    TCase *tc = tcase_create("check");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, test_good_program);
+    tcase_add_test(tc, test_planner_keeps_tight_leg_limit);
+    tcase_add_test(tc, test_unreachable_point);
+    tcase_add_test(tc, test_leg_too_long_along_move);
+    tcase_add_test(tc, test_leg_speed_over_drive_limit);
+    tcase_add_test(tc, test_near_singular_pose);
+    tcase_add_test(tc, test_interpreter_error);
+    tcase_add_test(tc, test_json_and_exit_status);
+    tcase_add_test(tc, test_json_reader_rejects_bad_text);
+    tcase_add_test(tc, test_plots_written);
+    tcase_add_test(tc, test_strip_compensation);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
