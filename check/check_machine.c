@@ -1,4 +1,5 @@
 /* check_machine.c: the machine of an INI file (kinematics, motion, interpreter settings) without HAL threads. */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,22 @@ static void ini_path(const struct check_machine *mc, const char *value, char *ou
         snprintf(out, len, "%s", value);
     else
         snprintf(out, len, "%s/%s", dir, value);
+}
+
+/* [KINS] TOOL_AXIS as a unit vector (default 0 0 -1, as the kinematics reads it). */
+static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, size_t errlen)
+{
+    const char *v = hal_ini_get(mc->hal, "KINS", "TOOL_AXIS");
+    double a[3] = { 0, 0, -1 };
+    if (v && sscanf(v, " %lf%*[ ,]%lf%*[ ,]%lf", &a[0], &a[1], &a[2]) != 3)
+        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS = %s: expected three "
+                    "numbers x y z", ini, v);
+    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(n > 0))
+        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS has no direction", ini);
+    for (int i = 0; i < 3; i++)
+        mc->tool_axis[i] = a[i] / n;
+    return CHECK_OK;
 }
 
 /* Reads the interpreter's settings: FEED_UNITS and TOOL_TABLE. */
@@ -124,7 +141,8 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
         st = fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
         goto fail;
     }
-    if ((st = read_interp_settings(mc, ini, err, errlen)))
+    if ((st = read_interp_settings(mc, ini, err, errlen)) ||
+        (st = read_tool_axis(mc, ini, err, errlen)))
         goto fail;
     *out = mc;
     return CHECK_OK;

@@ -229,7 +229,7 @@ static int deviation_plot(const char *dir, const struct check_trace *t,
         um[i] = t->dev_mm[i] * 1e3;
     double tx[2] = { 0, r->length_mm }, ty[2] = { r->kin_tol_mm * 1e3, r->kin_tol_mm * 1e3 };
     struct svg_series s[2] = {
-        { "deviation between set points", t->dev_dist_mm, um, t->ndev, 0, "#1f77b4", 0, 1 },
+        { "mid-chord deviation", t->dev_dist_mm, um, t->ndev, 0, "#1f77b4", 0, 1 },
         { "KINEMATIC_TOLERANCE", tx, ty, 2, 0, "#d62728", 1, 0 },
     };
     struct svg_chart c = { "Kinematic deviation from the programmed path",

@@ -21,6 +21,7 @@ struct check_machine {
     double scale[KINS_MAX_JOINTS];   /* [JOINT_n] SCALE, steps per mm (0 = none) */
     double drive_vel[KINS_MAX_JOINTS]; /* [JOINT_n] STEPGEN_MAXVEL, mm/s (0 = none) */
     double drive_acc[KINS_MAX_JOINTS]; /* [JOINT_n] STEPGEN_MAXACCEL, mm/s^2 (0 = none) */
+    double tool_axis[3];             /* [KINS] TOOL_AXIS, unit (the spindle's direction) */
     char ini[256];
     struct interp **interps;         /* every interpreter used: the canonical commands point
                                       * at their file name, so they live as long as mc */

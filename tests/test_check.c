@@ -206,7 +206,7 @@ START_TEST(test_plots_written)
     const char *files[] = { "toolpath_top.svg", "toolpath_3d.svg", "legs.svg", "leg_rates.svg",
                             "deviation.svg" };
     const char *expect[] = { "programmed contour", "compensated tool path", "leg 6", "leg 1",
-                             "deviation between set points" };
+                             "mid-chord deviation" };
     for (int i = 0; i < 5; i++) {
         char p[1300];
         snprintf(p, sizeof p, "%s/%s", dir, files[i]);
