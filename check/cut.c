@@ -200,3 +200,14 @@ double cut_wall_at(const struct cut_path *p, const struct cut_wall *w, double s_
     }
     return best > -HUGE_VAL ? best : (double)NAN;
 }
+
+double cut_wall_mean(const struct cut_path *p, const struct cut_wall *w, double s_mm,
+                     double half_mm, int n)
+{
+    double sum = 0;
+    for (int i = 0; i < n; i++) {
+        double s = n > 1 ? s_mm - half_mm + 2 * half_mm * i / (n - 1) : s_mm;
+        sum += cut_wall_at(p, w, s);
+    }
+    return sum / n;
+}

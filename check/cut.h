@@ -60,4 +60,10 @@ struct cut_wall {
  * axis) and at the instants the tool centre crosses the station between samples. */
 double cut_wall_at(const struct cut_path *p, const struct cut_wall *w, double s_mm);
 
+/* The mean of cut_wall_at() over n stations spread evenly across [s_mm - half_mm, s_mm +
+ * half_mm]: the wall's line read over a short length, as on a photograph, which averages the
+ * drives' step quantisation out of a single point. NAN if any station has no wall. */
+double cut_wall_mean(const struct cut_path *p, const struct cut_wall *w, double s_mm,
+                     double half_mm, int n);
+
 #endif
