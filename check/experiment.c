@@ -199,10 +199,10 @@ static int run_plots(const char *dir, const struct exp_run_def *d, const struct 
         sx[k] = st[k], sy[k] = cut_wall_at(a, w, st[k]);
     struct svg_series s[6] = {
         { "programmed contour", cs, cu, 2, 0, "#d62728", 1, 0 },
-        { "reference line (30 mm from the edge)", rs, ru, 2, 0, "#7f7f7f", 1, 0 },
-        { "tool tip path, G141/G142", xy, xy + 1, na, 2, "#1f77b4", 0, 0 },
+        { "reference line", rs, ru, 2, 0, "#7f7f7f", 1, 0 },
+        { "tool tip, G141/G142", xy, xy + 1, na, 2, "#1f77b4", 0, 0 },
         { "wall, G141/G142", ws, wc, NW, 0, "#2ca02c", 0, 0 },
-        { "wall, G1 (tool centre on contour)", ws, wp, NW, 0, "#ff7f0e", 0, 0 },
+        { "wall, G1 (no compensation)", ws, wp, NW, 0, "#ff7f0e", 0, 0 },
         { "stations d1..d4", sx, sy, 4, 0, "#000000", 0, 1 },
     };
     char file[1200], title[160];

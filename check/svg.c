@@ -7,7 +7,7 @@
 #define W_PX 900.0           /* drawing size, px */
 #define H_PX 560.0
 #define LEFT_PX 90.0         /* margins: room for tick labels, axis labels and the legend */
-#define RIGHT_PX 230.0
+#define RIGHT_PX 250.0
 #define TOP_PX 50.0
 #define BOTTOM_PX 60.0
 
