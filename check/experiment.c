@@ -210,16 +210,30 @@ static int run_plots(const char *dir, const struct exp_run_def *d, const struct 
     struct svg_chart top = { title, "along the wall, s (mm)", "into the material, u (mm)", 1 };
     snprintf(file, sizeof file, "%s/exp_run%s_top.svg", dir, d->name);
     int rc = svg_write_chart(file, &top, s, 6);
-    for (int i = 0; i < NW; i++)   /* the wall in um beyond the contour */
-        wc[i] *= 1e3, wp[i] *= 1e3;
+    /* the wall in um beyond the contour, where it is fully formed (away from the ends) */
+    double len = fabs(d->part[1][1] - d->part[0][0]), s0 = 0.5 * st[0], s1 = 0.5 * (st[3] + len);
+    for (int i = 0; i < NW; i++) {
+        ws[i] = s0 + (s1 - s0) * i / (NW - 1);
+        wc[i] = 1e3 * cut_wall_at(a, w, ws[i]);
+    }
     for (int k = 0; k < 4; k++)
-        sy[k] *= 1e3;
-    struct svg_series s2[2] = { { "wall, G141/G142", ws, wc, NW, 0, "#2ca02c", 0, 0 },
-                                { "stations d1..d4", sx, sy, 4, 0, "#000000", 0, 1 } };
+        sy[k] = 1e3 * cut_wall_mean(a, w, st[k], EXP_WINDOW_MM, EXP_WINDOW_POINTS);
+    for (int i = 0; i < NW; i++) {   /* the same read over +-EXP_WINDOW_MM */
+        double sum = 0;
+        int m = 0;
+        for (int j = 0; j < NW; j++)
+            if (fabs(ws[j] - ws[i]) <= EXP_WINDOW_MM)
+                sum += wc[j], m++;
+        wp[i] = sum / m;
+    }
+    struct svg_series s2[3] = {
+        { "wall at single points", ws, wc, NW, 0, "#9ecf9e", 0, 0 },
+        { "wall read over +-1 mm", ws, wp, NW, 0, "#2ca02c", 0, 0 },
+        { "stations d1..d4 (+-1 mm)", sx, sy, 4, 0, "#000000", 0, 1 } };
     snprintf(title, sizeof title, "Run %s: compensated wall beyond the contour", d->name);
     struct svg_chart wall = { title, "along the wall, s (mm)", "wall - contour (um)", 0 };
     snprintf(file, sizeof file, "%s/exp_run%s_wall.svg", dir, d->name);
-    rc = rc ? rc : svg_write_chart(file, &wall, s2, 2);
+    rc = rc ? rc : svg_write_chart(file, &wall, s2, 3);
     free(xy);
     return rc;
 }
