@@ -119,6 +119,21 @@ START_TEST(test_leg_speed_over_drive_limit)
 }
 END_TEST
 
+START_TEST(test_leg_acceleration_over_drive_limit)
+{
+    struct check_result r;
+    ck_assert_int_eq(run("tests/check/tmu-weak-drive.ini", PAPER_PROG, NULL, &r),
+                     CHECK_ERR_VIOLATION);
+    const struct check_problem *p = find(&r, CHECK_LEG_ACCELERATION);
+    ck_assert(p->line == 10 || p->line == 11);
+    ck_assert(p->value > 50.0 && p->limit == 50.0);
+    ck_assert(strstr(p->message, "STEPGEN_MAXACCEL"));
+    for (size_t i = 0; i < r.nproblems; i++)   /* speeds are within every limit */
+        ck_assert_int_ne(r.problems[i].kind, CHECK_LEG_VELOCITY);
+    check_result_free(&r);
+}
+END_TEST
+
 START_TEST(test_near_singular_pose)
 {
     struct check_result r;
@@ -243,6 +258,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_unreachable_point);
     tcase_add_test(tc, test_leg_too_long_along_move);
     tcase_add_test(tc, test_leg_speed_over_drive_limit);
+    tcase_add_test(tc, test_leg_acceleration_over_drive_limit);
     tcase_add_test(tc, test_near_singular_pose);
     tcase_add_test(tc, test_interpreter_error);
     tcase_add_test(tc, test_json_and_exit_status);
