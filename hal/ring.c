@@ -50,12 +50,14 @@ void ring_spsc_free(struct ring_spsc *r)
 }
 
 /* The producer's next slot. The acquire load of tail pairs with the consumer's release in
- * ring_spsc_release: once we see the slot freed, the consumer has finished reading it. */
+ * ring_spsc_release: once we see the slot freed, the consumer has finished reading it. The
+ * consumer's cache line is read only when the last look at tail says the ring is full. */
 void *ring_spsc_claim(struct ring_spsc *r)
 {
     uint64_t head = atomic_load_explicit(&r->head, memory_order_relaxed);
-    uint64_t tail = atomic_load_explicit(&r->tail, memory_order_acquire);
-    if (head - tail > r->mask) {
+    if (head - r->tail_seen > r->mask)
+        r->tail_seen = atomic_load_explicit(&r->tail, memory_order_acquire);
+    if (head - r->tail_seen > r->mask) {
         /* Only the producer writes `dropped`, so a relaxed load-add-store is exact. */
         uint64_t d = atomic_load_explicit(&r->dropped, memory_order_relaxed);
         atomic_store_explicit(&r->dropped, d + 1, memory_order_relaxed);
@@ -83,12 +85,14 @@ bool ring_spsc_push(struct ring_spsc *r, const void *item)
     return true;
 }
 
-/* The consumer's oldest slot; acquire on head pairs with the producer's commit. */
+/* The consumer's oldest slot; acquire on head pairs with the producer's commit. The
+ * producer's line is read only when the last look at head says the ring is empty. */
 const void *ring_spsc_peek(struct ring_spsc *r)
 {
     uint64_t tail = atomic_load_explicit(&r->tail, memory_order_relaxed);
-    uint64_t head = atomic_load_explicit(&r->head, memory_order_acquire);
-    if (tail == head)
+    if (tail == r->head_seen)
+        r->head_seen = atomic_load_explicit(&r->head, memory_order_acquire);
+    if (tail == r->head_seen)
         return NULL;
     return r->slots + (size_t)(tail & r->mask) * r->slot_size;
 }

@@ -32,9 +32,11 @@ const char *ring_strerror(int status);
 /* Single producer, single consumer. */
 struct ring_spsc {
     _Atomic uint64_t head;          /* next position the producer fills (producer writes) */
-    char pad0[RING_CACHE_LINE - sizeof(uint64_t)];
+    uint64_t tail_seen;             /* producer's last look at tail: most pushes need no other */
+    char pad0[RING_CACHE_LINE - 2 * sizeof(uint64_t)];
     _Atomic uint64_t tail;          /* next position the consumer reads (consumer writes) */
-    char pad1[RING_CACHE_LINE - sizeof(uint64_t)];
+    uint64_t head_seen;             /* consumer's last look at head */
+    char pad1[RING_CACHE_LINE - 2 * sizeof(uint64_t)];
     _Atomic uint64_t dropped;       /* pushes refused because the ring was full */
     uint64_t mask;                  /* slots - 1 */
     size_t slot_size;               /* bytes per slot */

@@ -35,3 +35,4 @@ $(LCM_CHECK): tests/lcm/lcm_check.c $(LIBDIR)/libhexcnc.a | $(GEN_HDRS)
 	$(call say,TEST,$@)
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) $< $(LIBDIR)/libhexcnc.a $(LDLIBS) -o $@
 test: $(LCM_CHECK)
+BENCHES += bench_lcm
