@@ -98,6 +98,15 @@ void check_print_json(const struct check_result *r, FILE *f)
     fputs("]}\n", f);
 }
 
+/* How often a measure was taken, in words. */
+static void schedule(char *buf, size_t len, double every_s)
+{
+    if (every_s > 0)
+        snprintf(buf, len, "every %g ms and at each line change", every_s * 1e3);
+    else
+        snprintf(buf, len, "at every servo period");
+}
+
 /* Minutes and seconds for people. */
 static void print_duration(FILE *f, double s)
 {
@@ -115,13 +124,14 @@ void check_print_table(const struct check_result *r, FILE *f)
         print_duration(f, r->machining_time_s);
         fprintf(f, " (%ld servo periods of %.3f ms), path %.3f mm\n", r->periods,
                 r->servo_period_s * 1e3, r->length_mm);
+        char when[64];
+        schedule(when, sizeof when, r->deviation_every_s);
         fprintf(f, "deviation       %.4g um max (line %d), %.3g deg; tolerance %g um; "
-                "measured every %g ms and at each line change\n", r->max_deviation_mm * 1e3,
-                r->max_deviation_line, r->max_deviation_deg, r->kin_tol_mm * 1e3,
-                r->deviation_every_s * 1e3);
-        fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured every %.0f ms and "
-                "at each line change\n\n", r->max_condition, r->max_condition_line,
-                r->condition_limit, r->condition_every_s * 1e3);
+                "measured %s\n", r->max_deviation_mm * 1e3, r->max_deviation_line,
+                r->max_deviation_deg, r->kin_tol_mm * 1e3, when);
+        schedule(when, sizeof when, r->condition_every_s);
+        fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
+                r->max_condition, r->max_condition_line, r->condition_limit, when);
         fputs("leg   min mm     max mm     range mm         peak mm/s  limit   "
               "peak mm/s^2  limit\n", f);
         for (int i = 0; i < r->njoints; i++) {
