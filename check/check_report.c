@@ -77,6 +77,10 @@ void check_print_json(const struct check_result *r, FILE *f)
         json_num(f, l->limit_vel_mm_s);
         fputs(",\"limit_acc_mm_s2\":", f);
         json_num(f, l->limit_acc_mm_s2);
+        fputs(",\"limit_vel_key\":", f);
+        json_str(f, l->vel_key ? l->vel_key : "");
+        fputs(",\"limit_acc_key\":", f);
+        json_str(f, l->acc_key ? l->acc_key : "");
         fputc('}', f);
     }
     fputs("],\"problems\":[", f);

@@ -107,19 +107,50 @@ static void leg_problem(struct check_machine *mc, const struct canon_cmd *c, enu
     int over = L[worst] > kn->joint_max[worst];
     p.value = L[worst];
     p.limit = over ? kn->joint_max[worst] : kn->joint_min[worst];
-    snprintf(p.message, sizeof p.message, "%s X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f is out of "
+    snprintf(p.message, sizeof p.message, "%s X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f, out of "
              "reach: leg %d would be %.3f mm, %.3f mm %s its %s %.3f mm ([JOINT_%d] %s)",
-             k == CHECK_UNREACHABLE ? "the programmed point" : "the move passes through",
+             k == CHECK_UNREACHABLE ? "the programmed point is" : "the move passes through",
              pose[0], pose[1], pose[2], pose[3], pose[4], pose[5], worst + 1, L[worst], excess,
              over ? "above" : "below", over ? "maximum" : "minimum", p.limit, worst,
              over ? "MAX_LIMIT" : "MIN_LIMIT");
     check_add_problem(r, &p);
 }
 
+/* Largest amount by which any leg is beyond its range (<= 0 when all are within). */
+static double leg_excess(const struct kins *k, const double *L)
+{
+    double e = -HUGE_VAL;
+    for (int i = 0; i < k->njoints; i++)
+        e = fmax(e, fmax(L[i] - k->joint_max[i], k->joint_min[i] - L[i]));
+    return e;
+}
+
+/* Samples the inside of a move whose end is reachable; reports the worst pose beyond reach. */
+static void scan_move(struct check_machine *mc, const double from[KINS_POSE_DIM],
+                      const struct canon_cmd *c, struct check_result *r)
+{
+    double pose[KINS_POSE_DIM], L[KINS_MAX_JOINTS], wpose[KINS_POSE_DIM], wL[KINS_MAX_JOINTS];
+    double worst = -HUGE_VAL;
+    int n = move_samples(from, c);
+    for (int j = 1; j < n; j++) {
+        check_move_pose(from, c, (double)j / n, pose);
+        if (kins_inverse(mc->kins, pose, L) == KINS_OK)
+            continue;
+        double e = leg_excess(mc->kins, L);
+        if (e > worst) {
+            worst = e;
+            memcpy(wpose, pose, sizeof wpose);
+            memcpy(wL, L, sizeof wL);
+        }
+    }
+    if (worst > -HUGE_VAL)     /* one report per move, at its worst pose */
+        leg_problem(mc, c, CHECK_LEG_RANGE, wpose, wL, r);
+}
+
 int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r)
 {
-    double from[KINS_POSE_DIM], pose[KINS_POSE_DIM], L[KINS_MAX_JOINTS];
+    double from[KINS_POSE_DIM], L[KINS_MAX_JOINTS];
     size_t before = r->nproblems;
     memcpy(from, prog->start, sizeof from);
     for (size_t k = 0; k < prog->count; k++) {
@@ -128,16 +159,8 @@ int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
             continue;
         if (kins_inverse(mc->kins, c->end, L) != KINS_OK)
             leg_problem(mc, c, CHECK_UNREACHABLE, c->end, L, r);
-        else {
-            int n = move_samples(from, c);
-            for (int j = 1; j < n; j++) {
-                check_move_pose(from, c, (double)j / n, pose);
-                if (kins_inverse(mc->kins, pose, L) != KINS_OK) {
-                    leg_problem(mc, c, CHECK_LEG_RANGE, pose, L, r);
-                    break;     /* one report per move: the first place it leaves the range */
-                }
-            }
-        }
+        else
+            scan_move(mc, from, c, r);
         memcpy(from, c->end, sizeof from);
     }
     return (int)(r->nproblems - before);
