@@ -112,6 +112,29 @@ static int cycle_words(struct interp *in, int g, int first)
     return 0;
 }
 
+/* R above the bottom, and a bounded number of pecks. */
+static int cycle_check(struct interp *in, const struct cycle *c, int reps)
+{
+    if (c->r < c->bottom)
+        return interp_fail(in, INTERP_ERR_CYCLE, W('r') ? W('r') : in->blk.gcol[1], "R (retract "
+                           "plane, %g) is below Z (hole bottom, %g)", c->r, c->bottom);
+    if ((c->g == 730 || c->g == 830) && (c->r - c->bottom) / c->q * reps > CYCLE_MAX_PECKS)
+        return interp_fail(in, INTERP_ERR_CYCLE, W('q'), "Q (peck depth) %g is too small for "
+                           "%d hole(s) %g deep (more than %d pecks)", c->q, reps,
+                           c->r - c->bottom, CYCLE_MAX_PECKS);
+    return 0;
+}
+
+/* Exact path during the cycle (its corners must be sharp), and back after it. */
+static int path_mode(struct interp *in, int mode, double tol_mm)
+{
+    struct canon_cmd pm;
+    interp_cmd_init(in, &pm, CANON_PATH_MODE);
+    pm.ivalue = mode;
+    pm.value = tol_mm;
+    return interp_emit(in, &pm);
+}
+
 /* A drilling cycle block: LinuxCNC's CYCLE_MACRO, one hole per repeat. */
 int interp_cycle(struct interp *in, int g)
 {
@@ -132,11 +155,14 @@ int interp_cycle(struct interp *in, int g)
     }
     double cur[6], ai = 0, bi = 0;
     interp_prog_pos(in, cur);
+    /* The Z a series of cycle blocks started from (LinuxCNC's "initial level"): G98 returns
+     * there and G91 R counts from it, until a motion that is not a cycle ends the series. */
+    if (!in->cycle_il_on) {
+        in->cycle_il = cur[AX_Z];
+        in->cycle_il_on = 1;
+    }
+    double old_z = in->cycle_il, cur_z = cur[AX_Z];
     struct cycle c = {.g = g, .q = in->cycle_q, .p_s = in->cycle_p};
-    double old_z = cur[AX_Z];
-    /* cur comes back from machine coordinates: within rounding of R is at R */
-    if (fabs(old_z - in->cycle_r) <= 1e-9 * fmax(1.0, fabs(in->cycle_r)) && !in->incremental)
-        old_z = in->cycle_r;
     if (in->incremental) {
         ai = W('x') ? V('x') : 0;
         bi = W('y') ? V('y') : 0;
@@ -150,41 +176,29 @@ int interp_cycle(struct interp *in, int g)
         c.r = in->cycle_r;
         c.bottom = in->cycle_z;
     }
-    if (c.r < c.bottom)
-        return interp_fail(in, INTERP_ERR_CYCLE, W('r') ? W('r') : in->blk.gcol[1], "R (retract "
-                           "plane, %g) is below Z (hole bottom, %g)", c.r, c.bottom);
-    if ((g == 730 || g == 830) && (c.r - c.bottom) / c.q * reps > CYCLE_MAX_PECKS)
-        return interp_fail(in, INTERP_ERR_CYCLE, W('q'), "Q (peck depth) %g is too small for "
-                           "%d hole(s) %g deep (more than %d pecks)", c.q, reps, c.r - c.bottom,
-                           CYCLE_MAX_PECKS);
+    /* cur comes back from machine coordinates: within rounding of R is at R */
+    if (fabs(cur_z - c.r) <= 1e-9 * fmax(1.0, fabs(c.r)))
+        cur_z = c.r;
+    CHP(cycle_check(in, &c, reps));
     in->cycle_mode = g;
-    int restore = in->path_mode != 610;
-    if (old_z < c.r) {
+    if (old_z < c.r) { /* below R: straight up to it first */
         CHP(cyc_move(in, CANON_TRAVERSE, cur[AX_X], cur[AX_Y], c.r));
-        old_z = c.r;
+        old_z = cur_z = c.r;
     }
     c.clear = in->retract_old_z ? old_z : c.r;
-    if (restore) {
-        struct canon_cmd pm;
-        interp_cmd_init(in, &pm, CANON_PATH_MODE);
-        pm.ivalue = 610;
-        CHP(interp_emit(in, &pm));
-    }
+    int restore = in->path_mode != 610;
+    if (restore)
+        CHP(path_mode(in, 610, 0.0));
     for (int i = 0; i < reps; i++) {
         c.x += ai;
         c.y += bi;
-        CHP(cyc_move(in, CANON_TRAVERSE, c.x, c.y, old_z));
-        if (old_z != c.r)
+        double over = i == 0 && cur_z > c.r ? cur_z : c.clear; /* level of the rapid over */
+        CHP(cyc_move(in, CANON_TRAVERSE, c.x, c.y, over));
+        if (over > c.r)
             CHP(cyc_move(in, CANON_TRAVERSE, c.x, c.y, c.r));
         CHP(cycle_hole(in, &c));
-        old_z = c.clear;
     }
-    if (restore) {
-        struct canon_cmd pm;
-        interp_cmd_init(in, &pm, CANON_PATH_MODE);
-        pm.ivalue = in->path_mode;
-        pm.value = in->path_tol_mm;
-        CHP(interp_emit(in, &pm));
-    }
+    if (restore)
+        CHP(path_mode(in, in->path_mode, in->path_tol_mm));
     return 0;
 }

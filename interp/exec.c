@@ -249,7 +249,7 @@ static int exec_motion(struct interp *in)
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
         if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
-            in->cycle_mode = 0;
+            in->cycle_mode = in->cycle_il_on = 0;
     }
     if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || b->g[8] == 431)
         return 0; /* those blocks' axis words are not motion */

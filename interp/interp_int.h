@@ -86,6 +86,8 @@ struct interp {
     double f_word;               /* F as programmed (for printers) */
     double cycle_r, cycle_q, cycle_p, cycle_z; /* sticky canned cycle words, program units */
     int cycle_mode;              /* the cycle (x10) whose words are sticky, 0 = none */
+    int cycle_il_on;             /* a series of cycle blocks is going on */
+    double cycle_il;             /* the Z (program units) that series started from */
     int current_tool, selected_tool;
     int spindle_dir;             /* 1, -1, 0 */
     double spindle_rpm;

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """gen_mix.py: writes random programs mixing moves, arcs, offsets, units and cycles (mixSEED.ngc).
 
-Used once to make the mix*.ngc programs of this folder, whose .out files LinuxCNC's rs274 -g
-printed; with rs274 installed it serves to compare many more: python3 gen_mix.py 1000 1200
-then run tests/interp_expected.sh with REGEN=1 in a scratch copy of the folder."""
+Used once to make the mix*.ngc and cyc*.ngc programs of this folder, whose .out files
+LinuxCNC's rs274 -g printed; with rs274 installed it serves to compare many more:
+python3 gen_mix.py [--cycles] FIRST_SEED LAST_SEED, then run tests/interp_expected.sh with
+REGEN=1 in a scratch copy of the folder."""
 import random
 import sys
 
@@ -66,6 +67,31 @@ def block():
             'X%s' % num(-20, 20), 'G80']
 
 
+def cycle_block():
+    """A drilling cycle in G90 or G91, G98 or G99, often followed by a second hole, no G80."""
+    cyc = random.choice(['G81', 'G82 P0.5', 'G83 Q%s' % num(0.5, 3), 'G73 Q%s' % num(0.5, 3),
+                         'G85', 'G89 P1'])
+    lines = ['%s G%d %s X%s Y%s Z%s R%s L%d' % (random.choice(['G90', 'G91', '']),
+                                               random.choice([98, 99]), cyc, num(-20, 20),
+                                               num(-20, 20), num(-10, -1), num(-3, 5),
+                                               random.randint(1, 3))]
+    if random.random() < 0.5:
+        lines.append('X%s' % num(-20, 20))
+    return lines
+
+
+def cycle_program(seed):
+    """Cycles back to back (the series LinuxCNC keeps an initial level for), G80 now and then."""
+    random.seed(seed)
+    lines = ['(generated drilling cycles back to back, seed %d)' % seed,
+             'G21 G90 G17 G94', 'G0 X0 Y0 Z10 F300']
+    for _ in range(30):
+        r = random.random()
+        lines += (cycle_block() if r < 0.5 else ['G80'] if r < 0.6 else
+                  ['G90 G0 Z%s' % num(-5, 30)] if r < 0.7 else block())
+    return '\n'.join(lines + ['M2']) + '\n'
+
+
 def program(seed):
     random.seed(seed)
     lines = ['(generated mix of moves, arcs, offsets, units and cycles, seed %d)' % seed,
@@ -76,7 +102,8 @@ def program(seed):
 
 
 if __name__ == '__main__':
-    first, last = int(sys.argv[1]), int(sys.argv[2])
+    cycles = sys.argv[1] == '--cycles'
+    first, last = int(sys.argv[1 + cycles]), int(sys.argv[2 + cycles])
     for seed in range(first, last):
-        with open('mix%d.ngc' % seed, 'w') as f:
-            f.write(program(seed))
+        with open('%s%d.ngc' % ('cyc' if cycles else 'mix', seed), 'w') as f:
+            f.write(cycle_program(seed) if cycles else program(seed))
