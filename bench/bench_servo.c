@@ -1,0 +1,164 @@
+/* bench_servo.c: cost of one servo period of the simulated TMU hexapod, and the simulated
+ * clock's speed-up over real time on the paper's programs. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "hal/hal.h"
+#include "task/runner.h"
+
+#define BARE_PERIODS 2000000L   /* periods of the empty-thread baseline */
+#define FWD_SOLVES 20000        /* forward solves per cold/warm measurement */
+
+/* The paper's programs (10) and (11) with G141 and G142, as printed (F2 = 2 m/min). */
+static const char *const bench_programs[] = {
+    "G141 X50 Y-80 Z630 A0 B-4 W10 F2\nG141 X50 Y-20 Z630 A0 B-4\nM2\n",
+    "G141 X50 Y-30 Z630 A0 B-4 W5 F2\nG141 X50 Y20 Z630 A0 B-4\nM2\n",
+    "G142 X50 Y-80 Z630 A0 B-4 W10 F2\nG142 X50 Y-20 Z630 A0 B-4\nM2\n",
+    "G142 X50 Y-30 Z630 A0 B-4 W5 F2\nG142 X50 Y20 Z630 A0 B-4\nM2\n",
+};
+#define NPROG (sizeof bench_programs / sizeof bench_programs[0])
+
+/* Leg feedback of a run, kept for the forward-kinematics measurement. */
+struct legs_log {
+    double (*legs)[KINS_MAX_JOINTS];
+    int n, cap, njoints;
+};
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* Observer: every 50th period's leg feedback. */
+static void log_legs(void *ctx, const struct runner_sample *s)
+{
+    struct legs_log *l = ctx;
+    if (l->n >= l->cap || (s->time_ns / 1000000) % 50)
+        return;
+    l->njoints = s->njoints;
+    memcpy(l->legs[l->n++], s->joint_fb_mm, (size_t)s->njoints * sizeof(double));
+}
+
+/* Runs the paper's programs on a fresh machine; returns wall seconds, machine seconds and
+ * periods through the pointers. with_monitor = 0 takes the runner's monitor off the thread
+ * (the config's own functs only). */
+static int run_paper(const char *ini, int with_monitor, struct legs_log *log, double *wall_s,
+                     double *machine_s, long *periods)
+{
+    struct runner_opts o = { ini, RUNNER_CLOCK_SIM };
+    struct runner *r;
+    char err[1024], path[256];
+    if (runner_create(&o, &r, err, sizeof err) != RUNNER_OK) {
+        fprintf(stderr, "bench_servo: %s\n", err);
+        return -1;
+    }
+    if (!with_monitor)
+        hal_delf(runner_hal(r), "runner.monitor", NULL);
+    if (log)
+        runner_set_observer(r, log_legs, log);
+    *wall_s = *machine_s = 0.0;
+    *periods = 0;
+    for (size_t i = 0; i < NPROG; i++) {
+        snprintf(path, sizeof path, "/tmp/bench_servo_%d_%zu.ngc", (int)getpid(), i);
+        FILE *f = fopen(path, "w");
+        if (!f)
+            return -1;
+        fputs(bench_programs[i], f);
+        fclose(f);
+        int st = runner_load_program(r, path, err, sizeof err);
+        remove(path);
+        struct motion_plan_info pi;
+        if (st || runner_plan_info(r, &pi) || runner_start(r, err, sizeof err)) {
+            fprintf(stderr, "bench_servo: %s\n", err);
+            runner_destroy(r);
+            return -1;
+        }
+        /* Exactly the planned time plus a few periods, so both variants run the same
+         * number of periods (runner_finished needs the monitor). */
+        long n = (long)(pi.time_s * 1000.0) + 5;
+        double t0 = now_s();
+        runner_advance(r, (double)n * 1e-3);
+        *wall_s += now_s() - t0;
+        *machine_s += (double)n * 1e-3;
+        *periods += n;
+    }
+    runner_destroy(r);
+    return 0;
+}
+
+/* The bare thread: the same periods with no functs at all (the runtime's own cost). */
+static double bare_thread_us(void)
+{
+    struct hal *h = hal_create();
+    hal_set_sim_clock(h, true);
+    if (!h || hal_thread_new(h, "servo-thread", 1000000) || hal_start(h))
+        return -1.0;
+    double t0 = now_s();
+    for (long i = 0; i < BARE_PERIODS / 1000; i++)
+        hal_sim_advance(h, 1000L * 1000000L);
+    double us = (now_s() - t0) * 1e6 / (double)BARE_PERIODS;
+    hal_destroy(h);
+    return us;
+}
+
+/* Forward kinematics of the logged legs: cold start (home pose) vs warm start (the previous
+ * solution, as the kins funct does inside the period). */
+static void bench_forward(const char *ini, const struct legs_log *log)
+{
+    struct runner_opts o = { ini, RUNNER_CLOCK_SIM };
+    struct runner *r;
+    char err[1024];
+    if (log->n < 2 || runner_create(&o, &r, err, sizeof err) != RUNNER_OK)
+        return;
+    struct kins *k = runner_kins(r);
+    double pose[KINS_POSE_DIM];
+    int fails = 0;
+    double t0 = now_s();
+    for (int i = 0; i < FWD_SOLVES; i++) {
+        memcpy(pose, k->home, sizeof pose);
+        fails += kins_forward(k, log->legs[i % log->n], pose, NULL) != KINS_OK;
+    }
+    double cold_us = (now_s() - t0) * 1e6 / FWD_SOLVES;
+    memcpy(pose, k->home, sizeof pose);
+    t0 = now_s();
+    for (int i = 0; i < FWD_SOLVES; i++)
+        fails += kins_forward(k, log->legs[i % log->n], pose, NULL) != KINS_OK;
+    double warm_us = (now_s() - t0) * 1e6 / FWD_SOLVES;
+    printf("forward kinematics per solve: cold start %.3f us, warm start %.3f us "
+           "(warm/cold %.2f)%s\n", cold_us, warm_us, warm_us / cold_us,
+           fails ? " (some solves failed)" : "");
+    runner_destroy(r);
+}
+
+int main(void)
+{
+    static char ini[1024];
+    const char *root = getenv("HEXCNC_ROOT");
+    snprintf(ini, sizeof ini, "%s/configs/sim/tmu-hexapod.ini", root ? root : ".");
+    static double legs[4096][KINS_MAX_JOINTS];
+    struct legs_log log = { legs, 0, 4096, 0 };
+    double wall_s, machine_s, wall2_s, machine2_s;
+    long periods, periods2;
+    if (run_paper(ini, 1, &log, &wall_s, &machine_s, &periods) ||
+        run_paper(ini, 0, NULL, &wall2_s, &machine2_s, &periods2))
+        return 1;
+    double bare_us = bare_thread_us();
+    double full_us = wall_s * 1e6 / (double)periods;
+    double cfg_us = wall2_s * 1e6 / (double)periods2;
+    printf("paper programs (10) and (11), G141 and G142: %ld servo periods of 1 ms\n", periods);
+    printf("servo period, sim config (motion + stepgen + kins.forward + e-stop): %.3f us "
+           "(target <= 5 us)\n", cfg_us);
+    printf("servo period with the run monitor of hexcnc run:                  %.3f us\n",
+           full_us);
+    printf("bare thread, no functs (baseline):                                %.3f us "
+           "(config / bare %.1fx)\n", bare_us, cfg_us / bare_us);
+    printf("simulated clock: %.3f s of machine time in %.4f s: %.0fx real time "
+           "(target >= 1000x)\n", machine_s, wall_s, machine_s / wall_s);
+    bench_forward(ini, &log);
+    return 0;
+}

@@ -1,0 +1,5 @@
+# task/: the runner behind `hexcnc run`: INI + HAL files, interpret and plan the whole
+# program, run it on the servo thread, watch every period, summarise.
+LIB_SRCS += task/runner.c task/runner_exec.c
+TESTS += test_e2e
+BENCHES += bench_servo

@@ -1,0 +1,265 @@
+/* runner.c: sets a machine up from its INI and HAL files, and interprets and plans a program. */
+#include "task/runner_priv.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interp/interp.h"
+#include "interp/tooltable.h"
+#include "motion/motion_hal.h"
+
+static const char *const runner_msgs[RUNNER_STATUS_COUNT] = {
+    [RUNNER_OK] = "ok",
+    [RUNNER_ERR_NOMEM] = "out of memory",
+    [RUNNER_ERR_CONFIG] = "the machine configuration (INI file) is wrong",
+    [RUNNER_ERR_HAL] = "a HAL file failed",
+    [RUNNER_ERR_PROGRAM] = "the program has an error",
+    [RUNNER_ERR_PLAN] = "the program cannot run on this machine",
+    [RUNNER_ERR_STATE] = "not possible in the machine's present state",
+    [RUNNER_ERR_RT] = "the servo thread could not be started",
+    [RUNNER_ERR_FAULT] = "the machine stopped on a fault",
+    [RUNNER_ERR_ABORTED] = "the program was stopped by the operator",
+    [RUNNER_ERR_TIMEOUT] = "the machine did not finish the program in time",
+};
+
+/* The text of a status. */
+const char *runner_strerror(int status)
+{
+    if (status < 0 || status >= RUNNER_STATUS_COUNT)
+        return "unknown runner status";
+    return runner_msgs[status];
+}
+
+int runner_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+/* A path from the INI, made relative to the INI's folder unless absolute. */
+static void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len)
+{
+    const char *dir = hal_ini_dir(r->hal);
+    if (value[0] == '/' || !dir || !dir[0])
+        snprintf(out, len, "%s", value);
+    else
+        snprintf(out, len, "%s/%s", dir, value);
+}
+
+/* Clock choice and servo period from the options and [EMCMOT]. */
+static int runner_read_timing(struct runner *r, const struct runner_opts *opts, char *err,
+                              size_t errlen)
+{
+    long sim = 0, period = 1000000;
+    if (hal_ini_int(r->hal, "EMCMOT", "SIM_CLOCK", 0, &sim) == HAL_ERR_SYNTAX ||
+        hal_ini_int(r->hal, "EMCMOT", "SERVO_PERIOD", 1000000, &period) == HAL_ERR_SYNTAX)
+        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
+    if (period <= 0)
+        return runner_fail(err, errlen, RUNNER_ERR_CONFIG,
+                           "%s: [EMCMOT] SERVO_PERIOD must be a positive number of ns",
+                           opts->ini_path);
+    r->period_ns = period;
+    r->sim_clock = opts->clock == RUNNER_CLOCK_SIM ||
+                   (opts->clock == RUNNER_CLOCK_INI && sim == 1);
+    hal_set_sim_clock(r->hal, r->sim_clock);
+    return RUNNER_OK;
+}
+
+/* The task's pins, created before the HAL files so that they can wire the e-stop chain. */
+static int runner_task_pins(struct runner *r, char *err, size_t errlen)
+{
+    struct hal *h = r->hal;
+    if (hal_pin_bit_newf(h, HAL_OUT, &r->user_enable_out, "task.user-enable-out") ||
+        hal_pin_bit_newf(h, HAL_OUT, &r->user_request_enable, "task.user-request-enable") ||
+        hal_pin_bit_newf(h, HAL_IN, &r->emc_enable_in, "task.emc-enable-in"))
+        return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(h));
+    return RUNNER_OK;
+}
+
+/* Runs every [HAL] HALFILE in order; the first error names its file and line. */
+static int runner_load_halfiles(struct runner *r, const char *ini_path, char *err,
+                                size_t errlen)
+{
+    const char *name = hal_ini_get_n(r->hal, "HAL", "HALFILE", 0);
+    if (!name)
+        return runner_fail(err, errlen, RUNNER_ERR_CONFIG,
+                           "%s: no [HAL] HALFILE: the machine has no HAL wiring", ini_path);
+    for (int n = 0; (name = hal_ini_get_n(r->hal, "HAL", "HALFILE", n)); n++) {
+        char path[1024];
+        runner_ini_path(r, name, path, sizeof path);
+        if (hal_source(r->hal, path) != HAL_OK)
+            return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(r->hal));
+    }
+    return RUNNER_OK;
+}
+
+/* Finds the kinematics, motion and the leg pins the HAL files created. */
+static int runner_bind(struct runner *r, const char *ini_path, char *err, size_t errlen)
+{
+    r->kins = hal_get_object(r->hal, "kins");
+    r->motion = motion_hal_get(r->hal);
+    if (!r->kins || !r->motion)
+        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s: the HAL files load no %s "
+                           "(they need `loadrt [KINS]KINEMATICS` and `loadrt motion`)",
+                           ini_path, r->kins ? "motion" : "kinematics");
+    r->njoints = r->kins->njoints;
+    for (int i = 0; i < r->njoints; i++) {
+        char name[64];
+        enum hal_type t;
+        snprintf(name, sizeof name, "motion.joint-pos-cmd-%d", i);
+        r->cmd_pin[i] = hal_data_ptr(r->hal, name, &t);
+        if (!r->cmd_pin[i] || t != HAL_FLOAT)
+            return runner_fail(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
+        snprintf(name, sizeof name, "motion.joint-pos-fb-%d", i);
+        r->fb_pin[i] = hal_data_ptr(r->hal, name, &t);
+        if (!r->fb_pin[i] || t != HAL_FLOAT)
+            return runner_fail(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
+    }
+    const char *open = hal_ini_get(r->hal, "DISPLAY", "OPEN_FILE");
+    if (open && open[0])
+        runner_ini_path(r, open, r->default_program, sizeof r->default_program);
+    return RUNNER_OK;
+}
+
+int runner_create(const struct runner_opts *opts, struct runner **out, char *err,
+                  size_t errlen)
+{
+    *out = NULL;
+    struct runner *r = calloc(1, sizeof *r);
+    if (!r || !(r->hal = hal_create())) {
+        free(r);
+        return runner_fail(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
+    }
+    int st;
+    if (hal_load_ini(r->hal, opts->ini_path) != HAL_OK) {
+        st = runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
+        goto fail;
+    }
+    if ((st = runner_read_timing(r, opts, err, errlen)) ||
+        (st = runner_task_pins(r, err, errlen)) ||
+        (st = runner_load_halfiles(r, opts->ini_path, err, errlen)) ||
+        (st = runner_bind(r, opts->ini_path, err, errlen)) ||
+        (st = runner_monitor_install(r, err, errlen)))
+        goto fail;
+    *out = r;
+    return RUNNER_OK;
+fail:
+    runner_destroy(r);
+    return st;
+}
+
+void runner_destroy(struct runner *r)
+{
+    if (!r)
+        return;
+    hal_destroy(r->hal);  /* stops the threads first */
+    free(r);
+}
+
+struct hal *runner_hal(struct runner *r) { return r->hal; }
+struct kins *runner_kins(struct runner *r) { return r->kins; }
+struct motion *runner_motion(struct runner *r) { return r->motion; }
+bool runner_sim_clock(const struct runner *r) { return r->sim_clock; }
+
+const char *runner_default_program(const struct runner *r)
+{
+    return r->default_program[0] ? r->default_program : NULL;
+}
+
+/* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE to the interpreter. */
+static int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt,
+                               char *err, size_t errlen)
+{
+    const char *ini = hal_ini_path(r->hal);
+    const char *units = hal_ini_get(r->hal, "RS274NGC", "FEED_UNITS");
+    double factor = 1.0;
+    if (units && interp_feed_units_parse(units, &factor) != 0)
+        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s: [RS274NGC] FEED_UNITS = %s: "
+                           "expected mm/min or m/min", ini, units);
+    interp_set_feed_factor(in, factor);
+    char path[1024];
+    const char *table = hal_ini_get(r->hal, "RS274NGC", "TOOL_TABLE");
+    if (table && table[0]) {
+        runner_ini_path(r, table, path, sizeof path);
+        char msg[512];
+        if (tooltable_load(tt, path, msg, sizeof msg) != TOOLTABLE_OK)
+            return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", msg);
+        interp_set_tooltable(in, tt);
+    }
+    const char *params = hal_ini_get(r->hal, "RS274NGC", "PARAMETER_FILE");
+    if (params && params[0]) {
+        runner_ini_path(r, params, path, sizeof path);
+        if (interp_set_param_file(in, path) != INTERP_OK) {
+            char msg[600];
+            return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s",
+                               interp_error_format(interp_last_error(in), msg, sizeof msg));
+        }
+    }
+    return RUNNER_OK;
+}
+
+/* Interprets the whole program into prog, starting from the machine's present pose. */
+static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
+                            char *err, size_t errlen)
+{
+    struct interp *in = interp_create();
+    struct tooltable *tt = malloc(sizeof *tt);
+    int st = RUNNER_ERR_NOMEM;
+    if (!in || !tt) {
+        runner_fail(err, errlen, st, "out of memory");
+        goto out;
+    }
+    tooltable_init(tt);
+    double start[KINS_POSE_DIM];
+    motion_hal_pose(r->hal, start);
+    interp_set_start(in, start);
+    memcpy(prog->start, start, sizeof start);
+    if ((st = runner_setup_interp(r, in, tt, err, errlen)))
+        goto out;
+    if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {
+        char msg[600];
+        st = runner_fail(err, errlen, RUNNER_ERR_PROGRAM, "%s",
+                         interp_error_format(interp_last_error(in), msg, sizeof msg));
+        goto out;
+    }
+    st = RUNNER_OK;
+out:
+    interp_destroy(in);
+    free(tt);
+    return st;
+}
+
+int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen)
+{
+    if (runner_moving(r))
+        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+    struct canon_prog prog;
+    canon_prog_init(&prog);
+    r->loaded = false;
+    int st = runner_interpret(r, path, &prog, err, errlen);
+    if (st == RUNNER_OK) {
+        char msg[512];
+        if (motion_hal_load(r->hal, &prog, msg, sizeof msg) != MOTION_OK)
+            st = runner_fail(err, errlen, RUNNER_ERR_PLAN, "%s", msg);
+        else if (motion_plan_info(r->motion, &r->plan) != MOTION_OK)
+            st = runner_fail(err, errlen, RUNNER_ERR_PLAN, "%s", motion_hal_fault(r->hal));
+    }
+    canon_prog_free(&prog);
+    r->loaded = st == RUNNER_OK;
+    return st;
+}
+
+int runner_plan_info(const struct runner *r, struct motion_plan_info *out)
+{
+    if (!r->loaded)
+        return RUNNER_ERR_STATE;
+    *out = r->plan;
+    return RUNNER_OK;
+}

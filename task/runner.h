@@ -1,0 +1,146 @@
+/* runner.h: runs a program on a machine described by an INI file (the task layer). */
+#ifndef HEXCNC_TASK_RUNNER_H
+#define HEXCNC_TASK_RUNNER_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "kins/kins.h"
+#include "motion/motion.h"
+
+/*
+ * What `hexcnc run` does, as a library so that tests and benchmarks drive the same code:
+ *
+ *   runner_create(&opts, &r, err, len)    INI, HAL runtime, HAL files in [HAL] HALFILE order
+ *   runner_load_program(r, path, ...)     interprets the WHOLE program, then plans it: any
+ *                                         error (file:line) comes here, before any motion
+ *   runner_start(r, ...)                  starts the threads and the program
+ *   runner_run(r, &stop, progress, ctx, ..) runs to the end (or a fault, or *stop: the
+ *                                         controlled stop of Ctrl-C)
+ *   runner_summary(r, &s)                 machine time, distance, peaks, final pose
+ *   runner_destroy(r)
+ *
+ * A monitor funct (`runner.monitor`, last on the servo thread) samples every period: leg
+ * commands and feedback, leg rates, following error, the program line. Tests can add an
+ * observer that sees every period.
+ */
+
+enum runner_status {
+    RUNNER_OK = 0,
+    RUNNER_ERR_NOMEM,        /* allocation failed */
+    RUNNER_ERR_CONFIG,       /* the INI file is missing or a key in it is wrong */
+    RUNNER_ERR_HAL,          /* a HAL file failed (the message names file and line) */
+    RUNNER_ERR_PROGRAM,      /* the interpreter refused the program (file:line: what) */
+    RUNNER_ERR_PLAN,         /* the program cannot run: unreachable pose, leg limits */
+    RUNNER_ERR_STATE,        /* not allowed now (start without a program, ...) */
+    RUNNER_ERR_RT,           /* the threads could not be started */
+    RUNNER_ERR_FAULT,        /* the machine faulted while running (following error, e-stop) */
+    RUNNER_ERR_ABORTED,      /* the operator stopped the program (Ctrl-C) */
+    RUNNER_ERR_TIMEOUT,      /* the machine did not finish in twice the planned time */
+    RUNNER_STATUS_COUNT
+};
+const char *runner_strerror(int status);
+
+/* Which clock drives the servo thread. */
+enum runner_clock {
+    RUNNER_CLOCK_INI = 0,    /* [EMCMOT] SIM_CLOCK decides (1 = simulated, else real time) */
+    RUNNER_CLOCK_SIM,        /* simulated: exact machine time, as fast as the CPU allows */
+    RUNNER_CLOCK_REALTIME,   /* paced on the wall clock */
+};
+
+struct runner_opts {
+    const char *ini_path;    /* the machine's INI file */
+    enum runner_clock clock;
+};
+
+/* One servo period as the monitor saw it (for observers). */
+struct runner_sample {
+    int64_t time_ns;                         /* machine time at the end of the period */
+    int njoints;
+    const double *joint_cmd_mm;              /* leg commands, [njoints] */
+    const double *joint_fb_mm;               /* leg feedback, [njoints] */
+    const double *joint_rate_mm_s;           /* commanded leg rates, [njoints] */
+    int line;                                /* program line being executed (0 before) */
+    enum motion_state state;
+};
+typedef void (*runner_observer_fn)(void *ctx, const struct runner_sample *s);
+
+/* Where the program is, for progress displays. */
+struct runner_progress {
+    enum motion_state state;
+    int line;                /* program line being executed */
+    const char *file;        /* its file (NULL before the first move) */
+    double elapsed_s;        /* machine time since start */
+    double remaining_s;      /* from the plan */
+    double percent;          /* of the planned path length (of the time when no length) */
+};
+
+/* What a run did. */
+struct runner_summary {
+    double machine_time_s;                   /* from start to the end of motion */
+    double planned_time_s;                   /* what the planner said it would take */
+    double distance_mm;                      /* XYZ path length covered */
+    long periods;                            /* servo periods run */
+    int njoints;
+    double peak_rate_mm_s[KINS_MAX_JOINTS];  /* largest |commanded leg rate| per leg */
+    double max_ferror_mm[KINS_MAX_JOINTS];   /* largest |command - feedback| per leg */
+    double leg_min_mm[KINS_MAX_JOINTS];      /* shortest commanded leg length seen */
+    double leg_max_mm[KINS_MAX_JOINTS];      /* longest commanded leg length seen */
+    double final_legs_mm[KINS_MAX_JOINTS];   /* leg feedback at the end */
+    double final_pose[KINS_POSE_DIM];        /* forward kinematics of the final feedback */
+    int final_pose_ok;                       /* 0 when the forward solve failed */
+    enum motion_state state;                 /* DONE, IDLE (after a stop), FAULT */
+};
+
+struct runner;
+
+/* Reads the INI, creates the HAL runtime and loads the HAL files. On failure err says
+ * which file, which line and what is wrong. */
+int runner_create(const struct runner_opts *opts, struct runner **out, char *err,
+                  size_t errlen);
+void runner_destroy(struct runner *r);
+
+/* The runtime, the kinematics and the motion instance of the machine (borrowed). */
+struct hal *runner_hal(struct runner *r);
+struct kins *runner_kins(struct runner *r);
+struct motion *runner_motion(struct runner *r);
+/* Whether the servo thread runs on the simulated clock. */
+bool runner_sim_clock(const struct runner *r);
+
+/* The program [DISPLAY] OPEN_FILE names (resolved against the INI's folder), or NULL. */
+const char *runner_default_program(const struct runner *r);
+
+/* Interprets the whole program (with [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE)
+ * and plans it. Nothing moves; on failure err holds "file:line: what". */
+int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen);
+/* The plan of the loaded program. */
+int runner_plan_info(const struct runner *r, struct motion_plan_info *out);
+
+/* Sets the observer called after every servo period (NULL to remove). */
+void runner_set_observer(struct runner *r, runner_observer_fn fn, void *ctx);
+
+/* Starts the threads and the loaded program. */
+int runner_start(struct runner *r, char *err, size_t errlen);
+/* Runs the machine for dt_s of machine time (simulated) or wall time (real time). */
+int runner_advance(struct runner *r, double dt_s);
+/* Asks for the controlled stop: decelerate along the path, then drop the program. */
+int runner_abort(struct runner *r);
+/* Whether the machine has come to rest for good (done, stopped, faulted). */
+bool runner_finished(const struct runner *r);
+int runner_get_progress(const struct runner *r, struct runner_progress *p);
+
+/* Called by runner_run after every slice of the run (10 servo periods of machine time on
+ * the simulated clock, about 20 ms in real time) and once at the end: displays throttle. */
+typedef void (*runner_progress_fn)(void *ctx, const struct runner_progress *p);
+/* Runs until the machine is finished. *stop (may be NULL), set by a signal handler,
+ * requests the controlled stop. Returns RUNNER_OK when the program ended, RUNNER_ERR_ABORTED
+ * after a stop, RUNNER_ERR_FAULT after a fault; err then says why (leg, amount, line). */
+int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progress_fn fn,
+               void *ctx, char *err, size_t errlen);
+
+/* What the run did (valid during and after it). */
+int runner_summary(struct runner *r, struct runner_summary *s);
+
+#endif

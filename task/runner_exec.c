@@ -1,0 +1,230 @@
+/* runner_exec.c: runs a planned program: start, the per-period monitor, stop, summary. */
+#include "task/runner_priv.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "motion/motion_hal.h"
+
+/* Slice of machine time between checks of the stop flag and progress calls. */
+#define RUNNER_SLICE_PERIODS 10
+#define RUNNER_RT_SLICE_S 0.02
+
+/* States in which the program is under way (the clock of the run is ticking). */
+static bool runner_state_active(enum motion_state s)
+{
+    return s == MOTION_RUNNING || s == MOTION_PAUSING || s == MOTION_PAUSED ||
+           s == MOTION_STOPPING;
+}
+
+bool runner_moving(const struct runner *r)
+{
+    return runner_state_active(motion_get_state(r->motion));
+}
+
+/* The monitor funct, last on the servo thread: it sees each period's leg commands and
+ * feedback after the drives have acted, and keeps the peaks for the summary. */
+static void runner_monitor(void *arg, long period_ns)
+{
+    struct runner *r = arg;
+    double dt_s = (double)period_ns * 1e-9;
+    double cmd[KINS_MAX_JOINTS], fb[KINS_MAX_JOINTS];
+    motion_hal_out(r->hal, &r->last);
+    enum motion_state state = r->last.state;
+    bool active = runner_state_active(state);
+    struct runner_summary *s = &r->sum;
+    for (int i = 0; i < r->njoints; i++) {
+        cmd[i] = *r->cmd_pin[i];
+        fb[i] = *r->fb_pin[i];
+        r->rate_mm_s[i] = r->have_prev ? (cmd[i] - r->prev_cmd_mm[i]) / dt_s : 0.0;
+        r->prev_cmd_mm[i] = cmd[i];
+        if (!r->started)
+            continue;
+        s->max_ferror_mm[i] = fmax(s->max_ferror_mm[i], fabs(cmd[i] - fb[i]));
+        s->leg_min_mm[i] = fmin(s->leg_min_mm[i], cmd[i]);
+        s->leg_max_mm[i] = fmax(s->leg_max_mm[i], cmd[i]);
+        if (active)
+            s->peak_rate_mm_s[i] = fmax(s->peak_rate_mm_s[i], fabs(r->rate_mm_s[i]));
+    }
+    r->have_prev = true;
+    /* The e-stop reset request lasts one period: the latch has seen its rising edge. */
+    *r->user_request_enable = false;
+    if (r->started && active)
+        r->running_periods++;
+    if (r->observer) {
+        struct runner_sample smp = {
+            .time_ns = hal_now_ns(r->hal), .njoints = r->njoints, .joint_cmd_mm = cmd,
+            .joint_fb_mm = fb, .joint_rate_mm_s = r->rate_mm_s, .line = r->last.line,
+            .state = state,
+        };
+        r->observer(r->observer_ctx, &smp);
+    }
+    atomic_store(&r->mon_line, r->last.line);
+    atomic_store(&r->mon_state, (int)state);
+    atomic_fetch_add(&r->mon_periods, 1);
+}
+
+int runner_monitor_install(struct runner *r, char *err, size_t errlen)
+{
+    snprintf(r->thread, sizeof r->thread, "servo-thread");
+    if (hal_export_functf(r->hal, runner_monitor, r, "runner.monitor") != HAL_OK ||
+        hal_addf(r->hal, "runner.monitor", r->thread, 0) != HAL_OK)
+        return runner_fail(err, errlen, RUNNER_ERR_HAL, "the run monitor cannot join the "
+                           "servo thread: %s", hal_last_error(r->hal));
+    return RUNNER_OK;
+}
+
+void runner_set_observer(struct runner *r, runner_observer_fn fn, void *ctx)
+{
+    r->observer = fn;
+    r->observer_ctx = ctx;
+}
+
+/* Clears the peaks before a run. */
+static void runner_reset_summary(struct runner *r)
+{
+    memset(&r->sum, 0, sizeof r->sum);
+    r->sum.njoints = r->njoints;
+    for (int i = 0; i < r->njoints; i++) {
+        r->sum.leg_min_mm[i] = INFINITY;
+        r->sum.leg_max_mm[i] = -INFINITY;
+    }
+    r->running_periods = 0;
+    atomic_store(&r->mon_periods, 0);
+}
+
+int runner_start(struct runner *r, char *err, size_t errlen)
+{
+    if (!r->loaded)
+        return runner_fail(err, errlen, RUNNER_ERR_STATE, "no program is loaded");
+    if (runner_moving(r))
+        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+    runner_reset_summary(r);
+    r->aborting = false;
+    /* Machine on: out of e-stop (reset pulse to the latch), then enabled. */
+    *r->user_enable_out = true;
+    if (!*r->emc_enable_in)
+        *r->user_request_enable = true;
+    if (motion_hal_start(r->hal) != MOTION_OK)
+        return runner_fail(err, errlen, RUNNER_ERR_STATE, "%s", motion_hal_fault(r->hal));
+    atomic_store(&r->mon_state, (int)MOTION_RUNNING);
+    r->started = true;
+    if (!hal_running(r->hal) && hal_start(r->hal) != HAL_OK) {
+        r->started = false;
+        return runner_fail(err, errlen, RUNNER_ERR_RT, "%s", hal_last_error(r->hal));
+    }
+    return RUNNER_OK;
+}
+
+int runner_advance(struct runner *r, double dt_s)
+{
+    if (r->sim_clock)
+        return hal_sim_advance(r->hal, (long)llround(dt_s * 1e9)) == HAL_OK ? RUNNER_OK
+                                                                           : RUNNER_ERR_RT;
+    struct timespec ts = { (time_t)dt_s, (long)((dt_s - floor(dt_s)) * 1e9) };
+    nanosleep(&ts, NULL);
+    return RUNNER_OK;
+}
+
+int runner_abort(struct runner *r)
+{
+    if (!r->started)
+        return RUNNER_ERR_STATE;
+    r->aborting = true;
+    return motion_hal_abort(r->hal) == MOTION_OK ? RUNNER_OK : RUNNER_ERR_STATE;
+}
+
+bool runner_finished(const struct runner *r)
+{
+    if (!r->started)
+        return false;
+    enum motion_state s = (enum motion_state)atomic_load(&r->mon_state);
+    return s == MOTION_DONE || s == MOTION_FAULT || (r->aborting && s == MOTION_IDLE);
+}
+
+int runner_get_progress(const struct runner *r, struct runner_progress *p)
+{
+    memset(p, 0, sizeof *p);
+    p->state = (enum motion_state)atomic_load(&r->mon_state);
+    p->line = atomic_load(&r->mon_line);
+    p->file = r->last.file;
+    p->elapsed_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
+    p->remaining_s = fmax(0.0, r->plan.time_s - p->elapsed_s);
+    if (r->plan.length_mm > 0.0)
+        p->percent = 100.0 * r->last.distance_done_mm / r->plan.length_mm;
+    else if (r->plan.time_s > 0.0)
+        p->percent = 100.0 * fmin(1.0, p->elapsed_s / r->plan.time_s);
+    if (p->state == MOTION_DONE)
+        p->percent = 100.0;
+    return RUNNER_OK;
+}
+
+/* How the run ended, as a status and a message. */
+static int runner_outcome(struct runner *r, char *err, size_t errlen)
+{
+    enum motion_state s = (enum motion_state)atomic_load(&r->mon_state);
+    double t_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
+    if (s == MOTION_FAULT)
+        return runner_fail(err, errlen, RUNNER_ERR_FAULT, "%s", motion_hal_fault(r->hal));
+    if (r->aborting)
+        return runner_fail(err, errlen, RUNNER_ERR_ABORTED, "stopped by the operator at line "
+                           "%d after %.3f s: the machine came to rest on the path",
+                           atomic_load(&r->mon_line), t_s);
+    return RUNNER_OK;
+}
+
+int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progress_fn fn,
+               void *ctx, char *err, size_t errlen)
+{
+    if (!r->started)
+        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the program is not started");
+    double slice_s = r->sim_clock ? RUNNER_SLICE_PERIODS * (double)r->period_ns * 1e-9
+                                  : RUNNER_RT_SLICE_S;
+    /* A program that overruns its plan by this much is stuck: stop rather than hang. */
+    double limit_s = 2.0 * r->plan.time_s + 10.0;
+    struct runner_progress p;
+    int st = RUNNER_OK;
+    while (!runner_finished(r)) {
+        if (stop && *stop && !r->aborting)
+            runner_abort(r);
+        if ((st = runner_advance(r, slice_s)) != RUNNER_OK) {
+            runner_fail(err, errlen, st, "%s", hal_last_error(r->hal));
+            break;
+        }
+        runner_get_progress(r, &p);
+        if (fn)
+            fn(ctx, &p);
+        if (p.elapsed_s > limit_s) {
+            st = runner_fail(err, errlen, RUNNER_ERR_TIMEOUT, "the machine was still moving "
+                             "after %.1f s, twice the planned %.1f s", p.elapsed_s,
+                             r->plan.time_s);
+            break;
+        }
+    }
+    if (!r->sim_clock)
+        hal_stop(r->hal);
+    if (st == RUNNER_OK)
+        st = runner_outcome(r, err, errlen);
+    runner_get_progress(r, &p);
+    if (fn)
+        fn(ctx, &p);
+    return st;
+}
+
+int runner_summary(struct runner *r, struct runner_summary *s)
+{
+    *s = r->sum;
+    s->njoints = r->njoints;
+    s->machine_time_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
+    s->planned_time_s = r->plan.time_s;
+    s->distance_mm = r->last.distance_done_mm;
+    s->periods = atomic_load(&r->mon_periods);
+    s->state = (enum motion_state)atomic_load(&r->mon_state);
+    for (int i = 0; i < r->njoints; i++)
+        s->final_legs_mm[i] = *r->fb_pin[i];
+    /* Forward kinematics of the final feedback, warm-started at the commanded pose. */
+    memcpy(s->final_pose, r->last.pose, sizeof s->final_pose);
+    s->final_pose_ok = kins_forward(r->kins, s->final_legs_mm, s->final_pose, NULL) == KINS_OK;
+    return RUNNER_OK;
+}

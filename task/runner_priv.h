@@ -1,0 +1,61 @@
+/* runner_priv.h: the runner's state, shared by runner.c (setup) and runner_exec.c (running). */
+#ifndef HEXCNC_TASK_RUNNER_PRIV_H
+#define HEXCNC_TASK_RUNNER_PRIV_H
+
+#include <stdatomic.h>
+
+#include "hal/hal.h"
+#include "task/runner.h"
+
+/* The machine, the program and what the monitor has seen. */
+struct runner {
+    struct hal *hal;                    /* the runtime (owns kins and motion) */
+    struct kins *kins;                  /* the machine's kinematics (HAL object "kins") */
+    struct motion *motion;              /* the motion instance (HAL object "motion") */
+    int njoints;                        /* legs */
+    bool sim_clock;                     /* simulated clock, else real time */
+    long period_ns;                     /* [EMCMOT] SERVO_PERIOD */
+    char thread[32];                    /* the thread the monitor runs on */
+    char default_program[1024];         /* [DISPLAY] OPEN_FILE, resolved; "" when none */
+    bool loaded;                        /* a program is planned */
+    bool started;                       /* runner_start succeeded */
+    bool aborting;                      /* runner_abort was called */
+    struct motion_plan_info plan;       /* the loaded program's plan */
+
+    /* The task's own pins, as LinuxCNC's iocontrol: the HAL files wire them to the e-stop
+     * chain. user-enable-out is the operator's "machine on"; user-request-enable pulses for
+     * one period to reset the latch; emc-enable-in reports the chain. */
+    bool *user_enable_out;              /* out: task.user-enable-out */
+    bool *user_request_enable;          /* out: task.user-request-enable (one-period pulse) */
+    bool *emc_enable_in;                /* in: task.emc-enable-in */
+
+    /* Pin data the monitor reads (the signals' storage once the HAL files are loaded). */
+    const double *cmd_pin[KINS_MAX_JOINTS];  /* motion.joint-pos-cmd-N, mm */
+    const double *fb_pin[KINS_MAX_JOINTS];   /* motion.joint-pos-fb-N, mm */
+
+    /* Written by the monitor funct (servo thread), read by the caller. */
+    double prev_cmd_mm[KINS_MAX_JOINTS];     /* last period's leg commands */
+    double rate_mm_s[KINS_MAX_JOINTS];       /* this period's commanded leg rates */
+    bool have_prev;                          /* prev_cmd_mm is valid */
+    struct runner_summary sum;               /* peaks and extremes so far */
+    _Atomic long running_periods;            /* periods since the program started moving */
+    _Atomic int mon_state;                   /* enum motion_state after the last period */
+    _Atomic int mon_line;                    /* program line after the last period */
+    _Atomic long mon_periods;                /* periods run since start */
+    struct motion_out last;                  /* motion's output after the last period */
+
+    runner_observer_fn observer;             /* called every period (may be NULL) */
+    void *observer_ctx;
+};
+
+/* Registers the monitor funct and adds it last on the servo thread (runner_exec.c). */
+int runner_monitor_install(struct runner *r, char *err, size_t errlen);
+
+/* Whether the motion core is under way (running, pausing, paused, stopping). */
+bool runner_moving(const struct runner *r);
+
+/* printf into err (when given) and return status. */
+int runner_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+#endif
