@@ -9,3 +9,16 @@ TESTS += test_modbus test_modbus_faults test_modbus_hal test_modbus_e2e
 # Simulated CiA 402 drives on CANopen.
 LIB_SRCS += sim/cia402_sim.c sim/cia402_sim_od.c sim/cia402_sim_hal.c
 HAL_COMPS += cia402_sim
+
+# `make run`: the simulated TMU hexapod on the paper's programs, each started the way a
+# machinist starts it (scripts/hexcnc-start): program (10) with the 20 mm tool and program
+# (11) with the 10 mm tool, with G141 and with G142, then path 1 with both tools in one
+# program, radii from the tool table. Each prints its plan, progress and summary.
+SIM_RUN_PROGRAMS := prog10_g141_d20 prog11_g141_d10 prog10_g142_d20 prog11_g142_d10 \
+                    path1_tooltable
+run: all
+	@for p in $(SIM_RUN_PROGRAMS); do \
+	    echo; echo "== examples/paper/$$p.ngc"; \
+	    $(RUN_ENV) sh scripts/hexcnc-start configs/sim/tmu-hexapod.ini \
+	        examples/paper/$$p.ngc || exit $$?; \
+	done
