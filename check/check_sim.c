@@ -214,6 +214,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         s.line = out.line, s.file = out.file;
         if (out.state == MOTION_DONE || out.state == MOTION_FAULT || st != MOTION_OK)
             break;
+        if (out.state == MOTION_PAUSED)   /* M0/M1: the operator would press resume */
+            motion_resume(mc->motion);
     }
     r->machining_time_s = out.time_elapsed_s;
     r->length_mm = out.distance_total_mm;

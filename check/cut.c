@@ -131,6 +131,9 @@ int cut_simulate(struct check_machine *mc, const struct canon_prog *prog, struct
     }
     memcpy(pose, prog->start, sizeof pose);
     struct motion_out out;
+    struct motion_plan_info info;
+    motion_plan_info(mc->motion, &info);
+    long left = (long)(2 * info.time_s / mc->mcfg.servo_period_s) + 1000; /* a stuck plan */
     int settle = 0;
     do {
         if ((st = machine_period(mc, sg, lim, &out, pose, err, errlen)))
@@ -143,8 +146,14 @@ int cut_simulate(struct check_machine *mc, const struct canon_prog *prog, struct
             st = CHECK_ERR_VIOLATION;
             break;
         }
+        if (out.state == MOTION_PAUSED)   /* M0/M1: the operator would press resume */
+            motion_resume(mc->motion);
         settle += out.state == MOTION_DONE;
-    } while (settle < SETTLE_PERIODS);
+    } while (settle < SETTLE_PERIODS && --left > 0);
+    if (st == CHECK_OK && left <= 0) {
+        snprintf(err, errlen, "motion did not finish in twice the planned time");
+        st = CHECK_ERR_VIOLATION;
+    }
     path->machining_time_s = out.time_elapsed_s;
     free(radii);
     return st;
