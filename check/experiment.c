@@ -174,6 +174,42 @@ static void wall_coords(const struct cut_wall *w, const double p[3], double *s, 
     *u = d[0] * w->n[0] + d[1] * w->n[1] + d[2] * w->n[2];
 }
 
+/* Isometric view of a workpiece-frame point: (x - y) cos 30, z + (x + y) sin 30. */
+static void iso(const double p[3], double *u, double *v)
+{
+    *u = (p[0] - p[1]) * cos(M_PI / 6);
+    *v = p[2] + (p[0] + p[1]) * sin(M_PI / 6);
+}
+
+/* The tool tip's path over the workpiece and the programmed contour, in an isometric view. */
+static int iso_plot(const char *dir, const struct exp_run_def *d, const struct cut_wall *w,
+                    const struct cut_path *a)
+{
+    size_t n = a->n ? a->n : 1;
+    double *uv = malloc(2 * n * sizeof *uv), cu[2], cv[2], e[3];
+    if (!uv)
+        return -1;
+    for (size_t k = 0; k < a->n; k++)
+        iso(a->s[k].tip, &uv[2 * k], &uv[2 * k + 1]);
+    double len = fabs(d->part[1][1] - d->part[0][0]);
+    for (int i = 0; i < 3; i++)
+        e[i] = w->origin[i] + len * w->t[i];
+    iso(w->origin, &cu[0], &cv[0]);
+    iso(e, &cu[1], &cv[1]);
+    struct svg_series s[2] = {
+        { "tool tip (actual path)", uv, uv + 1, a->n, 2, "#1f77b4", 0, 0 },
+        { "programmed contour", cu, cv, 2, 0, "#d62728", 1, 0 },
+    };
+    char file[1200], title[160];
+    snprintf(title, sizeof title, "Run %s: tool tip over the workpiece, isometric", d->name);
+    struct svg_chart c = { title, "(x - y) cos 30 deg, workpiece frame (mm)",
+                           "z + (x + y) sin 30 deg (mm)", 1 };
+    snprintf(file, sizeof file, "%s/exp_run%s_3d.svg", dir, d->name);
+    int rc = svg_write_chart(file, &c, s, 2);
+    free(uv);
+    return rc;
+}
+
 static int run_plots(const char *dir, const struct exp_run_def *d, const struct cut_wall *w,
                      const struct cut_path *a, const struct cut_path *b, const double st[4])
 {
@@ -206,10 +242,11 @@ static int run_plots(const char *dir, const struct exp_run_def *d, const struct 
         { "stations d1..d4", sx, sy, 4, 0, "#000000", 0, 1 },
     };
     char file[1200], title[160];
+    int rc = iso_plot(dir, d, w, a);
     snprintf(title, sizeof title, "Run %s: wall seen from above (workpiece frame)", d->name);
     struct svg_chart top = { title, "along the wall, s (mm)", "into the material, u (mm)", 1 };
     snprintf(file, sizeof file, "%s/exp_run%s_top.svg", dir, d->name);
-    int rc = svg_write_chart(file, &top, s, 6);
+    rc = rc ? rc : svg_write_chart(file, &top, s, 6);
     /* the wall in um beyond the contour, where it is fully formed (away from the ends) */
     double len = fabs(d->part[1][1] - d->part[0][0]), s0 = 0.5 * st[0], s1 = 0.5 * (st[3] + len);
     for (int i = 0; i < NW; i++) {

@@ -53,7 +53,7 @@ struct exp_result {
 };
 
 /* Runs one experiment from the source tree root (the programs' folder is relative to it).
- * plot_dir (may be NULL) receives exp_run<name>_top.svg and exp_run<name>_wall.svg. */
+ * plot_dir (may be NULL) receives exp_run<name>_top.svg, _wall.svg and _3d.svg. */
 int exp_run(const char *root, const struct exp_run_def *def, const char *plot_dir,
             struct exp_result *res, char *err, size_t errlen);
 

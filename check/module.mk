@@ -9,6 +9,12 @@ EXP_BIN := $(BUILD)/check/hexcnc-experiment
 $(EXP_BIN): check/experiment_main.c $(LIBDIR)/libhexcnc.a
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBDIR)/libhexcnc.a $(LDLIBS) -o $@
+EXP_PROGS := run1_g141:1 run2_g141:1 run3_g141:2 run4_g141:2 run1_g142:1
 experiment: all $(EXP_BIN)
 	@mkdir -p $(BUILD)/experiment
 	@$(RUN_ENV) $(EXP_BIN) $(BUILD)/experiment
+	@for r in $(EXP_PROGS); do n=$${r%%:*}; p=$${r##*:}; mkdir -p $(BUILD)/experiment/$$n; \
+	  $(RUN_ENV) $(HEXCNC) check --plot $(BUILD)/experiment/$$n \
+	    examples/paper/experiment/tmu-path$$p.ini examples/paper/experiment/$$n.ngc \
+	    > $(BUILD)/experiment/$$n/check.txt || { cat $(BUILD)/experiment/$$n/check.txt; exit 1; }; \
+	done; echo "hexcnc check of each program (table and plots): $(BUILD)/experiment/run*/"
