@@ -160,6 +160,7 @@ void runner_destroy(struct runner *r)
     if (!r)
         return;
     hal_destroy(r->hal);  /* stops the threads first */
+    interp_destroy(r->interp);
     free(r);
 }
 
@@ -209,7 +210,8 @@ static int runner_setup_interp(struct runner *r, struct interp *in, struct toolt
 static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
                             char *err, size_t errlen)
 {
-    struct interp *in = interp_create();
+    interp_destroy(r->interp);  /* the previous program's plan is being replaced */
+    struct interp *in = r->interp = interp_create();
     struct tooltable *tt = malloc(sizeof *tt);
     int st = RUNNER_ERR_NOMEM;
     if (!in || !tt) {
@@ -231,7 +233,8 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     }
     st = RUNNER_OK;
 out:
-    interp_destroy(in);
+    if (in)
+        interp_set_tooltable(in, NULL);  /* the table goes; the interpreter stays */
     free(tt);
     return st;
 }

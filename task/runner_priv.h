@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 
 #include "hal/hal.h"
+#include "interp/interp.h"
 #include "task/runner.h"
 
 /* The machine, the program and what the monitor has seen. */
@@ -21,6 +22,9 @@ struct runner {
     bool started;                       /* runner_start succeeded */
     bool aborting;                      /* runner_abort was called */
     struct motion_plan_info plan;       /* the loaded program's plan */
+    struct interp *interp;              /* the interpreter of the loaded program: it owns the
+                                         * file names the plan's moves point at, so it lives
+                                         * until the next program or runner_destroy */
 
     /* The task's own pins, as LinuxCNC's iocontrol: the HAL files wire them to the e-stop
      * chain. user-enable-out is the operator's "machine on"; user-request-enable pulses for

@@ -304,6 +304,51 @@ START_TEST(test_abort_controlled)
 }
 END_TEST
 
+/* A leg that cannot keep up (its stepgen limited to 5 mm/s) trips the following-error
+ * check: the run ends in a fault that names the leg, the amount and the program line. */
+START_TEST(test_following_error_fault)
+{
+    struct watch w;
+    struct runner *r = make_runner(&w);
+    char err[1024];
+    ck_assert_int_eq(runner_load_program(r, paper("prog10_g141_d20.ngc"), err, sizeof err),
+                     RUNNER_OK);
+    ck_assert_int_eq(hal_setp(runner_hal(r), "stepgen.3.maxvel", "5"), HAL_OK);
+    ck_assert_int_eq(runner_start(r, err, sizeof err), RUNNER_OK);
+    ck_assert_int_eq(runner_run(r, NULL, NULL, NULL, err, sizeof err), RUNNER_ERR_FAULT);
+    ck_assert_msg(strstr(err, "following error") && strstr(err, "[JOINT_3]") &&
+                  strstr(err, "prog10_g141_d20.ngc:"), "message: %s", err);
+    struct runner_summary s;
+    runner_summary(r, &s);
+    ck_assert_int_eq(s.state, MOTION_FAULT);
+    ck_assert(s.machine_time_s < s.planned_time_s);
+    runner_destroy(r);
+}
+END_TEST
+
+/* The e-stop chain: a fault on the latch stops motion and the stepgens at once. */
+START_TEST(test_estop_fault)
+{
+    struct watch w;
+    struct runner *r = make_runner(&w);
+    char err[1024];
+    ck_assert_int_eq(runner_load_program(r, paper("prog10_g141_d20.ngc"), err, sizeof err),
+                     RUNNER_OK);
+    ck_assert_int_eq(runner_start(r, err, sizeof err), RUNNER_OK);
+    ck_assert_int_eq(runner_advance(r, 1.0), RUNNER_OK);
+    ck_assert_int_eq(hal_setp(runner_hal(r), "estop-latch.0.fault-in", "1"), HAL_OK);
+    ck_assert_int_eq(runner_run(r, NULL, NULL, NULL, err, sizeof err), RUNNER_ERR_FAULT);
+    ck_assert_msg(strstr(err, "emergency stop") != NULL, "message: %s", err);
+    struct runner_summary a, b;
+    runner_summary(r, &a);
+    ck_assert_int_eq(runner_advance(r, 0.5), RUNNER_OK);
+    runner_summary(r, &b);
+    for (int i = 0; i < a.njoints; i++)
+        ck_assert(a.final_legs_mm[i] == b.final_legs_mm[i]);  /* the legs stand still */
+    runner_destroy(r);
+}
+END_TEST
+
 static Suite *e2e_suite(void)
 {
     Suite *s = suite_create("e2e");
@@ -317,6 +362,8 @@ static Suite *e2e_suite(void)
     tcase_add_test(tc, test_malformed_refused);
     tcase_add_test(tc, test_hal_error_named);
     tcase_add_test(tc, test_abort_controlled);
+    tcase_add_test(tc, test_following_error_fault);
+    tcase_add_test(tc, test_estop_fault);
     suite_add_tcase(s, tc);
     return s;
 }

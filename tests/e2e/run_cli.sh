@@ -1,0 +1,67 @@
+#!/bin/sh
+# run_cli.sh: `hexcnc run` and scripts/hexcnc-start as a machinist uses them: the paper's
+# program to its end, refusals before any motion (exit 1 with file:line), Ctrl-C (exit 130).
+# Needs HEXCNC_ROOT and HEXCNC_BIN (make test sets them).
+set -u
+root=${HEXCNC_ROOT:-.}
+bin=${HEXCNC_BIN:-$root/bin/hexcnc}
+start="$root/scripts/hexcnc-start"
+ini="$root/configs/sim/tmu-hexapod.ini"
+tmp=$(mktemp -d /tmp/hexcnc-run-cli.XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+export HEXCNC_BIN="$bin"
+fails=0
+
+# check NAME CONDITION...: prints ok/FAIL for one expectation.
+check() {
+    name=$1; shift
+    if "$@"; then echo "ok   $name"; else echo "FAIL $name"; fails=$((fails + 1)); fi
+}
+has() { grep -q -- "$2" "$1"; }
+
+# 1. The paper's program (10) runs to its end on the simulated clock.
+sh "$start" "$ini" "$root/examples/paper/prog10_g141_d20.ngc" >"$tmp/out" 2>"$tmp/err"
+rc=$?
+check "program (10) exits 0" [ $rc -eq 0 ]
+check "summary printed" has "$tmp/out" "machine time"
+check "program finished" has "$tmp/out" "program finished"
+check "final pose at the compensated end point" has "$tmp/out" "X 59.97[56]"
+
+# 2. A missing INI file is refused by the script.
+sh "$start" "$tmp/none.ini" >"$tmp/out" 2>"$tmp/err"
+check "missing INI exits 1" [ $? -eq 1 ]
+check "missing INI named" has "$tmp/err" "cannot find the INI file"
+
+# 3. A malformed program: the interpreter's file:line, no motion, exit 1.
+printf 'G1 X10 Y0 Z640 F2\nG1 X1 Y=\nM2\n' >"$tmp/bad.ngc"
+"$bin" run "$ini" "$tmp/bad.ngc" >"$tmp/out" 2>"$tmp/err"
+check "malformed program exits 1" [ $? -eq 1 ]
+check "malformed program names file:line" has "$tmp/err" "bad.ngc:2"
+check "malformed program: no motion" has "$tmp/err" "did not move"
+
+# 4. A point out of reach is refused before motion, naming its line.
+printf 'G1 X0 Y0 Z645 F2\nG1 X10\nG1 X600\nM2\n' >"$tmp/far.ngc"
+"$bin" run "$ini" "$tmp/far.ngc" >"$tmp/out" 2>"$tmp/err"
+check "unreachable point exits 1" [ $? -eq 1 ]
+check "unreachable point names line 3" has "$tmp/err" "far.ngc:3"
+
+# 5. A HAL file error names the HAL file and line.
+printf 'loadrt stepgen count=6\nnet leg-0-cmd nosuch.pin\n' >"$tmp/broken.hal"
+sed "s|^HALFILE = .*|HALFILE = $tmp/broken.hal|" "$ini" >"$tmp/broken.ini"
+"$bin" run "$tmp/broken.ini" "$tmp/far.ngc" >"$tmp/out" 2>"$tmp/err"
+check "HAL error exits 1" [ $? -eq 1 ]
+check "HAL error names file:line" has "$tmp/err" "broken.hal:2"
+
+# 6. Ctrl-C on a real-time run: controlled stop, summary, exit 130.
+sh "$start" --realtime "$ini" "$root/examples/paper/prog10_g141_d20.ngc" >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+sleep 1
+kill -INT $pid
+wait $pid
+rc=$?
+check "Ctrl-C exits 130" [ $rc -eq 130 ]
+check "Ctrl-C says it stopped" has "$tmp/err" "interrupted"
+check "Ctrl-C still prints the summary" has "$tmp/out" "machine time"
+
+[ $fails -eq 0 ] || { echo "run_cli: $fails failed"; cat "$tmp/err"; exit 1; }
+echo "run_cli: all passed"
