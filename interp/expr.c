@@ -188,7 +188,9 @@ static int read_function(struct interp *in, int *pos, double *out)
             return interp_fail(in, INTERP_ERR_EXPR, col, "LN of %g: the value must be positive", a);
         *out = log(a);
         return 0;
-    case 9: *out = (double)(long long)(a + (a < 0 ? -0.5 : 0.5)); return 0;
+    case 9: /* to nearest, halves away from zero; no integer cast, any magnitude */
+        *out = a < 0 ? ceil(a - 0.5) : floor(a + 0.5);
+        return 0;
     case 10: *out = sin(a / DEG_PER_RAD); return 0;
     case 11:
         if (a < 0.0)

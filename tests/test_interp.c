@@ -114,6 +114,8 @@ START_TEST(expr_functions)
     ck_assert_double_eq(eval("[FUP[-2.5]]"), -2);
     ck_assert_double_eq(eval("[ROUND[2.5]]"), 3);
     ck_assert_double_eq(eval("[ROUND[-2.5]]"), -3);
+    ck_assert_double_eq(eval("[ROUND[1444444444444444444444444444444.5]]"), 1.4444444444444444e30);
+    ck_assert_double_eq(eval("[ROUND[-100000000000000000000]]"), -1e20); /* fuzzer find */
     ck_assert_double_eq(eval("sin[90]"), 1);
 }
 END_TEST
