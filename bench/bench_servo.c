@@ -21,6 +21,15 @@ static const char *const bench_programs[] = {
 };
 #define NPROG (sizeof bench_programs / sizeof bench_programs[0])
 
+/* CPU seconds of this thread: unlike wall time, not inflated when other processes share
+ * the cores (the simulated clock runs on this one thread). */
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
 /* Leg feedback of a run, kept for the forward-kinematics measurement. */
 struct legs_log {
     double (*legs)[KINS_MAX_JOINTS];
@@ -48,7 +57,7 @@ static void log_legs(void *ctx, const struct runner_sample *s)
  * periods through the pointers. with_monitor = 0 takes the runner's monitor off the thread
  * (the config's own functs only). */
 static int run_paper(const char *ini, int with_monitor, struct legs_log *log, double *wall_s,
-                     double *machine_s, long *periods)
+                     double *cpu_used_s, double *machine_s, long *periods)
 {
     struct runner_opts o = { ini, RUNNER_CLOCK_SIM };
     struct runner *r;
@@ -61,7 +70,7 @@ static int run_paper(const char *ini, int with_monitor, struct legs_log *log, do
         hal_delf(runner_hal(r), "runner.monitor", NULL);
     if (log)
         runner_set_observer(r, log_legs, log);
-    *wall_s = *machine_s = 0.0;
+    *wall_s = *cpu_used_s = *machine_s = 0.0;
     *periods = 0;
     for (size_t i = 0; i < NPROG; i++) {
         snprintf(path, sizeof path, "/tmp/bench_servo_%d_%zu.ngc", (int)getpid(), i);
@@ -81,14 +90,102 @@ static int run_paper(const char *ini, int with_monitor, struct legs_log *log, do
         /* Exactly the planned time plus a few periods, so both variants run the same
          * number of periods (runner_finished needs the monitor). */
         long n = (long)(pi.time_s * 1000.0) + 5;
-        double t0 = now_s();
+        double t0 = now_s(), c0 = cpu_s();
         runner_advance(r, (double)n * 1e-3);
         *wall_s += now_s() - t0;
+        *cpu_used_s += cpu_s() - c0;
         *machine_s += (double)n * 1e-3;
         *periods += n;
     }
     runner_destroy(r);
     return 0;
+}
+
+/* Per-funct cost: a time stamp funct between every two functs of the servo thread. */
+#define MAX_FUNCTS 16
+struct stamps {
+    double last_s;                    /* time of the previous stamp */
+    double acc_s[MAX_FUNCTS];         /* time spent in funct i, summed over the run */
+    char name[MAX_FUNCTS][64];        /* funct i's name */
+    int n;                            /* functs on the thread */
+};
+struct stamp_slot {
+    struct stamps *s;
+    int idx;                          /* the funct this stamp ends (-1: the first stamp) */
+};
+
+/* A stamp: charges the time since the previous stamp to the funct before it. */
+static void stamp(void *arg, long period_ns)
+{
+    struct stamp_slot *slot = arg;
+    double t = now_s();
+    if (slot->idx >= 0)
+        slot->s->acc_s[slot->idx] += t - slot->s->last_s;
+    slot->s->last_s = now_s();  /* the stamp's own cost is not charged to the next funct */
+}
+
+/* The names of the functs on servo-thread, in order, from `show thread`. */
+static int thread_functs(struct hal *h, struct stamps *st)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return -1;
+    hal_cmd(h, "show thread servo-thread", NULL, 0, f);
+    fclose(f);
+    st->n = 0;
+    for (char *line = strtok(buf, "\n"); line; line = strtok(NULL, "\n")) {
+        int k;
+        char name[64];
+        if (!strchr(line, '(') && sscanf(line, " %d %63s", &k, name) == 2 &&
+            st->n < MAX_FUNCTS)
+            snprintf(st->name[st->n++], sizeof st->name[0], "%s", name);
+    }
+    free(buf);
+    return st->n > 0 ? 0 : -1;
+}
+
+/* Runs program (10) with a stamp after every funct and prints each funct's mean cost. */
+static void bench_functs(const char *ini)
+{
+    struct runner_opts o = { ini, RUNNER_CLOCK_SIM };
+    struct runner *r;
+    char err[1024], path[256];
+    static struct stamps st;
+    static struct stamp_slot slots[MAX_FUNCTS + 1];
+    if (runner_create(&o, &r, err, sizeof err) != RUNNER_OK)
+        return;
+    struct hal *h = runner_hal(r);
+    if (thread_functs(h, &st)) {
+        runner_destroy(r);
+        return;
+    }
+    for (int i = 0; i <= st.n; i++) {
+        slots[i] = (struct stamp_slot){ &st, i - 1 };
+        hal_export_functf(h, stamp, &slots[i], "bench.stamp-%d", i);
+        char name[32];
+        snprintf(name, sizeof name, "bench.stamp-%d", i);
+        hal_addf(h, name, "servo-thread", 2 * i + 1);  /* before funct i (1-based 2i+2) */
+    }
+    snprintf(path, sizeof path, "/tmp/bench_servo_%d.ngc", (int)getpid());
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return;
+    fputs(bench_programs[0], f);
+    fclose(f);
+    struct motion_plan_info pi;
+    int bad = runner_load_program(r, path, err, sizeof err) || runner_plan_info(r, &pi) ||
+              runner_start(r, err, sizeof err);
+    remove(path);
+    if (!bad) {
+        long n = (long)(pi.time_s * 1000.0);
+        runner_advance(r, (double)n * 1e-3);
+        printf("per funct, program (10), %ld periods (time stamps between functs):\n", n);
+        for (int i = 0; i < st.n; i++)
+            printf("  %-16s %.3f us\n", st.name[i], st.acc_s[i] * 1e6 / (double)n);
+    }
+    runner_destroy(r);
 }
 
 /* The bare thread: the same periods with no functs at all (the runtime's own cost). */
@@ -135,6 +232,25 @@ static void bench_forward(const char *ini, const struct legs_log *log)
     runner_destroy(r);
 }
 
+/* The fastest of REPEATS runs of one variant (the machine is shared: the minimum is the
+ * figure least disturbed by other processes). */
+#define REPEATS 5
+static int best_of(const char *ini, int with_monitor, struct legs_log *log, double *wall_s,
+                   double *cpu_used_s, double *machine_s, long *periods)
+{
+    double best_wall = 1e30, best_cpu = 1e30;
+    for (int i = 0; i < REPEATS; i++) {
+        if (run_paper(ini, with_monitor, i == 0 ? log : NULL, wall_s, cpu_used_s, machine_s,
+                      periods))
+            return -1;
+        best_wall = *wall_s < best_wall ? *wall_s : best_wall;
+        best_cpu = *cpu_used_s < best_cpu ? *cpu_used_s : best_cpu;
+    }
+    *wall_s = best_wall;
+    *cpu_used_s = best_cpu;
+    return 0;
+}
+
 int main(void)
 {
     static char ini[1024];
@@ -142,23 +258,26 @@ int main(void)
     snprintf(ini, sizeof ini, "%s/configs/sim/tmu-hexapod.ini", root ? root : ".");
     static double legs[4096][KINS_MAX_JOINTS];
     struct legs_log log = { legs, 0, 4096, 0 };
-    double wall_s, machine_s, wall2_s, machine2_s;
+    double wall_s, cpu1_s, machine_s, wall2_s, cpu2_s, machine2_s;
     long periods, periods2;
-    if (run_paper(ini, 1, &log, &wall_s, &machine_s, &periods) ||
-        run_paper(ini, 0, NULL, &wall2_s, &machine2_s, &periods2))
+    if (best_of(ini, 1, &log, &wall_s, &cpu1_s, &machine_s, &periods) ||
+        best_of(ini, 0, NULL, &wall2_s, &cpu2_s, &machine2_s, &periods2))
         return 1;
     double bare_us = bare_thread_us();
-    double full_us = wall_s * 1e6 / (double)periods;
-    double cfg_us = wall2_s * 1e6 / (double)periods2;
-    printf("paper programs (10) and (11), G141 and G142: %ld servo periods of 1 ms\n", periods);
-    printf("servo period, sim config (motion + stepgen + kins.forward + e-stop): %.3f us "
-           "(target <= 5 us)\n", cfg_us);
-    printf("servo period with the run monitor of hexcnc run:                  %.3f us\n",
-           full_us);
-    printf("bare thread, no functs (baseline):                                %.3f us "
-           "(config / bare %.1fx)\n", bare_us, cfg_us / bare_us);
-    printf("simulated clock: %.3f s of machine time in %.4f s: %.0fx real time "
-           "(target >= 1000x)\n", machine_s, wall_s, machine_s / wall_s);
+    double p1 = (double)periods, p2 = (double)periods2;
+    printf("paper programs (10) and (11), G141 and G142: %ld servo periods of 1 ms, "
+           "best of %d runs; us per period, wall clock / CPU time of the thread\n",
+           periods, REPEATS);
+    printf("  sim config (e-stop + motion + stepgen + kins.forward): %.3f / %.3f us "
+           "(target <= 5 us)\n", wall2_s * 1e6 / p2, cpu2_s * 1e6 / p2);
+    printf("  the same with the run monitor of hexcnc run:          %.3f / %.3f us\n",
+           wall_s * 1e6 / p1, cpu1_s * 1e6 / p1);
+    printf("  bare thread, no functs (baseline, wall):              %.3f us "
+           "(config / bare %.0fx)\n", bare_us, wall2_s * 1e6 / p2 / bare_us);
+    printf("simulated clock, as hexcnc run: %.3f s of machine time in %.4f s wall "
+           "(%.4f s CPU): %.0fx real time (%.0fx per CPU second; target >= 1000x)\n",
+           machine_s, wall_s, cpu1_s, machine_s / wall_s, machine_s / cpu1_s);
     bench_forward(ini, &log);
+    bench_functs(ini);
     return 0;
 }
