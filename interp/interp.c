@@ -181,13 +181,16 @@ double interp_param(const struct interp *in, int n)
     return n >= 1 && n < INTERP_NPARAMS ? in->params[n] : 0.0;
 }
 
-/* Handles a lone '%': the first one opens the program, the next one ends it. */
+/* Handles a lone '%': one on the first line opens the program, the next one ends it. */
 static int percent_line(struct interp *in, int first)
 {
     if (first) {
         in->pct_open = 1;
         return 0;
     }
+    if (!in->pct_open)
+        return interp_fail(in, INTERP_ERR_SYNTAX, 1, "a '%%' line may only open the program (on "
+                           "its first line) and then close it");
     in->ended = 1;
     int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
     if (rc)

@@ -278,8 +278,8 @@ START_TEST(two_interpreters)
 {
     struct interp *a = interp_create(), *b = interp_create();
     struct canon_prog pa, pb;
-    ck_assert_int_eq(run_on(a, "G20 G10 L2 P1 X1\n%\n", &pa), 0);
-    ck_assert_int_eq(run_on(b, "G21 G91 G0 X1\n%\n", &pb), 0);
+    ck_assert_int_eq(run_on(a, "%\nG20 G10 L2 P1 X1\n%\n", &pa), 0);
+    ck_assert_int_eq(run_on(b, "%\nG21 G91 G0 X1\n%\n", &pb), 0);
     canon_prog_free(&pa);
     canon_prog_free(&pb);
     ck_assert_int_eq(run_on(a, "G0 X1\nM2\n", &pa), 0);
