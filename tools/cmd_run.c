@@ -112,10 +112,10 @@ static void run_print_summary(struct runner *r, const char *program, double wall
     if (runner_sim_clock(r) && wall_s > 0.0)
         printf(", simulated in %.3f s (%.0fx real time)", wall_s, s.machine_time_s / wall_s);
     printf("\n  path distance  %.3f mm\n", s.distance_mm);
-    printf("  leg  peak rate mm/s  max following error mm  length range mm\n");
+    printf("  leg            peak rate mm/s  max following error mm  length range mm\n");
     for (int i = 0; i < s.njoints; i++)
-        printf("  %-3d  %14.3f  %22.5f  %.3f .. %.3f\n", i, s.peak_rate_mm_s[i],
-               s.max_ferror_mm[i], s.leg_min_mm[i], s.leg_max_mm[i]);
+        printf("  %d ([JOINT_%d])  %14.3f  %22.5f  %.3f .. %.3f\n", i + 1, i,
+               s.peak_rate_mm_s[i], s.max_ferror_mm[i], s.leg_min_mm[i], s.leg_max_mm[i]);
     if (s.final_pose_ok)
         printf("  final pose     X %.4f  Y %.4f  Z %.4f  A %.4f  B %.4f  C %.4f\n",
                s.final_pose[0], s.final_pose[1], s.final_pose[2], s.final_pose[3],
