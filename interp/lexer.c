@@ -106,7 +106,7 @@ static int read_word(struct interp *in, int *pos)
 {
     struct interp_block *b = &in->blk;
     char c = in->norm[*pos];
-    int col = in->normcol[*pos];
+    int col = in->normcol[*pos], first = *pos == 0;
     if (c == 'o')
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
                            "O-words (subroutines, loops, conditions) are not supported yet");
@@ -134,11 +134,13 @@ static int read_word(struct interp *in, int *pos)
     if (c == 'm')
         return interp_add_m(in, v, col);
     if (c == 'n') {
-        if (b->n_present)
-            return interp_fail(in, INTERP_ERR_WORD, col, "two N words in one block");
+        if (!first)
+            return interp_fail(in, INTERP_ERR_WORD, col, "the N word (line number) must be the "
+                               "first word of the block");
         CHP(interp_to_int(in, v, col, "N line number", &b->n_number));
-        if (b->n_number < 0 || b->n_number > 99999)
-            return interp_fail(in, INTERP_ERR_WORD, col, "N line number out of range (0 to 99999)");
+        if (b->n_number < 0)
+            return interp_fail(in, INTERP_ERR_WORD, col, "negative N line number %d",
+                               b->n_number);
         b->n_present = 1;
         return 0;
     }
