@@ -8,9 +8,10 @@
 #define V(c) (in->blk.val[(c) - 'a'])
 
 /* LinuxCNC's check that both ends are on one circle: an error when the radii differ by more
- * than 0.02 mm (0.002 in) and 0.1 %, or by more than 100 times that absolute tolerance. */
-#define ARC_TOL_MM 0.02
-#define ARC_TOL_IN 0.002
+ * than 0.0283 mm (0.00283 in: a centre and ends rounded to 0.01 mm, 2 sqrt(2) 0.01) and by
+ * 0.1 %, or by more than 100 times that absolute tolerance. */
+#define ARC_TOL_MM (0.02 * M_SQRT2)
+#define ARC_TOL_IN (0.002 * M_SQRT2)
 #define ARC_REL_TOL 0.001
 
 /* The two in-plane axes (first, second, as LinuxCNC orders them), the normal axis and the

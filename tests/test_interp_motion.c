@@ -122,15 +122,16 @@ START_TEST(arc_radius_form_and_turns)
 }
 END_TEST
 
-/* LinuxCNC's tolerance: 0.02 mm absolute and 0.1 %; more is an error. */
+/* LinuxCNC's tolerance: 0.0283 mm (0.00283 in) absolute and 0.1 %, or 100 times the
+ * absolute one; more is an error. Each case was checked against rs274 -g. */
 START_TEST(arc_radius_mismatch)
 {
-    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.01 J0\nM2\n"), INTERP_OK);
-    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.02 J0\nM2\n"), INTERP_ERR_ARC);
-    /* large radius: 1.5 mm off at R 10000 is under 0.1 % but over 100 x 0.02 mm = 2 mm? no */
-    ck_assert_int_eq(status_of("G1 X20000 F1\nG2 X0 I-10000.75 J0\nM2\n"), INTERP_OK);
+    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.01 J0\nM2\n"), INTERP_OK);   /* 0.02 */
+    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.02 J0\nM2\n"), INTERP_ERR_ARC); /* 0.04 */
+    /* large radius: under 0.1 %, so only the 100 x 0.0283 = 2.83 mm bound applies */
+    ck_assert_int_eq(status_of("G1 X20000 F1\nG2 X0 I-10001.01 J0\nM2\n"), INTERP_OK);
     ck_assert_int_eq(status_of("G1 X20000 F1\nG2 X0 I-10001.5 J0\nM2\n"), INTERP_ERR_ARC);
-    ck_assert_int_eq(status_of("G20 G1 X1 F1\nG2 X0 I-0.5005 J0\nM2\n"), INTERP_OK);
+    ck_assert_int_eq(status_of("G20 G1 X1 F1\nG2 X0 I-0.5011 J0\nM2\n"), INTERP_OK);
     ck_assert_int_eq(status_of("G20 G1 X1 F1\nG2 X0 I-0.502 J0\nM2\n"), INTERP_ERR_ARC);
     ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-10 J0\nM2\n"), INTERP_ERR_ARC); /* r2 = 0 */
 }
