@@ -50,8 +50,10 @@ static void runner_monitor(void *arg, long period_ns)
     r->have_prev = true;
     /* The e-stop reset request lasts one period: the latch has seen its rising edge. */
     *r->user_request_enable = false;
-    if (r->started && active)
-        r->running_periods++;
+    if (r->started && active)  /* only this thread writes it: no read-modify-write needed */
+        atomic_store_explicit(&r->running_periods,
+                              atomic_load_explicit(&r->running_periods, memory_order_relaxed)
+                              + 1, memory_order_relaxed);
     if (r->observer) {
         struct runner_sample smp = {
             .time_ns = hal_now_ns(r->hal), .njoints = r->njoints, .joint_cmd_mm = cmd,
@@ -60,9 +62,14 @@ static void runner_monitor(void *arg, long period_ns)
         };
         r->observer(r->observer_ctx, &smp);
     }
-    atomic_store(&r->mon_line, r->last.line);
-    atomic_store(&r->mon_state, (int)state);
-    atomic_fetch_add(&r->mon_periods, 1);
+    /* Relaxed: the readers only display these; no other data hangs on their order. */
+    atomic_store_explicit(&r->mon_distance_mm, r->last.distance_done_mm, memory_order_relaxed);
+    atomic_store_explicit(&r->mon_file, r->last.file, memory_order_relaxed);
+    atomic_store_explicit(&r->mon_line, r->last.line, memory_order_relaxed);
+    atomic_store_explicit(&r->mon_state, (int)state, memory_order_relaxed);
+    atomic_store_explicit(&r->mon_periods,
+                          atomic_load_explicit(&r->mon_periods, memory_order_relaxed) + 1,
+                          memory_order_relaxed);
 }
 
 int runner_monitor_install(struct runner *r, char *err, size_t errlen)
@@ -148,11 +155,11 @@ int runner_get_progress(const struct runner *r, struct runner_progress *p)
     memset(p, 0, sizeof *p);
     p->state = (enum motion_state)atomic_load(&r->mon_state);
     p->line = atomic_load(&r->mon_line);
-    p->file = r->last.file;
+    p->file = atomic_load(&r->mon_file);
     p->elapsed_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
     p->remaining_s = fmax(0.0, r->plan.time_s - p->elapsed_s);
     if (r->plan.length_mm > 0.0)
-        p->percent = 100.0 * r->last.distance_done_mm / r->plan.length_mm;
+        p->percent = 100.0 * atomic_load(&r->mon_distance_mm) / r->plan.length_mm;
     else if (r->plan.time_s > 0.0)
         p->percent = 100.0 * fmin(1.0, p->elapsed_s / r->plan.time_s);
     if (p->state == MOTION_DONE)

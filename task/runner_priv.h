@@ -46,6 +46,8 @@ struct runner {
     _Atomic int mon_state;                   /* enum motion_state after the last period */
     _Atomic int mon_line;                    /* program line after the last period */
     _Atomic long mon_periods;                /* periods run since start */
+    _Atomic double mon_distance_mm;          /* path length covered after the last period */
+    const char *_Atomic mon_file;            /* program file of the line being executed */
     struct motion_out last;                  /* motion's output after the last period */
 
     runner_observer_fn observer;             /* called every period (may be NULL) */
