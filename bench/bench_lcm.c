@@ -12,7 +12,7 @@
 #include "hal/hal.h"
 #include "hal/ring.h"
 
-#define SLOT_BYTES 320              /* about one status sample (lcm_status_priv.h) */
+#define SLOT_BYTES 344              /* one status sample, sizeof(struct lcm_sample) */
 #define RING_SLOTS 1024
 #define ITEMS 1000000L              /* ring items per throughput run */
 #define PERIODS 100000L             /* servo periods per funct-cost run */

@@ -176,8 +176,10 @@ START_TEST(test_memq_stream)
     struct hal *h = make_graph("loadrt lcm-status url=memq:// rate=50");
     lcm_t *lcm = lcm_status_lcm(h);
     ck_assert_ptr_nonnull(lcm);
-    hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
-    hexcnc_event_t_subscribe(lcm, LCM_EVENT_CHANNEL, on_event, &g);
+    hexcnc_status_t_subscription_t *ss =
+        hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
+    hexcnc_event_t_subscription_t *se =
+        hexcnc_event_t_subscribe(lcm, LCM_EVENT_CHANNEL, on_event, &g);
     run_scenario(h);
     while (lcm_handle_timeout(lcm, 50) > 0) {
     }
@@ -188,6 +190,8 @@ START_TEST(test_memq_stream)
     ck_assert_uint_eq(st.status_sent, 51);
     ck_assert_uint_eq(st.events_sent, 3);
     ck_assert_uint_eq(st.samples_dropped + st.events_dropped + st.publish_errors, 0);
+    hexcnc_status_t_unsubscribe(lcm, ss);
+    hexcnc_event_t_unsubscribe(lcm, se);
     hal_destroy(h);
 }
 END_TEST
@@ -327,8 +331,10 @@ START_TEST(test_full_ring_drops)
     memset(&g, 0, sizeof g);
     struct hal *h = make_graph("loadrt lcm-status url=memq:// rate=1000 ring=2");
     lcm_t *lcm = lcm_status_lcm(h);
-    hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
-    hexcnc_event_t_subscribe(lcm, LCM_EVENT_CHANNEL, on_event, &g);
+    hexcnc_status_t_subscription_t *ss =
+        hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
+    hexcnc_event_t_subscription_t *se =
+        hexcnc_event_t_subscribe(lcm, LCM_EVENT_CHANNEL, on_event, &g);
     ck_assert_int_eq(hal_start(h), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, 200 * PERIOD_NS), HAL_OK);   /* 200 samples at once */
     ck_assert_int_eq(lcm_status_flush(h, 5000), LCM_STATUS_OK);
@@ -347,6 +353,8 @@ START_TEST(test_full_ring_drops)
     ck_assert_int_ge(g.n_event, 1);
     ck_assert_int_eq(g.event[0].code, LCM_CODE_SAMPLES_DROPPED);
     ck_assert_int_eq(g.event[0].severity, HEXCNC_EVENT_T_WARNING);
+    hexcnc_status_t_unsubscribe(lcm, ss);
+    hexcnc_event_t_unsubscribe(lcm, se);
     hal_destroy(h);
 }
 END_TEST
@@ -362,7 +370,8 @@ START_TEST(test_realtime_decimates)
     cmd(h, "loadrt lcm-status url=memq:// rate=50");
     cmd(h, "addf lcm-status.sample servo-thread");
     lcm_t *lcm = lcm_status_lcm(h);
-    hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
+    hexcnc_status_t_subscription_t *ss =
+        hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
     ck_assert_int_eq(hal_start(h), HAL_OK);
     struct timespec ts = { 0, 300000000 };
     nanosleep(&ts, NULL);
@@ -378,6 +387,7 @@ START_TEST(test_realtime_decimates)
         ck_assert_int_gt(g.status[i].seq, g.status[i - 1].seq);
         ck_assert_int_ge(g.status[i].utime, g.status[i - 1].utime);
     }
+    hexcnc_status_t_unsubscribe(lcm, ss);
     hal_destroy(h);
 }
 END_TEST

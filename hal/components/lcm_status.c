@@ -290,9 +290,10 @@ static void lcm_open(struct lcm_status *s)
         return;
     s->lcm = lcm_create(s->url);
     if (!s->lcm)
-        fprintf(stderr, "lcm-status: warning: cannot open the LCM URL '%s'; machine status "
-                "is not published. A udpm:// URL needs a multicast route (e.g. `ip route add "
-                "224.0.0.0/4 dev lo`); see docs/lcm.md.\n", s->url);
+        fprintf(stderr, "lcm-status: warning: cannot open the LCM URL '%s'; the machine "
+                "runs, but its status is not published. A udpm:// URL needs a multicast route "
+                "(as root: `ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo`); "
+                "see docs/lcm.md.\n", s->url);
 }
 
 /* loadrt lcm-status: one instance, funct lcm-status.sample. */
