@@ -83,19 +83,23 @@ static int runner_task_pins(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
-/* Runs every [HAL] HALFILE in order; the first error names its file and line. */
+/* Runs every [HAL] HALFILE in order, then every [TASK] HALFILE (the wiring of the task.*
+ * pins, which only hexcnc run has); the first error names its file and line. */
 static int runner_load_halfiles(struct runner *r, const char *ini_path, char *err,
                                 size_t errlen)
 {
-    const char *name = hal_ini_get_n(r->hal, "HAL", "HALFILE", 0);
-    if (!name)
+    if (!hal_ini_get_n(r->hal, "HAL", "HALFILE", 0))
         return runner_fail(err, errlen, RUNNER_ERR_CONFIG,
                            "%s: no [HAL] HALFILE: the machine has no HAL wiring", ini_path);
-    for (int n = 0; (name = hal_ini_get_n(r->hal, "HAL", "HALFILE", n)); n++) {
-        char path[1024];
-        runner_ini_path(r, name, path, sizeof path);
-        if (hal_source(r->hal, path) != HAL_OK)
-            return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(r->hal));
+    static const char *const sections[] = { "HAL", "TASK" };
+    for (int sec = 0; sec < 2; sec++) {
+        const char *name;
+        for (int n = 0; (name = hal_ini_get_n(r->hal, sections[sec], "HALFILE", n)); n++) {
+            char path[1024];
+            runner_ini_path(r, name, path, sizeof path);
+            if (hal_source(r->hal, path) != HAL_OK)
+                return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(r->hal));
+        }
     }
     return RUNNER_OK;
 }

@@ -181,6 +181,24 @@ static int runner_outcome(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
+/* A program that has not started moving after this many periods never will: the machine
+ * is held in e-stop (motion.enable false). */
+#define RUNNER_START_PERIODS 100
+
+/* Says why a started program stays idle, instead of waiting for the time-out. */
+static int runner_check_started(struct runner *r, char *err, size_t errlen)
+{
+    if (r->aborting || r->running_periods > 0 ||
+        atomic_load(&r->mon_periods) < RUNNER_START_PERIODS ||
+        (enum motion_state)atomic_load(&r->mon_state) != MOTION_IDLE)
+        return RUNNER_OK;
+    return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine did not come out of "
+                       "e-stop: motion.enable stayed false (task.emc-enable-in %s); the HAL "
+                       "files must wire task.user-enable-out and task.user-request-enable "
+                       "into the e-stop chain ([TASK] HALFILE)",
+                       *r->emc_enable_in ? "true" : "false");
+}
+
 int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progress_fn fn,
                void *ctx, char *err, size_t errlen)
 {
@@ -202,6 +220,8 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
         runner_get_progress(r, &p);
         if (fn)
             fn(ctx, &p);
+        if ((st = runner_check_started(r, err, errlen)) != RUNNER_OK)
+            break;
         if (p.elapsed_s > limit_s) {
             st = runner_fail(err, errlen, RUNNER_ERR_TIMEOUT, "the machine was still moving "
                              "after %.1f s, twice the planned %.1f s", p.elapsed_s,

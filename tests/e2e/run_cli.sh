@@ -52,7 +52,14 @@ sed "s|^HALFILE = .*|HALFILE = $tmp/broken.hal|" "$ini" >"$tmp/broken.ini"
 check "HAL error exits 1" [ $? -eq 1 ]
 check "HAL error names file:line" has "$tmp/err" "broken.hal:2"
 
-# 6. Ctrl-C on a real-time run: controlled stop, summary, exit 130.
+# 6. Without the task's e-stop wiring the machine stays in e-stop: said at once, not hung.
+grep -v "^HALFILE = tmu-hexapod-task.hal" "$ini" | sed "s|^HALFILE = |HALFILE = $root/configs/sim/|" \
+    | sed "s|^TOOL_TABLE = |TOOL_TABLE = $root/configs/sim/|" >"$tmp/noreset.ini"
+"$bin" run "$tmp/noreset.ini" "$root/examples/paper/prog10_g141_d20.ngc" >"$tmp/out" 2>"$tmp/err"
+check "held in e-stop exits 3" [ $? -eq 3 ]
+check "held in e-stop says so" has "$tmp/err" "did not come out of e-stop"
+
+# 7. Ctrl-C on a real-time run: controlled stop, summary, exit 130.
 sh "$start" --realtime "$ini" "$root/examples/paper/prog10_g141_d20.ngc" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
 sleep 1
