@@ -89,6 +89,7 @@ struct runner_summary {
     double leg_min_mm[KINS_MAX_JOINTS];      /* shortest commanded leg length seen */
     double leg_max_mm[KINS_MAX_JOINTS];      /* longest commanded leg length seen */
     double final_legs_mm[KINS_MAX_JOINTS];   /* leg feedback at the end */
+    double final_cmd_pose[KINS_POSE_DIM];    /* the pose motion commanded last */
     double final_pose[KINS_POSE_DIM];        /* forward kinematics of the final feedback */
     int final_pose_ok;                       /* 0 when the forward solve failed */
     enum motion_state state;                 /* DONE, IDLE (after a stop), FAULT */

@@ -251,6 +251,7 @@ int runner_summary(struct runner *r, struct runner_summary *s)
     for (int i = 0; i < r->njoints; i++)
         s->final_legs_mm[i] = *r->fb_pin[i];
     /* Forward kinematics of the final feedback, warm-started at the commanded pose. */
+    memcpy(s->final_cmd_pose, r->last.pose, sizeof s->final_cmd_pose);
     memcpy(s->final_pose, r->last.pose, sizeof s->final_pose);
     s->final_pose_ok = kins_forward(r->kins, s->final_legs_mm, s->final_pose, NULL) == KINS_OK;
     return RUNNER_OK;

@@ -1,4 +1,5 @@
 /* cmd_run.c: `hexcnc run`: starts the machine from its INI file and runs a program on it. */
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -116,11 +117,17 @@ static void run_print_summary(struct runner *r, const char *program, double wall
     for (int i = 0; i < s.njoints; i++)
         printf("  %d ([JOINT_%d])  %14.3f  %22.5f  %.3f .. %.3f\n", i + 1, i,
                s.peak_rate_mm_s[i], s.max_ferror_mm[i], s.leg_min_mm[i], s.leg_max_mm[i]);
-    if (s.final_pose_ok)
-        printf("  final pose     X %.4f  Y %.4f  Z %.4f  A %.4f  B %.4f  C %.4f\n",
-               s.final_pose[0], s.final_pose[1], s.final_pose[2], s.final_pose[3],
-               s.final_pose[4], s.final_pose[5]);
-    else
+    const double *c = s.final_cmd_pose;
+    printf("  commanded end  X %.6f  Y %.6f  Z %.6f  A %.4f  B %.4f  C %.4f\n", c[0], c[1],
+           c[2], c[3], c[4], c[5]);
+    if (s.final_pose_ok) {
+        const double *p = s.final_pose;
+        double d_mm = sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                           (p[2] - c[2]) * (p[2] - c[2]));
+        printf("  final pose     X %.6f  Y %.6f  Z %.6f  A %.4f  B %.4f  C %.4f\n"
+               "                 (forward kinematics of the legs' steps: %.4f mm from the "
+               "commanded end)\n", p[0], p[1], p[2], p[3], p[4], p[5], d_mm);
+    } else
         printf("  final pose     unknown: the forward kinematics of the leg feedback failed\n");
     printf("  final legs mm ");
     for (int i = 0; i < s.njoints; i++)

@@ -25,7 +25,7 @@ rc=$?
 check "program (10) exits 0" [ $rc -eq 0 ]
 check "summary printed" has "$tmp/out" "machine time"
 check "program finished" has "$tmp/out" "program finished"
-check "final pose at the compensated end point" has "$tmp/out" "X 59.97[56]"
+check "ends at the compensated end point of paper.md" has "$tmp/out" "commanded end  X 59.975641  Y -20.000000  Z 630.697565"
 
 # 2. A missing INI file is refused by the script.
 sh "$start" "$tmp/none.ini" >"$tmp/out" 2>"$tmp/err"
