@@ -36,6 +36,7 @@ struct legs_log {
     int n, cap, njoints;
 };
 
+/* Monotonic wall-clock seconds. */
 static double now_s(void)
 {
     struct timespec ts;
@@ -251,6 +252,7 @@ static int best_of(const char *ini, int with_monitor, struct legs_log *log, doub
     return 0;
 }
 
+/* Runs every measurement and prints each beside its baseline. */
 int main(void)
 {
     static char ini[1024];

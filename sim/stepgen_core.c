@@ -36,6 +36,7 @@ static double stepgen_clamp(double x, double lim)
     return x > lim ? lim : (x < -lim ? -lim : x);
 }
 
+/* A channel at rest at pos_mm, not yet primed by an enabled period. */
 void stepgen_state_init(struct stepgen_state *s, double pos_mm)
 {
     memset(s, 0, sizeof *s);
@@ -43,6 +44,7 @@ void stepgen_state_init(struct stepgen_state *s, double pos_mm)
     s->cmd_prev_mm = pos_mm;
 }
 
+/* One period of the controller described above; returns the whole-step count. */
 int64_t stepgen_step(struct stepgen_state *s, const struct stepgen_limits *lim,
                      double cmd_mm, bool enable, double dt_s)
 {

@@ -32,6 +32,7 @@ const char *runner_strerror(int status)
     return runner_msgs[status];
 }
 
+/* Formats err (when given) and returns status: every error path is one line. */
 int runner_fail(char *err, size_t errlen, int status, const char *fmt, ...)
 {
     if (err && errlen) {
@@ -132,6 +133,7 @@ static int runner_bind(struct runner *r, const char *ini_path, char *err, size_t
     return RUNNER_OK;
 }
 
+/* INI, HAL runtime, task pins, HAL files, monitor; unwinds through one error path. */
 int runner_create(const struct runner_opts *opts, struct runner **out, char *err,
                   size_t errlen)
 {
@@ -159,6 +161,7 @@ fail:
     return st;
 }
 
+/* Stops the threads, frees the runtime (and with it motion and kins), the interpreter. */
 void runner_destroy(struct runner *r)
 {
     if (!r)
@@ -168,11 +171,13 @@ void runner_destroy(struct runner *r)
     free(r);
 }
 
+/* Accessors for callers that need the parts (tests, benchmarks). */
 struct hal *runner_hal(struct runner *r) { return r->hal; }
 struct kins *runner_kins(struct runner *r) { return r->kins; }
 struct motion *runner_motion(struct runner *r) { return r->motion; }
 bool runner_sim_clock(const struct runner *r) { return r->sim_clock; }
 
+/* [DISPLAY] OPEN_FILE resolved against the INI folder, or NULL. */
 const char *runner_default_program(const struct runner *r)
 {
     return r->default_program[0] ? r->default_program : NULL;
@@ -243,6 +248,7 @@ out:
     return st;
 }
 
+/* Interprets then plans; nothing is handed to motion unless both succeed. */
 int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen)
 {
     if (runner_moving(r))
@@ -263,6 +269,7 @@ int runner_load_program(struct runner *r, const char *path, char *err, size_t er
     return st;
 }
 
+/* The plan of the loaded program (time, length, peak leg rates). */
 int runner_plan_info(const struct runner *r, struct motion_plan_info *out)
 {
     if (!r->loaded)

@@ -18,6 +18,7 @@ static bool runner_state_active(enum motion_state s)
            s == MOTION_STOPPING;
 }
 
+/* Asks the motion core itself, so it works with or without the monitor. */
 bool runner_moving(const struct runner *r)
 {
     return runner_state_active(motion_get_state(r->motion));
@@ -72,6 +73,7 @@ static void runner_monitor(void *arg, long period_ns)
                           memory_order_relaxed);
 }
 
+/* Exports runner.monitor and appends it to servo-thread, after every HAL file's functs. */
 int runner_monitor_install(struct runner *r, char *err, size_t errlen)
 {
     snprintf(r->thread, sizeof r->thread, "servo-thread");
@@ -82,6 +84,7 @@ int runner_monitor_install(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
+/* Sets the per-period observer (tests use it to check every period). */
 void runner_set_observer(struct runner *r, runner_observer_fn fn, void *ctx)
 {
     r->observer = fn;
@@ -101,6 +104,7 @@ static void runner_reset_summary(struct runner *r)
     atomic_store(&r->mon_periods, 0);
 }
 
+/* Machine on, program start request, threads running. */
 int runner_start(struct runner *r, char *err, size_t errlen)
 {
     if (!r->loaded)
@@ -124,6 +128,7 @@ int runner_start(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
+/* Simulated clock: runs the threads for dt_s; real time: sleeps dt_s. */
 int runner_advance(struct runner *r, double dt_s)
 {
     if (r->sim_clock)
@@ -134,6 +139,7 @@ int runner_advance(struct runner *r, double dt_s)
     return RUNNER_OK;
 }
 
+/* Ctrl-C's path: motion decelerates along the path, then drops the program. */
 int runner_abort(struct runner *r)
 {
     if (!r->started)
@@ -142,6 +148,7 @@ int runner_abort(struct runner *r)
     return motion_hal_abort(r->hal) == MOTION_OK ? RUNNER_OK : RUNNER_ERR_STATE;
 }
 
+/* Done, faulted, or at rest after an abort. */
 bool runner_finished(const struct runner *r)
 {
     if (!r->started)
@@ -150,6 +157,7 @@ bool runner_finished(const struct runner *r)
     return s == MOTION_DONE || s == MOTION_FAULT || (r->aborting && s == MOTION_IDLE);
 }
 
+/* Line, percent, elapsed and remaining machine time, from the monitor's last period. */
 int runner_get_progress(const struct runner *r, struct runner_progress *p)
 {
     memset(p, 0, sizeof *p);
@@ -199,6 +207,7 @@ static int runner_check_started(struct runner *r, char *err, size_t errlen)
                        *r->emc_enable_in ? "true" : "false");
 }
 
+/* The run loop: slices of machine time, stop flag, progress, start check, time-out. */
 int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progress_fn fn,
                void *ctx, char *err, size_t errlen)
 {
@@ -239,6 +248,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
     return st;
 }
 
+/* Peaks from the monitor, plan figures, and the final pose by forward kinematics. */
 int runner_summary(struct runner *r, struct runner_summary *s)
 {
     *s = r->sum;

@@ -349,6 +349,7 @@ START_TEST(test_estop_fault)
 }
 END_TEST
 
+/* The suite: the paper's programs, refusals before motion, stop and faults. */
 static Suite *e2e_suite(void)
 {
     Suite *s = suite_create("e2e");
@@ -368,6 +369,7 @@ static Suite *e2e_suite(void)
     return s;
 }
 
+/* Runs the suite in a fresh temporary folder for its programs. */
 int main(void)
 {
     snprintf(tmp_dir, sizeof tmp_dir, "/tmp/hexcnc-e2e-XXXXXX");
