@@ -17,10 +17,13 @@
  *   stepgen.N.position-fb    float out  counts / position-scale, mm (quantised to a step)
  *   stepgen.N.counts         s32   out  whole steps since start
  *   stepgen.N.velocity-fb    float out  current step rate / position-scale, mm/s
+ *   stepgen.N.velocity-cmd   float in   commanded velocity, mm/s (velocity mode only)
  *   stepgen.N.position-scale float param steps per mm
  *   stepgen.N.maxvel         float param mm/s (0 = no limit)
  *   stepgen.N.maxaccel       float param mm/s^2 (0 = no limit)
  * Funct: stepgen.update (all channels; add it after the funct that writes position-cmd).
+ * `loadrt stepgen count=N [ctrl_type=p,v,...]`: as in LinuxCNC, p (the default) follows
+ * position-cmd, v follows velocity-cmd.
  */
 extern const struct hal_comp_type hal_comp_stepgen;
 
@@ -46,5 +49,9 @@ void stepgen_state_init(struct stepgen_state *s, double pos_mm);
  * tests stream commands through it without a HAL. */
 int64_t stepgen_step(struct stepgen_state *s, const struct stepgen_limits *lim,
                      double cmd_mm, bool enable, double dt_s);
+
+/* One period of velocity mode: the step rate follows vel_cmd_mm_s within the limits. */
+int64_t stepgen_step_velocity(struct stepgen_state *s, const struct stepgen_limits *lim,
+                              double vel_cmd_mm_s, bool enable, double dt_s);
 
 #endif

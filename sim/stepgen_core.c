@@ -76,3 +76,19 @@ int64_t stepgen_step(struct stepgen_state *s, const struct stepgen_limits *lim,
     s->counts = (int64_t)llround(s->pos_mm * lim->scale);
     return s->counts;
 }
+
+/* Velocity mode (LinuxCNC's ctrl_type v): the step rate follows vel_cmd_mm_s within maxvel
+ * and maxaccel; the position is whatever the steps add up to. */
+int64_t stepgen_step_velocity(struct stepgen_state *s, const struct stepgen_limits *lim,
+                              double vel_cmd_mm_s, bool enable, double dt_s)
+{
+    s->primed = s->primed || enable;
+    double v = enable ? stepgen_clamp(vel_cmd_mm_s, lim->maxvel_mm_s) : 0.0;
+    if (lim->maxaccel_mm_s2 > 0.0 && enable)
+        v = s->vel_mm_s + stepgen_clamp(v - s->vel_mm_s, lim->maxaccel_mm_s2 * dt_s);
+    s->vel_mm_s = v;
+    s->pos_mm += v * dt_s;
+    s->cmd_prev_mm = s->pos_mm;
+    s->counts = (int64_t)llround(s->pos_mm * lim->scale);
+    return s->counts;
+}

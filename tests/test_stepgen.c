@@ -125,6 +125,32 @@ START_TEST(test_powers_up_at_command)
 }
 END_TEST
 
+/* Velocity mode: the rate ramps to the command at maxaccel, holds, and counts whole steps
+ * of the integrated position; maxvel caps the command. */
+START_TEST(test_velocity_mode)
+{
+    struct stepgen_limits lim = { 100.0, 10.0, 100.0 };
+    struct stepgen_state s;
+    stepgen_state_init(&s, 0.0);
+    for (int i = 0; i < 50; i++)   /* 0.05 s: 100 mm/s^2 gives 5 mm/s */
+        stepgen_step_velocity(&s, &lim, 8.0, true, DT_S);
+    ck_assert(fabs(s.vel_mm_s - 5.0) < 1e-9);
+    for (int i = 0; i < 1000; i++)
+        stepgen_step_velocity(&s, &lim, 8.0, true, DT_S);
+    ck_assert(fabs(s.vel_mm_s - 8.0) < 1e-9);
+    /* 0.08 s ramp (0.32 mm) then 0.97 s at 8 mm/s (7.76 mm): 8.08 mm, to a period's
+     * rounding of the ramp */
+    ck_assert_msg(fabs(s.pos_mm - 8.08) < 0.01, "%.4f mm", s.pos_mm);
+    ck_assert_int_eq(s.counts, llround(s.pos_mm * 100.0));
+    for (int i = 0; i < 100; i++)
+        stepgen_step_velocity(&s, &lim, 50.0, true, DT_S);
+    ck_assert(fabs(s.vel_mm_s - 10.0) < 1e-9);   /* capped at maxvel */
+    int64_t held = s.counts;
+    stepgen_step_velocity(&s, &lim, 5.0, false, DT_S);
+    ck_assert(s.vel_mm_s == 0.0 && s.counts == held);  /* disabled: no steps */
+}
+END_TEST
+
 static Suite *stepgen_suite(void)
 {
     Suite *s = suite_create("stepgen");
@@ -135,6 +161,7 @@ static Suite *stepgen_suite(void)
     tcase_add_test(tc, test_negative_scale);
     tcase_add_test(tc, test_enable);
     tcase_add_test(tc, test_powers_up_at_command);
+    tcase_add_test(tc, test_velocity_mode);
     suite_add_tcase(s, tc);
     return s;
 }

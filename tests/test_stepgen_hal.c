@@ -127,6 +127,35 @@ START_TEST(test_hal_enable_and_args)
 }
 END_TEST
 
+/* `ctrl_type=p,v`: channel 1 follows velocity-cmd; channel 0 stays in position mode. */
+START_TEST(test_hal_ctrl_type)
+{
+    struct hal *h = hal_create();
+    ck_assert_ptr_nonnull(h);
+    hal_set_sim_clock(h, true);
+    cmd(h, "newthread servo-thread 1000000");
+    cmd(h, "loadrt stepgen ctrl_type=p,v");
+    cmd(h, "setp stepgen.1.position-scale 1000");
+    cmd(h, "setp stepgen.1.maxvel 5");
+    cmd(h, "setp stepgen.1.maxaccel 100");
+    cmd(h, "setp stepgen.1.enable 1");
+    cmd(h, "setp stepgen.1.velocity-cmd 2");
+    cmd(h, "setp stepgen.1.position-cmd 99");  /* ignored in velocity mode */
+    cmd(h, "addf stepgen.update servo-thread");
+    ck_assert_int_eq(hal_start(h), HAL_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 1000 * PERIOD_NS), HAL_OK);
+    /* 0.02 s ramp to 2 mm/s (0.02 mm), then 0.98 s at 2 mm/s (1.96 mm): 1.98 mm */
+    int32_t *counts1 = pin(h, "stepgen.1.counts", HAL_S32);
+    ck_assert_msg(abs(*counts1 - 1980) <= 2, "counts %d, expected about 1980", *counts1);
+    ck_assert(fabs(*(double *)pin(h, "stepgen.1.velocity-fb", HAL_FLOAT) - 2.0) < 1e-9);
+    hal_destroy(h);
+    h = hal_create();
+    ck_assert_int_ne(hal_cmd(h, "loadrt stepgen ctrl_type=p,x", "y.hal", 1, stdout), HAL_OK);
+    ck_assert_ptr_nonnull(strstr(hal_last_error(h), "ctrl_type"));
+    hal_destroy(h);
+}
+END_TEST
+
 static Suite *stepgen_hal_suite(void)
 {
     Suite *s = suite_create("stepgen-hal");
@@ -134,6 +163,7 @@ static Suite *stepgen_hal_suite(void)
     tcase_add_test(tc, test_hal_matches_core);
     tcase_add_test(tc, test_hal_step_limits);
     tcase_add_test(tc, test_hal_enable_and_args);
+    tcase_add_test(tc, test_hal_ctrl_type);
     suite_add_tcase(s, tc);
     return s;
 }
