@@ -90,7 +90,7 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
         mc->have_tt = 1;
     }
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
-        char sec[16];
+        char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         if (hal_ini_double(mc->hal, sec, "SCALE", 0, &mc->scale[i]) == HAL_ERR_SYNTAX ||
             hal_ini_double(mc->hal, sec, "STEPGEN_MAXVEL", 0, &mc->drive_vel[i]) ==

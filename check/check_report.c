@@ -29,77 +29,84 @@ static void json_num(FILE *f, double v)
         fputs("null", f);
 }
 
-void check_print_json(const struct check_result *r, FILE *f)
+/* "key":number, with a leading comma unless first. */
+static void json_field(FILE *f, const char *key, double v, int first)
 {
-    fputs("{\"program\":", f);
-    json_str(f, r->program);
-    fputs(",\"config\":", f);
-    json_str(f, r->config);
-    fprintf(f, ",\"ok\":%s,\"simulated\":%s,\"servo_period_s\":", r->nproblems ? "false" : "true",
-            r->simulated ? "true" : "false");
-    json_num(f, r->servo_period_s);
-    fputs(",\"machining_time_s\":", f);
-    json_num(f, r->machining_time_s);
-    fputs(",\"planned_time_s\":", f);
-    json_num(f, r->planned_time_s);
-    fputs(",\"length_mm\":", f);
-    json_num(f, r->length_mm);
-    fprintf(f, ",\"periods\":%ld,\"deviation\":{\"max_mm\":", r->periods);
-    json_num(f, r->max_deviation_mm);
-    fprintf(f, ",\"line\":%d,\"max_deg\":", r->max_deviation_line);
-    json_num(f, r->max_deviation_deg);
-    fputs(",\"tolerance_mm\":", f);
-    json_num(f, r->kin_tol_mm);
-    fputs(",\"every_s\":", f);
-    json_num(f, r->deviation_every_s);
-    fprintf(f, ",\"evaluations\":%ld},\"condition\":{\"max\":", r->deviation_evals);
-    json_num(f, r->max_condition);
-    fprintf(f, ",\"line\":%d,\"limit\":", r->max_condition_line);
-    json_num(f, r->condition_limit);
-    fputs(",\"every_s\":", f);
-    json_num(f, r->condition_every_s);
-    fprintf(f, ",\"evaluations\":%ld},\"legs\":[", r->condition_evals);
+    fprintf(f, "%s\"%s\":", first ? "" : ",", key);
+    json_num(f, v);
+}
+
+/* The per-leg figures. */
+static void json_legs(const struct check_result *r, FILE *f)
+{
+    fputs(",\"legs\":[", f);
     for (int i = 0; r->simulated && i < r->njoints; i++) {
         const struct check_leg *l = &r->leg[i];
-        fprintf(f, "%s{\"leg\":%d,\"min_mm\":", i ? "," : "", i + 1);
-        json_num(f, l->min_mm);
-        fputs(",\"max_mm\":", f);
-        json_num(f, l->max_mm);
-        fputs(",\"peak_vel_mm_s\":", f);
-        json_num(f, l->peak_vel_mm_s);
-        fputs(",\"peak_acc_mm_s2\":", f);
-        json_num(f, l->peak_acc_mm_s2);
-        fputs(",\"limit_min_mm\":", f);
-        json_num(f, l->limit_min_mm);
-        fputs(",\"limit_max_mm\":", f);
-        json_num(f, l->limit_max_mm);
-        fputs(",\"limit_vel_mm_s\":", f);
-        json_num(f, l->limit_vel_mm_s);
-        fputs(",\"limit_acc_mm_s2\":", f);
-        json_num(f, l->limit_acc_mm_s2);
+        fprintf(f, "%s{\"leg\":%d", i ? "," : "", i + 1);
+        json_field(f, "min_mm", l->min_mm, 0);
+        json_field(f, "max_mm", l->max_mm, 0);
+        json_field(f, "peak_vel_mm_s", l->peak_vel_mm_s, 0);
+        json_field(f, "peak_acc_mm_s2", l->peak_acc_mm_s2, 0);
+        json_field(f, "limit_min_mm", l->limit_min_mm, 0);
+        json_field(f, "limit_max_mm", l->limit_max_mm, 0);
+        json_field(f, "limit_vel_mm_s", l->limit_vel_mm_s, 0);
+        json_field(f, "limit_acc_mm_s2", l->limit_acc_mm_s2, 0);
         fputs(",\"limit_vel_key\":", f);
         json_str(f, l->vel_key ? l->vel_key : "");
         fputs(",\"limit_acc_key\":", f);
         json_str(f, l->acc_key ? l->acc_key : "");
         fputc('}', f);
     }
-    fputs("],\"problems\":[", f);
+    fputc(']', f);
+}
+
+/* The problems, in the order found. */
+static void json_problems(const struct check_result *r, FILE *f)
+{
+    fputs(",\"problems\":[", f);
     for (size_t i = 0; i < r->nproblems; i++) {
         const struct check_problem *p = &r->problems[i];
         fprintf(f, "%s{\"kind\":\"%s\",\"file\":", i ? "," : "", check_kind_name(p->kind));
         json_str(f, p->file);
-        fprintf(f, ",\"line\":%d,\"column\":%d,\"leg\":%d,\"value\":", p->line, p->column,
+        fprintf(f, ",\"line\":%d,\"column\":%d,\"leg\":%d", p->line, p->column,
                 p->leg >= 0 ? p->leg + 1 : 0);
-        json_num(f, p->value);
-        fputs(",\"limit\":", f);
-        json_num(f, p->limit);
-        fputs(",\"time_s\":", f);
-        json_num(f, p->time_s);
+        json_field(f, "value", p->value, 0);
+        json_field(f, "limit", p->limit, 0);
+        json_field(f, "time_s", p->time_s, 0);
         fprintf(f, ",\"count\":%d,\"message\":", p->count);
         json_str(f, p->message);
         fputc('}', f);
     }
-    fputs("]}\n", f);
+    fputc(']', f);
+}
+
+void check_print_json(const struct check_result *r, FILE *f)
+{
+    fputs("{\"program\":", f);
+    json_str(f, r->program);
+    fputs(",\"config\":", f);
+    json_str(f, r->config);
+    fprintf(f, ",\"ok\":%s,\"simulated\":%s", r->nproblems ? "false" : "true",
+            r->simulated ? "true" : "false");
+    json_field(f, "servo_period_s", r->servo_period_s, 0);
+    json_field(f, "machining_time_s", r->machining_time_s, 0);
+    json_field(f, "planned_time_s", r->planned_time_s, 0);
+    json_field(f, "length_mm", r->length_mm, 0);
+    fprintf(f, ",\"periods\":%ld,\"deviation\":{", r->periods);
+    json_field(f, "max_mm", r->max_deviation_mm, 1);
+    fprintf(f, ",\"line\":%d", r->max_deviation_line);
+    json_field(f, "max_deg", r->max_deviation_deg, 0);
+    json_field(f, "tolerance_mm", r->kin_tol_mm, 0);
+    json_field(f, "every_s", r->deviation_every_s, 0);
+    fprintf(f, ",\"evaluations\":%ld},\"condition\":{", r->deviation_evals);
+    json_field(f, "max", r->max_condition, 1);
+    fprintf(f, ",\"line\":%d", r->max_condition_line);
+    json_field(f, "limit", r->condition_limit, 0);
+    json_field(f, "every_s", r->condition_every_s, 0);
+    fprintf(f, ",\"evaluations\":%ld}", r->condition_evals);
+    json_legs(r, f);
+    json_problems(r, f);
+    fputs("}\n", f);
 }
 
 /* How often a measure was taken, in words. */

@@ -1,7 +1,9 @@
 /* cmd_check.c: `hexcnc check`: verifies a program on the simulated machine before cutting. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "check/check.h"
 #include "check/plot.h"
@@ -97,6 +99,9 @@ static int run_check(struct check_machine *mc, const struct args *a, struct chec
     }
     if (a->plot_dir && res->simulated) {
         char err[512];
+        if (mkdir(a->plot_dir, 0777) != 0 && errno != EEXIST)   /* one level, like mkdir */
+            fprintf(stderr, "hexcnc check: cannot create %s: %s\n", a->plot_dir,
+                    strerror(errno));
         int have_contour = contour_of(mc, a->program, &contour) == CHECK_OK;
         if (check_write_plots(a->plot_dir, &prog, have_contour ? &contour : NULL, &trace, res,
                               err, sizeof err) != CHECK_OK) {
