@@ -98,11 +98,17 @@ START_TEST(test_real_exception_illegal_address)
     c.map.target = 101;
     struct modbus_link l;
     ck_assert_int_eq(modbus_link_init(&l, &c), MODBUS_DRIVE_OK);
-    /* Before the first command a cycle only connects: nothing is written. */
+    /* Before the first command a cycle only reads: the feedback is the drive's position and
+     * nothing is written (the target the drive was parked at stays). */
+    modbus_sim_set_position(s, 0, 1234);
     ck_assert_int_eq(modbus_link_cycle(&l), MODBUS_DRIVE_OK);
     struct modbus_sim_drive_state st;
     modbus_sim_state(s, 0, &st);
-    ck_assert_uint_eq(st.requests, 0);
+    ck_assert_uint_eq(st.requests, 1);
+    ck_assert_int_eq(st.target_counts, 1234);
+    struct modbus_feedback fb;
+    modbus_link_feedback(&l, &fb);
+    ck_assert_double_eq(fb.pos_mm, 1.234);
     modbus_link_command(&l, 0.0, false);
     ck_assert_int_eq(modbus_link_cycle(&l), MODBUS_DRIVE_ERR_EXCEPTION);
     expect_msg(&l, s, 0, "exception 2 illegal data address at register 100");

@@ -325,7 +325,10 @@ START_TEST(test_rtu_drive_through_hal)
     ck_assert_msg(hal_load_ini(h, ini) == HAL_OK, "%s", hal_last_error(h));
     unlink(ini);
     cmd(h, "newthread servo-thread 1000000");
+    modbus_sim_set_position(s, 0, -1000);
     cmd(h, "loadrt modbus");
+    /* Loading reads the drive once: the feedback is its position before any command. */
+    ck_assert_double_eq(*(double *)pin(h, "modbus.0.position-fb", HAL_FLOAT), -2.0);
     cmd(h, "addf modbus.update servo-thread");
     cmd(h, "setp modbus.0.enable 1");
     cmd(h, "setp modbus.0.position-cmd 612.346");
@@ -337,7 +340,7 @@ START_TEST(test_rtu_drive_through_hal)
     struct modbus_sim_drive_state st;
     modbus_sim_state(s, 0, &st);
     ck_assert_int_eq(st.target_counts, 306173);
-    ck_assert_uint_eq(st.requests, 3);             /* 12 periods, one exchange per 4 */
+    ck_assert_uint_eq(st.requests, 1 + 3);   /* a read at load, then one exchange per 4 periods */
     hal_destroy(h);
     modbus_sim_destroy(s);
 }

@@ -307,6 +307,20 @@ static int modbus_drive_write(struct modbus_drive *d, const uint16_t wr[3])
     return modbus_write_register(d->ctx, m->control, wr[0]) == -1 ? -1 : 0;
 }
 
+/* Checks a read's result (rc: registers read or -1) and unpacks actual and status. */
+static int modbus_drive_unpack(struct modbus_drive *d, int rc, const uint16_t *rd,
+                               int32_t *actual_counts, uint16_t *status_word)
+{
+    const struct modbus_regmap *m = &d->cfg.map;
+    if (rc == -1)
+        return modbus_drive_io_error(d, errno);
+    if (rc != d->plan.read_nb)
+        return modbus_drive_io_error(d, EMBBADDATA);
+    *actual_counts = modbus_words_unpack(&rd[m->actual - d->plan.read_addr], m->order);
+    *status_word = rd[m->status - d->plan.read_addr];
+    return MODBUS_DRIVE_OK;
+}
+
 /* One cycle: the write and read as planned, then unpack actual position and status word. */
 int modbus_drive_exchange(struct modbus_drive *d, int32_t target_counts, uint16_t control,
                           int32_t *actual_counts, uint16_t *status_word)
@@ -336,13 +350,18 @@ int modbus_drive_exchange(struct modbus_drive *d, int32_t target_counts, uint16_
             rc = modbus_read_registers(d->ctx, p->read_addr, p->read_nb, rd);
         }
     }
-    if (rc == -1)
-        return modbus_drive_io_error(d, errno);
-    if (rc != p->read_nb)
-        return modbus_drive_io_error(d, EMBBADDATA);
-    *actual_counts = modbus_words_unpack(&rd[m->actual - p->read_addr], m->order);
-    *status_word = rd[m->status - p->read_addr];
-    return MODBUS_DRIVE_OK;
+    return modbus_drive_unpack(d, rc, rd, actual_counts, status_word);
+}
+
+/* Reads status and actual position alone (see modbus_drive.h). */
+int modbus_drive_read(struct modbus_drive *d, int32_t *actual_counts, uint16_t *status_word)
+{
+    uint16_t rd[MODBUS_MAX_WR_READ_REGISTERS];
+    if (!d->ctx || !d->connected)
+        return modbus_drive_fail(d, MODBUS_DRIVE_ERR_CLOSED, "connection closed");
+    d->requests++;
+    int rc = modbus_read_registers(d->ctx, d->plan.read_addr, d->plan.read_nb, rd);
+    return modbus_drive_unpack(d, rc, rd, actual_counts, status_word);
 }
 
 /* The last error message. */

@@ -131,6 +131,9 @@ void modbus_drive_close(struct modbus_drive *d);
  * connection is closed (a later connect starts clean) and d->msg names drive and cause. */
 int modbus_drive_exchange(struct modbus_drive *d, int32_t target_counts, uint16_t control,
                           int32_t *actual_counts, uint16_t *status_word);
+/* Reads actual position and status word only (FC3), writing nothing: what a drive reports
+ * before the controller has a command for it. Errors as modbus_drive_exchange. */
+int modbus_drive_read(struct modbus_drive *d, int32_t *actual_counts, uint16_t *status_word);
 /* The last error message ("modbus drive 3 (127.0.0.1:5023): no answer within 20 ms"). */
 const char *modbus_drive_message(const struct modbus_drive *d);
 /* Text of a Modbus exception code ("illegal data address"). */

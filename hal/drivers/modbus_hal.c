@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "hal/hal.h"
 #include "hal/drivers/modbus_cfg.h"
@@ -59,6 +60,21 @@ static void modbus_hal_report(void *arg, const char *msg)
     fprintf(stderr, "hexcnc: %s\n", msg);
 }
 
+/* Copies drive d's latest feedback to its pins; returns its fault. */
+static bool modbus_hal_publish(struct modbus_hal_drive *d)
+{
+    struct modbus_feedback fb;
+    modbus_link_feedback(&d->link, &fb);
+    *d->pos_fb = fb.pos_mm;
+    *d->fault = fb.fault;
+    *d->connected = fb.connected;
+    *d->rtt_us = fb.rtt_us;
+    *d->rtt_max_us = fb.rtt_max_us;
+    *d->errors = fb.errors;
+    *d->status_word = fb.status_word;
+    return fb.fault;
+}
+
 /* Inline mode: true on the servo periods where drive d exchanges (the first, then every
  * SETPOINT_PERIOD / servo period, rounded, at least every period). */
 static bool modbus_hal_due(struct modbus_hal_drive *d, long period_ns)
@@ -87,16 +103,7 @@ static void modbus_hal_update(void *arg, long period_ns)
         modbus_link_command(&d->link, *d->pos_cmd, *d->enable);
         if (c->inline_io && modbus_hal_due(d, period_ns))
             modbus_link_cycle(&d->link);
-        struct modbus_feedback fb;
-        modbus_link_feedback(&d->link, &fb);
-        *d->pos_fb = fb.pos_mm;
-        *d->fault = fb.fault;
-        *d->connected = fb.connected;
-        *d->rtt_us = fb.rtt_us;
-        *d->rtt_max_us = fb.rtt_max_us;
-        *d->errors = fb.errors;
-        *d->status_word = fb.status_word;
-        any = any || fb.fault;
+        any = modbus_hal_publish(d) || any;
     }
     *c->fault_any = any;
 }
@@ -173,6 +180,31 @@ static int modbus_hal_drive_new(struct hal *h, struct modbus_hal *c, int i, cons
     return modbus_hal_pins(h, d, i);
 }
 
+/* The pins hold the drives' own positions before the servo thread first runs (motion checks
+ * its following error from the first period): one read now inline, or a bounded wait for
+ * each I/O thread's first read (a drive that cannot answer is faulted by then). */
+static void modbus_hal_first_read(struct modbus_hal *c)
+{
+    bool any = false;
+    for (int i = 0; i < c->count; i++) {
+        struct modbus_hal_drive *d = &c->d[i];
+        if (c->inline_io) {
+            modbus_link_cycle(&d->link);
+        } else {
+            const struct modbus_drive_cfg *cfg = &d->link.drive.cfg;
+            long wait_ms = cfg->timeout_us / 1000 + 2 * cfg->period_ns / 1000000 + 100;
+            struct timespec nap = { 0, 1000000 };
+            struct modbus_feedback fb = { 0 };
+            for (long ms = 0; ms < wait_ms && !fb.exchanges && !fb.fault; ms++) {
+                nanosleep(&nap, NULL);
+                modbus_link_feedback(&d->link, &fb);
+            }
+        }
+        any = modbus_hal_publish(d) || any;
+    }
+    *c->fault_any = any;
+}
+
 /* `loadrt modbus ...`: the drives, their pins, modbus.fault-any and modbus.update. */
 static int modbus_hal_load(struct hal *h, int argc, char **argv)
 {
@@ -208,6 +240,7 @@ static int modbus_hal_load(struct hal *h, int argc, char **argv)
         if (modbus_link_start(&c->d[i].link))
             return hal_error(h, HAL_ERR_RT, "modbus: drive %d: %s", i,
                              modbus_drive_strerror(MODBUS_DRIVE_ERR_THREAD));
+    modbus_hal_first_read(c);
     return HAL_OK;
 }
 

@@ -111,6 +111,26 @@ static void modbus_link_publish(struct modbus_link *l, int32_t actual, uint16_t 
     atomic_fetch_add_explicit(&l->exchanges, 1u, memory_order_relaxed);
 }
 
+/* The servo side's command as target counts and control word; a range error latches. */
+static int modbus_link_take_command(struct modbus_link *l, int32_t *target, uint16_t *control)
+{
+    struct modbus_drive *d = &l->drive;
+    uint64_t bits = atomic_load_explicit(&l->cmd_pos_bits, memory_order_relaxed);
+    double pos_mm;
+    memcpy(&pos_mm, &bits, sizeof(pos_mm));
+    if (modbus_mm_to_counts(pos_mm, d->cfg.counts_per_mm, target)) {
+        char msg[320];
+        snprintf(msg, sizeof(msg), "modbus drive %d (%s): position command %.3f mm is beyond "
+                 "the drive's 32-bit count range at %g counts/mm", d->cfg.index, d->where,
+                 pos_mm, d->cfg.counts_per_mm);
+        return modbus_link_raise(l, MODBUS_DRIVE_ERR_RANGE, msg);
+    }
+    *control = atomic_load_explicit(&l->cmd_enable, memory_order_relaxed) ? MODBUS_CTRL_ENABLE : 0;
+    if (l->send_fault_reset)
+        *control |= MODBUS_CTRL_FAULT_RESET;
+    return MODBUS_DRIVE_OK;
+}
+
 /* One set-point cycle (see modbus_link.h). */
 int modbus_link_cycle(struct modbus_link *l)
 {
@@ -124,32 +144,22 @@ int modbus_link_cycle(struct modbus_link *l)
             return modbus_link_raise(l, rc, modbus_drive_message(d));
         atomic_store_explicit(&l->connected, 1u, memory_order_relaxed);
     }
-    if (!atomic_load_explicit(&l->cmd_posted, memory_order_acquire))
-        return MODBUS_DRIVE_OK;
-    uint64_t bits = atomic_load_explicit(&l->cmd_pos_bits, memory_order_relaxed);
-    double pos_mm;
-    memcpy(&pos_mm, &bits, sizeof(pos_mm));
-    int32_t target;
-    if (modbus_mm_to_counts(pos_mm, d->cfg.counts_per_mm, &target)) {
-        char msg[320];
-        snprintf(msg, sizeof(msg), "modbus drive %d (%s): position command %.3f mm is beyond "
-                 "the drive's 32-bit count range at %g counts/mm", d->cfg.index, d->where,
-                 pos_mm, d->cfg.counts_per_mm);
-        return modbus_link_raise(l, MODBUS_DRIVE_ERR_RANGE, msg);
-    }
-    uint16_t control = atomic_load_explicit(&l->cmd_enable, memory_order_relaxed)
-                       ? MODBUS_CTRL_ENABLE : 0;
-    bool resetting = l->send_fault_reset;
-    if (resetting)
-        control |= MODBUS_CTRL_FAULT_RESET;
-    int32_t actual;
-    uint16_t status;
+    /* Before the first command only read, so the feedback is the drive's own position. */
+    bool posted = atomic_load_explicit(&l->cmd_posted, memory_order_acquire) != 0;
+    int32_t target = 0, actual;
+    uint16_t control = 0, status;
+    int rc;
+    if (posted && (rc = modbus_link_take_command(l, &target, &control)))
+        return rc;
+    bool resetting = (control & MODBUS_CTRL_FAULT_RESET) != 0;
     int64_t t0 = modbus_link_now_ns();
-    int rc = modbus_drive_exchange(d, target, control, &actual, &status);
+    rc = posted ? modbus_drive_exchange(d, target, control, &actual, &status)
+                : modbus_drive_read(d, &actual, &status);
     int64_t t1 = modbus_link_now_ns();
     if (rc)
         return modbus_link_raise(l, rc, modbus_drive_message(d));
-    l->send_fault_reset = false;
+    if (resetting)
+        l->send_fault_reset = false;
     modbus_link_publish(l, actual, status, t1 - t0);
     /* A drive gets the one exchange that carries FAULT_RESET to clear its fault bit. */
     if ((status & MODBUS_STAT_FAULT) && !resetting) {

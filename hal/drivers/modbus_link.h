@@ -87,8 +87,9 @@ const char *modbus_link_fault_message(const struct modbus_link *l);
 /* ---- I/O side ---------------------------------------------------------------------------- */
 
 /* One set-point cycle: act on a reset, connect if needed, exchange, publish. Does nothing
- * while a fault is latched, and only connects until the first command is posted (so a drive
- * never sees a made-up target). Returns the exchange status (MODBUS_DRIVE_OK when idle). */
+ * while a fault is latched. Until the first command is posted it only reads (FC3): the
+ * feedback is then the drive's own position and a drive never sees a made-up target.
+ * Returns the exchange status (MODBUS_DRIVE_OK when idle). */
 int modbus_link_cycle(struct modbus_link *l);
 
 #endif
