@@ -126,26 +126,59 @@ char *check_strip_compensation(const char *text, size_t len)
     return o;
 }
 
-/* XYZ of the moves of a canonical program, lines as their ends, arcs in 32 pieces. */
-static size_t path_points(const struct canon_prog *p, double *xyz, size_t cap)
+/* Whether line is one of the lines the compensation made moves for (comp: per line, or NULL). */
+static int on_comp_line(const unsigned char *comp, int ncomp, int line)
+{
+    return comp && line >= 0 && line < ncomp && comp[line];
+}
+
+/* XYZ of the moves of a canonical program, lines as their ends, arcs in 32 pieces. With comp
+ * given, only the contour: moves on a compensated line that follow a move on one (the first
+ * move of a run only brings the tool to the contour's start); NaN breaks the line elsewhere. */
+static size_t path_points(const struct canon_prog *p, const unsigned char *comp, int ncomp,
+                          double *xyz, size_t cap)
 {
     double from[KINS_POSE_DIM], pose[KINS_POSE_DIM];
     size_t n = 0;
+    int prev_comp = 0;
     memcpy(from, p->start, sizeof from);
     if (cap)
         memcpy(xyz, from, 3 * sizeof *xyz), n = 1;
-    for (size_t k = 0; k < p->count && n < cap; k++) {
+    for (size_t k = 0; k < p->count && n + 1 < cap; k++) {
         const struct canon_cmd *c = &p->cmds[k];
         if (!check_is_motion(c->type))
             continue;
-        int pieces = c->type == CANON_ARC ? 32 : 1;
-        for (int j = 1; j <= pieces && n < cap; j++, n++) {
-            check_move_pose(from, c, (double)j / pieces, pose);
-            memcpy(&xyz[3 * n], pose, 3 * sizeof *xyz);
+        int here = on_comp_line(comp, ncomp, c->line);
+        if (comp && !(here && prev_comp)) {     /* not contour: break the line, restart */
+            xyz[3 * n] = xyz[3 * n + 1] = xyz[3 * n + 2] = NAN;
+            memcpy(&xyz[3 * (n + 1)], c->end, 3 * sizeof *xyz);
+            n += 2;
+        } else {
+            int pieces = c->type == CANON_ARC ? 32 : 1;
+            for (int j = 1; j <= pieces && n < cap; j++, n++) {
+                check_move_pose(from, c, (double)j / pieces, pose);
+                memcpy(&xyz[3 * n], pose, 3 * sizeof *xyz);
+            }
         }
+        prev_comp = here;
         memcpy(from, c->end, sizeof from);
     }
     return n;
+}
+
+/* Marks the lines on which the compensation emitted moves; NULL when none (or no memory). */
+static unsigned char *comp_lines(const struct canon_prog *p, int *n)
+{
+    int maxl = 0, any = 0;
+    for (size_t k = 0; k < p->count; k++)
+        if (p->cmds[k].compensated && p->cmds[k].line > maxl)
+            maxl = p->cmds[k].line, any = 1;
+    unsigned char *m = any ? calloc((size_t)maxl + 1, 1) : NULL;
+    for (size_t k = 0; m && k < p->count; k++)
+        if (p->cmds[k].compensated && p->cmds[k].line >= 0)
+            m[p->cmds[k].line] = 1;
+    *n = maxl + 1;
+    return m;
 }
 
 /* Isometric view: u = (X - Y) cos 30, v = Z + (X + Y) sin 30, in place over n points. */
@@ -162,12 +195,14 @@ static void isometric(double *xyz, size_t n)
 static int path_plots(const char *dir, const struct canon_prog *path,
                       const struct canon_prog *contour, char *file, size_t flen)
 {
-    size_t cap = 1 + 32 * (path->count + (contour ? contour->count : 0));
+    size_t cap = 2 + 33 * (path->count + (contour ? contour->count : 0));
     double *a = malloc(3 * cap * sizeof *a), *b = malloc(3 * cap * sizeof *b);
-    int st = -1;
+    int st = -1, ncomp = 0;
+    unsigned char *comp = comp_lines(path, &ncomp);
     if (!a || !b)
         goto out;
-    size_t na = path_points(path, a, cap), nb = contour ? path_points(contour, b, cap) : 0;
+    size_t na = path_points(path, NULL, 0, a, cap);
+    size_t nb = contour && comp ? path_points(contour, comp, ncomp, b, cap) : 0;
     struct svg_series s[2] = {
         { "compensated tool path", a, a + 1, na, 3, "#1f77b4", 0, 0 },
         { "programmed contour", b, b + 1, nb, 3, "#d62728", 1, 0 },
@@ -183,7 +218,7 @@ static int path_plots(const char *dir, const struct canon_prog *path,
     snprintf(file, flen, "%s/toolpath_3d.svg", dir);
     st = svg_write_chart(file, &iso, s, nb ? 2 : 1);
 out:
-    free(a), free(b);
+    free(a), free(b), free(comp);
     return st;
 }
 

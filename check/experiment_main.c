@@ -76,6 +76,6 @@ int main(int argc, char **argv)
            "contour is cut with G1 and the tool centre on it.\n", EXP_WINDOW_MM, 1 / 400.0);
     extra(root);
     if (out)
-        printf("plots: %s/exp_run*_top.svg, %s/exp_run*_wall.svg\n", out, out);
+        printf("plots: %s/exp_run*_top.svg, _wall.svg, _3d.svg\n", out);
     return failed;
 }
