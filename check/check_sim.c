@@ -18,9 +18,11 @@ struct sim {
     double T;                          /* servo period, s */
     double inv_T;                      /* 1 / T, 1/s */
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
-    double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s */
+    double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s (the
+                                        * machine starts at rest: 0) */
+    double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
+    double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
-    int have_v;                        /* v0 valid (two set points seen) */
     int line;                          /* program line of the previous period */
     const char *file;
     double next_dev_s, next_cond_s;    /* machine time of the next scheduled measure */
@@ -28,12 +30,13 @@ struct sim {
 };
 
 /* Adds a leg limit problem (velocity or acceleration) at the current period. */
-static void leg_limit(struct sim *s, enum check_kind k, int leg, double value, double limit,
-                      double t_s)
+static void leg_limit(struct sim *s, const struct motion_out *out, enum check_kind k, int leg,
+                      double value, double limit)
 {
-    struct check_problem p = { .kind = k, .line = s->line, .leg = leg, .value = value,
+    double t_s = out->time_elapsed_s;
+    struct check_problem p = { .kind = k, .line = out->line, .leg = leg, .value = value,
                                .limit = limit, .time_s = t_s, .count = 1 };
-    snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
+    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
     const char *what = k == CHECK_LEG_VELOCITY ? "moves at" : "accelerates at";
     const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : "mm/s^2";
     const struct check_leg *lg = &s->r->leg[leg];
@@ -44,13 +47,13 @@ static void leg_limit(struct sim *s, enum check_kind k, int leg, double value, d
 }
 
 /* A leg beyond its length range at this period. */
-static void leg_out_of_range(struct sim *s, int i, double L, double t_s)
+static void leg_out_of_range(struct sim *s, const struct motion_out *out, int i, double L)
 {
     const struct check_leg *lg = &s->r->leg[i];
-    struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = s->line, .leg = i, .value = L,
-                               .time_s = t_s, .count = 1 };
+    struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = out->line, .leg = i,
+                               .value = L, .time_s = out->time_elapsed_s, .count = 1 };
     p.limit = L > lg->limit_max_mm ? lg->limit_max_mm : lg->limit_min_mm;
-    snprintf(p.file, sizeof p.file, "%s", s->file ? s->file : "");
+    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
     snprintf(p.message, sizeof p.message, "leg %d reaches %.3f mm, beyond its limit %.3f mm",
              i + 1, L, p.limit);
     check_add_problem(s->r, &p);
@@ -60,28 +63,20 @@ static void leg_out_of_range(struct sim *s, int i, double L, double t_s)
  * This runs every period: comparisons only, the reports are out of line. */
 static void legs_period(struct sim *s, const struct motion_out *out)
 {
-    double t = out->time_elapsed_s;
     for (int i = 0; i < s->nj; i++) {
         struct check_leg *lg = &s->r->leg[i];
         double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
         double av = fabs(v), aa = fabs(v - s->v0[i]) * s->inv_T;
-        if (L < lg->min_mm)
-            lg->min_mm = L;
-        if (L > lg->max_mm)
-            lg->max_mm = L;
+        lg->min_mm = L < lg->min_mm ? L : lg->min_mm;
+        lg->max_mm = L > lg->max_mm ? L : lg->max_mm;
+        lg->peak_vel_mm_s = av > lg->peak_vel_mm_s ? av : lg->peak_vel_mm_s;
+        lg->peak_acc_mm_s2 = aa > lg->peak_acc_mm_s2 ? aa : lg->peak_acc_mm_s2;
         if (L > lg->limit_max_mm || L < lg->limit_min_mm)
-            leg_out_of_range(s, i, L, t);
-        if (av > lg->peak_vel_mm_s) {
-            lg->peak_vel_mm_s = av;
-            if (av > lg->limit_vel_mm_s * (1 + LIMIT_SLACK))
-                leg_limit(s, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s, t);
-        } else if (av > lg->limit_vel_mm_s * (1 + LIMIT_SLACK)) {
-            leg_limit(s, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s, t);
-        }
-        if (s->have_v && aa > lg->peak_acc_mm_s2)
-            lg->peak_acc_mm_s2 = aa;
-        if (s->have_v && aa > lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK))
-            leg_limit(s, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2, t);
+            leg_out_of_range(s, out, i, L);
+        if (av > s->vel_thr[i])
+            leg_limit(s, out, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
+        if (aa > s->acc_thr[i])
+            leg_limit(s, out, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
         s->v0[i] = v;
     }
 }
@@ -177,6 +172,8 @@ static void leg_limits(struct sim *s)
             lg->limit_vel_mm_s = s->mc->drive_vel[i], lg->vel_key = "STEPGEN_MAXVEL";
         if (s->mc->drive_acc[i] > 0 && s->mc->drive_acc[i] < lg->limit_acc_mm_s2)
             lg->limit_acc_mm_s2 = s->mc->drive_acc[i], lg->acc_key = "STEPGEN_MAXACCEL";
+        s->vel_thr[i] = lg->limit_vel_mm_s * (1 + LIMIT_SLACK);
+        s->acc_thr[i] = lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK);
         lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
     }
 }
@@ -203,7 +200,6 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         st = motion_step(mc->motion, s.T, &out);
         r->periods++;
         legs_period(&s, &out);
-        s.have_v = 1;
         measures(&s, &out);
         if (o->trace && ++s.trace_count >= s.trace_every) {
             check_trace_add(o->trace, out.time_elapsed_s, s.nj, out.joint_pos, s.v0, out.pose);
