@@ -26,6 +26,7 @@ static double uniform(unsigned long long *s, double lo, double hi)
     return lo + (hi - lo) * (double)(*s >> 11) / 9007199254740992.0;
 }
 
+/* v limited to [lo, hi]. */
 static double clampd(double v, double lo, double hi) { return v < lo ? lo : v > hi ? hi : v; }
 
 /* A random walk of G1 X Y Z A B C moves inside the TMU working region (X, Y +-100 mm,
@@ -129,6 +130,7 @@ static int make_program(struct check_machine *mc, double target_s, struct canon_
     return 0;
 }
 
+/* The hour with its baselines, then the exhaustive baseline on a tenth of it. */
 int main(void)
 {
     char err[1024];

@@ -16,11 +16,13 @@ static const char *const kind_names[CHECK_KIND_COUNT] = {
     [CHECK_PLAN] = "plan",
 };
 
+/* JSON name of a problem kind. */
 const char *check_kind_name(enum check_kind k)
 {
     return k < CHECK_KIND_COUNT ? kind_names[k] : "unknown";
 }
 
+/* The default schedule (see check.h). */
 void check_opts_default(struct check_opts *o)
 {
     memset(o, 0, sizeof *o);
@@ -28,11 +30,13 @@ void check_opts_default(struct check_opts *o)
     o->condition_every_s = 0.500;
 }
 
+/* An empty result. */
 void check_result_init(struct check_result *r)
 {
     memset(r, 0, sizeof *r);
 }
 
+/* Frees the problem list. */
 void check_result_free(struct check_result *r)
 {
     free(r->problems);
@@ -40,6 +44,7 @@ void check_result_free(struct check_result *r)
     r->nproblems = r->capproblems = 0;
 }
 
+/* Adds or merges a problem (same kind, file, line and leg). */
 int check_add_problem(struct check_result *r, const struct check_problem *p)
 {
     for (size_t i = 0; i < r->nproblems; i++) {
@@ -91,6 +96,7 @@ static void result_header(struct check_machine *mc, const struct check_opts *o,
     snprintf(r->config, sizeof r->config, "%s", mc->ini);
 }
 
+/* Reach pass, plan, then the servo-rate pass. */
 int check_canon(struct check_machine *mc, const struct canon_prog *prog,
                 const struct check_opts *opts, struct check_result *r)
 {
@@ -128,6 +134,7 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
     return r->nproblems ? CHECK_ERR_VIOLATION : CHECK_OK;
 }
 
+/* Interprets the file, then check_canon(). */
 int check_program(struct check_machine *mc, const char *path, const struct check_opts *opts,
                   struct check_result *r)
 {

@@ -19,6 +19,7 @@ static const char *const status_text[CHECK_STATUS_COUNT] = {
     [CHECK_ERR_VIOLATION] = "the program has problems",
 };
 
+/* Text of a check status. */
 const char *check_strerror(int status)
 {
     if (status < 0 || status >= CHECK_STATUS_COUNT)
@@ -29,6 +30,7 @@ const char *check_strerror(int status)
 /* Formats into err and returns status (one-line error paths). */
 static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+/* Formats into err and returns status (one-line error paths). */
 static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
 {
     if (err && errlen) {
@@ -102,6 +104,7 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
     return CHECK_OK;
 }
 
+/* Reads the INI and builds kinematics (by name), motion and the interpreter settings. */
 int check_machine_open(const char *ini, struct check_machine **out, char *err, size_t errlen)
 {
     *out = NULL;
@@ -151,6 +154,7 @@ fail:
     return st;
 }
 
+/* Frees the machine and the interpreters its programs point into. */
 void check_machine_close(struct check_machine *mc)
 {
     if (!mc)
@@ -165,6 +169,7 @@ void check_machine_close(struct check_machine *mc)
     free(mc);
 }
 
+/* Accessors (borrowed pointers). */
 struct kins *check_machine_kins(struct check_machine *mc) { return mc->kins; }
 struct motion *check_machine_motion(struct check_machine *mc) { return mc->motion; }
 const struct motion_config *check_machine_motion_config(const struct check_machine *mc)
@@ -172,11 +177,13 @@ const struct motion_config *check_machine_motion_config(const struct check_machi
     return &mc->mcfg;
 }
 
+/* [JOINT_n] SCALE, steps per mm. */
 double check_machine_scale(const struct check_machine *mc, int joint)
 {
     return joint >= 0 && joint < KINS_MAX_JOINTS ? mc->scale[joint] : 0;
 }
 
+/* Effective radius of a tool from the tool table, mm. */
 double check_machine_tool_radius(struct check_machine *mc, int tool)
 {
     double r;
@@ -219,12 +226,14 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
     return st;
 }
 
+/* Interprets a program file. */
 int check_machine_interpret(struct check_machine *mc, const char *path, struct canon_prog *prog,
                             struct check_problem *pb)
 {
     return interpret(mc, path, NULL, 0, prog, pb);
 }
 
+/* Interprets G-code held in memory. */
 int check_machine_interpret_text(struct check_machine *mc, const char *name, const char *text,
                                  size_t len, struct canon_prog *prog, struct check_problem *pb)
 {

@@ -13,11 +13,13 @@ static const char *const leg_colors[KINS_MAX_JOINTS] = {
     "#bcbd22",
 };
 
+/* An empty trace. */
 void check_trace_init(struct check_trace *t)
 {
     memset(t, 0, sizeof *t);
 }
 
+/* Frees the trace's arrays. */
 void check_trace_free(struct check_trace *t)
 {
     free(t->t_s), free(t->legs_mm), free(t->rates_mm_s), free(t->pose);
@@ -25,6 +27,7 @@ void check_trace_free(struct check_trace *t)
     check_trace_init(t);
 }
 
+/* Chooses the decimation for about CHECK_TRACE_POINTS samples. */
 long check_trace_begin(struct check_trace *t, double planned_s, double period_s)
 {
     long periods = (long)(planned_s / period_s) + 1;
@@ -43,6 +46,7 @@ static int grow(double **a, size_t cap, size_t width)
     return 0;
 }
 
+/* Keeps one period's legs, rates and pose. */
 void check_trace_add(struct check_trace *t, double t_s, int nj, const double *legs,
                      const double *rates, const double *pose)
 {
@@ -63,6 +67,7 @@ void check_trace_add(struct check_trace *t, double t_s, int nj, const double *le
     t->n++;
 }
 
+/* Keeps one deviation measure (halving the kept ones when there are too many). */
 void check_trace_deviation(struct check_trace *t, double dist_mm, double t_s, double dev_mm)
 {
     if (++t->dev_count < t->dev_every)
@@ -103,6 +108,7 @@ static size_t number_len(const char *s, size_t left)
     return i > d ? i : 0;
 }
 
+/* G141/G142 -> G1, W and D words blanked, same length and lines (errors keep their columns). */
 char *check_strip_compensation(const char *text, size_t len)
 {
     char *o = malloc(len + 1);
@@ -275,6 +281,7 @@ static int deviation_plot(const char *dir, const struct check_trace *t,
     return st;
 }
 
+/* All the check's plots into dir. */
 int check_write_plots(const char *dir, const struct canon_prog *path,
                       const struct canon_prog *contour, const struct check_trace *trace,
                       const struct check_result *r, char *err, size_t errlen)

@@ -80,6 +80,7 @@ static void json_problems(const struct check_result *r, FILE *f)
     fputc(']', f);
 }
 
+/* One JSON object (docs/verification.md has the schema). */
 void check_print_json(const struct check_result *r, FILE *f)
 {
     fputs("{\"program\":", f);
@@ -127,6 +128,7 @@ static void print_duration(FILE *f, double s)
         fprintf(f, "%.3f s", s);
 }
 
+/* The short table for people. */
 void check_print_table(const struct check_result *r, FILE *f)
 {
     fprintf(f, "check %s on %s\n", r->program, r->config);

@@ -16,6 +16,7 @@ struct arc_geom {
     double r0, r1, h0, h1, sweep_rad;
 };
 
+/* Dot product of two 3-vectors. */
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Builds the arc frame: e1 towards the start, e2 = n x e1, the signed sweep (canon.h rules). */
@@ -49,6 +50,7 @@ static void arc_geom(const double from[KINS_POSE_DIM], const struct canon_cmd *c
     }
 }
 
+/* Pose along a move: linear in all six axes, on the arc/helix for arcs. */
 void check_move_pose(const double from[KINS_POSE_DIM], const struct canon_cmd *c, double u,
                      double pose[KINS_POSE_DIM])
 {
@@ -147,6 +149,7 @@ static void scan_move(struct check_machine *mc, const double from[KINS_POSE_DIM]
         leg_problem(mc, c, CHECK_LEG_RANGE, wpose, wL, r);
 }
 
+/* The reach pass over every move of the program. */
 int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r)
 {

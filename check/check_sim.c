@@ -178,6 +178,7 @@ static void leg_limits(struct sim *s)
     }
 }
 
+/* Steps motion at the servo period to the program's end, measuring as it goes. */
 int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
                    const struct check_opts *o, struct check_result *r)
 {

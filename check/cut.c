@@ -11,11 +11,13 @@
 #define SETTLE_PERIODS 50    /* periods after the program end for the drives to arrive */
 #define DEG (M_PI / 180.0)
 
+/* An empty path. */
 void cut_path_init(struct cut_path *p)
 {
     memset(p, 0, sizeof *p);
 }
 
+/* Frees the samples. */
 void cut_path_free(struct cut_path *p)
 {
     free(p->s);
@@ -32,6 +34,7 @@ static void rotation(const double pose[KINS_POSE_DIM], double R[3][3])
     R[2][0] = -sb, R[2][1] = cb * sa, R[2][2] = cb * ca;
 }
 
+/* Tool tip in the platform (workpiece) frame. */
 int cut_tip_in_workpiece(struct check_machine *mc, const double pose[KINS_POSE_DIM],
                          double tip[3])
 {
@@ -106,6 +109,7 @@ static int machine_period(struct check_machine *mc, struct stepgen_state *sg,
     return CHECK_OK;
 }
 
+/* Runs the program period by period and keeps the tool in the workpiece frame. */
 int cut_simulate(struct check_machine *mc, const struct canon_prog *prog, struct cut_path *path,
                  char *err, size_t errlen)
 {
@@ -159,6 +163,7 @@ int cut_simulate(struct check_machine *mc, const struct canon_prog *prog, struct
     return st;
 }
 
+/* Dot product of two 3-vectors. */
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Furthest point along n of the station line b + u n inside the cylinder (tip c, unit axis a,
@@ -180,6 +185,7 @@ static double reach(const double b[3], const double n[3], const double c[3], con
     return (-B + sqrt(disc)) / (2 * A);
 }
 
+/* Furthest reach of all swept cylinders along n at one station. */
 double cut_wall_at(const struct cut_path *p, const struct cut_wall *w, double s_mm)
 {
     double b[3], best = -HUGE_VAL;
@@ -210,6 +216,7 @@ double cut_wall_at(const struct cut_path *p, const struct cut_wall *w, double s_
     return best > -HUGE_VAL ? best : (double)NAN;
 }
 
+/* The wall read over a short length around a station. */
 double cut_wall_mean(const struct cut_path *p, const struct cut_wall *w, double s_mm,
                      double half_mm, int n)
 {

@@ -25,6 +25,7 @@ static const struct exp_run_def runs[] = {
       { { -80, -20 }, { -30, 20 } }, { 8.0, 7.7, 7.9, 8.1 } },
 };
 
+/* The run table. */
 const struct exp_run_def *exp_runs(int *count)
 {
     *count = (int)(sizeof runs / sizeof runs[0]);
@@ -38,6 +39,7 @@ static int contour_at(struct check_machine *mc, const struct exp_run_def *d, dou
     return cut_tip_in_workpiece(mc, pose, p);
 }
 
+/* Wall frame of a run: origin, along, into the material, top face, reference line. */
 int exp_wall_frame(struct check_machine *mc, const struct exp_run_def *d, struct cut_wall *w)
 {
     double a[3], b[3], len = 0;
@@ -109,6 +111,7 @@ static char *nocomp_text(const char *path)
 static int run_plots(const char *dir, const struct exp_run_def *d, const struct cut_wall *w,
                      const struct cut_path *a, const struct cut_path *b, const double st[4]);
 
+/* Cuts a run with and without compensation and reads the four stations. */
 int exp_run(const char *root, const struct exp_run_def *d, const char *plot_dir,
             struct exp_result *res, char *err, size_t errlen)
 {
@@ -210,6 +213,7 @@ static int iso_plot(const char *dir, const struct exp_run_def *d, const struct c
     return rc;
 }
 
+/* Writes a run's plots. */
 static int run_plots(const char *dir, const struct exp_run_def *d, const struct cut_wall *w,
                      const struct cut_path *a, const struct cut_path *b, const double st[4])
 {

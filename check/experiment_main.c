@@ -38,6 +38,7 @@ static void extra(const char *root)
     }
 }
 
+/* Runs every experiment and prints the table; argv[1]: folder for the plots. */
 int main(int argc, char **argv)
 {
     const char *root = getenv("HEXCNC_ROOT"), *out = argc > 1 ? argv[1] : NULL;

@@ -78,10 +78,12 @@ static void fit_frame(struct frame *fr, int equal)
     }
 }
 
+/* Data x to drawing x, px. */
 static double px(const struct frame *fr, double x)
 {
     return fr->px0 + (x - fr->x0) / (fr->x1 - fr->x0) * (fr->px1 - fr->px0);
 }
+/* Data y to drawing y, px (SVG y grows downwards). */
 static double py(const struct frame *fr, double y)
 {
     return fr->py1 - (y - fr->y0) / (fr->y1 - fr->y0) * (fr->py1 - fr->py0);
@@ -163,6 +165,7 @@ static void legend(FILE *f, const struct frame *fr, const struct svg_series *s, 
     }
 }
 
+/* Writes one chart: frame, grid, ticks, labels, series, legend. */
 int svg_write_chart(const char *path, const struct svg_chart *c, const struct svg_series *s,
                     int ns)
 {

@@ -312,6 +312,7 @@ START_TEST(test_strip_compensation)
 }
 END_TEST
 
+/* The test cases. */
 static Suite *suite(void)
 {
     Suite *s = suite_create("check");
@@ -334,6 +335,7 @@ static Suite *suite(void)
     return s;
 }
 
+/* Runs the suite; non-zero when a test failed. */
 int main(void)
 {
     SRunner *sr = srunner_create(suite());

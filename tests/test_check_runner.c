@@ -54,6 +54,7 @@ START_TEST(test_check_agrees_with_run)
 }
 END_TEST
 
+/* The test case. */
 static Suite *suite(void)
 {
     Suite *s = suite_create("check_runner");
@@ -64,6 +65,7 @@ static Suite *suite(void)
     return s;
 }
 
+/* Runs the suite; non-zero when a test failed. */
 int main(void)
 {
     SRunner *sr = srunner_create(suite());

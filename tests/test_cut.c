@@ -111,6 +111,7 @@ START_TEST(test_untilted_head_breaks_coincidence)
 }
 END_TEST
 
+/* The test cases. */
 static Suite *suite(void)
 {
     Suite *s = suite_create("cut");
@@ -125,6 +126,7 @@ static Suite *suite(void)
     return s;
 }
 
+/* Runs the suite; non-zero when a test failed. */
 int main(void)
 {
     SRunner *sr = srunner_create(suite());

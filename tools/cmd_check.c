@@ -22,6 +22,7 @@ struct args {
     const char *ini, *program;
 };
 
+/* Options and the two paths; -1 on a usage error. */
 static int parse_args(int argc, char **argv, struct args *a)
 {
     memset(a, 0, sizeof *a);
@@ -115,6 +116,7 @@ static int run_check(struct check_machine *mc, const struct args *a, struct chec
     return st;
 }
 
+/* hexcnc check: exit 0 clean, 1 problems, 2 the check could not run. */
 int cmd_check(int argc, char **argv)
 {
     struct args a;
