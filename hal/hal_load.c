@@ -249,7 +249,7 @@ static int hal_threads_load(struct hal *h, int argc, char **argv)
 {
     int made = 0;
     for (int i = 1; i <= 9; i++) {
-        char nk[16], pk[16];
+        char nk[24], pk[24];  /* "period" and any int fit */
         snprintf(nk, sizeof nk, "name%d", i);
         snprintf(pk, sizeof pk, "period%d", i);
         const char *name = hal_arg(argc, argv, nk), *per = hal_arg(argc, argv, pk);
