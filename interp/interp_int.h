@@ -52,7 +52,6 @@ struct interp {
     struct tooltable *tt;        /* tool table or NULL (not owned) */
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
-    int started;                 /* a run has happened (pos is valid) */
 
     /* where we are in the program */
     char file[256];
