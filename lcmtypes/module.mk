@@ -28,7 +28,7 @@ HAL_COMPS += lcm_status
 TESTS += test_lcm_ring test_lcm_status
 
 # UDP multicast in a network namespace: tests/lcm/udpm.sh with its checker program.
-SCRIPT_TESTS += tests/lcm/udpm.sh
+SCRIPT_TESTS += tests/lcm/udpm.sh tests/lcm/sim_run.sh
 LCM_CHECK := $(BUILD)/tests/lcm/lcm_check
 $(LCM_CHECK): tests/lcm/lcm_check.c $(LIBDIR)/libhexcnc.a | $(GEN_HDRS)
 	@mkdir -p $(@D)

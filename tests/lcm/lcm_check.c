@@ -3,7 +3,9 @@
  *
  *   lcm_check LOG COUNT                 the log holds exactly COUNT status messages, right
  *   lcm_check --listen URL COUNT MS     COUNT status messages arrive within MS ms
+ *   lcm_check --run LOG PERIOD_MS       a log of `hexcnc run` on the simulated machine
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -121,8 +123,64 @@ static int listen_url(const char *url, int count, int ms, struct check *c)
     return 0;
 }
 
+/* A program run on the simulated machine: samples on the PERIOD_MS grid of machine time,
+ * numbered 0, 1, 2, ...; running (state 1) on a program line; feedback within 0.01 mm (and
+ * deg) of the command, which moves. Returns the number of status messages, or -1. */
+static int check_run(const char *path, int period_ms, struct check *c)
+{
+    lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
+    if (!log) {
+        snprintf(c->error, sizeof c->error, "cannot read the LCM log %s", path);
+        return -1;
+    }
+    lcm_eventlog_event_t *ev;
+    double first_x = NAN, moved = 0;
+    while ((ev = lcm_eventlog_read_next_event(log)) && !c->error[0]) {
+        hexcnc_status_t m;
+        if (!strcmp(ev->channel, "HEXCNC_STATUS") &&
+            hexcnc_status_t_decode(ev->data, 0, (int)ev->datalen, &m) >= 0) {
+            int64_t want_ms = m.seq == 0 ? 1 : (int64_t)period_ms * m.seq;
+            double worst = 0;
+            for (int i = 0; i < 6; i++) {
+                worst = fmax(worst, fabs(m.pose_cmd[i] - m.pose_fb[i]));
+                worst = fmax(worst, fabs(m.leg_cmd_mm[i] - m.leg_fb_mm[i]));
+                worst = fmax(worst, fabs(m.ferror_mm[i]));
+            }
+            if (isnan(first_x))
+                first_x = m.pose_cmd[0];
+            moved = fmax(moved, fabs(m.pose_cmd[0] - first_x));
+            if (m.seq != c->last_seq + 1 || m.machine_time_ns != want_ms * 1000000)
+                snprintf(c->error, sizeof c->error, "sample %lld at %lld ns after %lld",
+                         (long long)m.seq, (long long)m.machine_time_ns, (long long)c->last_seq);
+            else if (m.state != 1 || m.line <= 0 || worst > 0.01 || m.fault_flags)
+                snprintf(c->error, sizeof c->error, "sample %lld: state %d line %d, feedback "
+                         "%g from command, faults '%s'", (long long)m.seq, (int)m.state,
+                         (int)m.line, worst, m.fault_text);
+            c->last_seq = m.seq;
+            c->status++;
+            hexcnc_status_t_decode_cleanup(&m);
+        }
+        lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(log);
+    if (!c->error[0] && (c->status < 2 || moved < 1.0))
+        snprintf(c->error, sizeof c->error, "%d status messages, X moved %g mm", c->status,
+                 moved);
+    return c->error[0] ? -1 : c->status;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && !strcmp(argv[1], "--run")) {
+        struct check c = { .last_seq = -1 };
+        if (check_run(argv[2], atoi(argv[3]), &c) < 0) {
+            printf("FAIL %s: %s\n", argv[2], c.error);
+            return 1;
+        }
+        printf("ok   %s: %d status messages of a program run, on the machine-time grid, "
+               "feedback following the command\n", argv[2], c.status);
+        return 0;
+    }
     struct check c = { .last_seq = -1 };
     int count, st;
     const char *what;
@@ -135,7 +193,8 @@ int main(int argc, char **argv)
         what = argv[1];
         st = read_log(argv[1], &c);
     } else {
-        fprintf(stderr, "usage: lcm_check LOG COUNT | lcm_check --listen URL COUNT MS\n");
+        fprintf(stderr, "usage: lcm_check LOG COUNT | lcm_check --listen URL COUNT MS | "
+                "lcm_check --run LOG PERIOD_MS\n");
         return 2;
     }
     if (st == 0 && !c.error[0] && c.status != count)
