@@ -106,8 +106,9 @@ static int listen_url(const char *url, int count, int ms, struct check *c)
         snprintf(c->error, sizeof c->error, "cannot open %s", url);
         return -1;
     }
-    hexcnc_status_t_subscribe(lcm, "HEXCNC_STATUS", on_status, c);
-    hexcnc_event_t_subscribe(lcm, "HEXCNC_EVENT", on_event, c);
+    hexcnc_status_t_subscription_t *ss =
+        hexcnc_status_t_subscribe(lcm, "HEXCNC_STATUS", on_status, c);
+    hexcnc_event_t_subscription_t *se = hexcnc_event_t_subscribe(lcm, "HEXCNC_EVENT", on_event, c);
     printf("lcm_check: listening on %s\n", url);
     fflush(stdout);
     struct timespec t0, t;
@@ -119,6 +120,8 @@ static int listen_url(const char *url, int count, int ms, struct check *c)
             break;
         lcm_handle_timeout(lcm, (int)(left < 100 ? left : 100));
     }
+    hexcnc_status_t_unsubscribe(lcm, ss);
+    hexcnc_event_t_unsubscribe(lcm, se);
     lcm_destroy(lcm);
     return 0;
 }
