@@ -181,8 +181,12 @@ int main(void)
     }
     printf("push of a %d-byte sample into %d slots while another thread drains, %ld pushes "
            "x 3 (timing included)\n", SLOT_BYTES, RING_SLOTS, ITEMS);
-    printf("  lock-free SPSC    %8.1f ns mean, longest %8.1f us\n", lf_mean, lf_max * 1e-3);
-    printf("  mutex baseline    %8.1f ns mean, longest %8.1f us\n", lk_mean, lk_max * 1e-3);
-    printf("  ratio             %8.2f mean, %8.2f longest\n", lf_mean / lk_mean, lf_max / lk_max);
+    printf("  lock-free SPSC    %8.1f ns mean\n", lf_mean);
+    printf("  mutex baseline    %8.1f ns mean\n", lk_mean);
+    printf("  ratio             %8.2f\n", lf_mean / lk_mean);
+    /* Without SCHED_FIFO the longest push is this thread being preempted, for both queues:
+     * printed so that it is not mistaken for a property of either. */
+    printf("  longest push      %8.1f us lock-free, %8.1f us mutex (preemption of this "
+           "normal-priority thread)\n", lf_max * 1e-3, lk_max * 1e-3);
     return 0;
 }
