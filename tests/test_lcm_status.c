@@ -392,6 +392,30 @@ START_TEST(test_realtime_decimates)
 }
 END_TEST
 
+/* Real time at a rate far below the servo rate: 500 samples per publish period go through a
+ * ring of 256 without loss, because the publisher empties it at every look (at most 10 ms
+ * apart), not once per publish period. */
+START_TEST(test_realtime_slow_rate)
+{
+    struct hal *h = hal_create();
+    cmd(h, "newthread servo-thread 1000000");
+    cmd(h, "loadrt lcm-status url=memq:// rate=2 ring=256");
+    cmd(h, "addf lcm-status.sample servo-thread");
+    ck_assert_int_eq(hal_start(h), HAL_OK);
+    struct timespec ts = { 0, 700000000 };
+    nanosleep(&ts, NULL);
+    ck_assert_int_eq(hal_stop(h), HAL_OK);
+    ck_assert_int_eq(lcm_status_flush(h, 5000), LCM_STATUS_OK);
+    struct lcm_status_stats st;
+    lcm_status_get_stats(h, &st);
+    ck_assert_uint_gt(st.samples, 256);
+    ck_assert_uint_eq(st.samples_dropped, 0);
+    ck_assert_uint_ge(st.status_sent, 1);
+    ck_assert_uint_le(st.status_sent, 3);
+    hal_destroy(h);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("lcm_status");
@@ -403,6 +427,7 @@ int main(void)
     tcase_add_test(tc, test_bad_args);
     tcase_add_test(tc, test_full_ring_drops);
     tcase_add_test(tc, test_realtime_decimates);
+    tcase_add_test(tc, test_realtime_slow_rate);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -145,40 +145,56 @@ static void lcm_pub_losses(struct lcm_status *s, const struct lcm_clock *c,
     }
 }
 
+/* The publisher's own state between looks at the rings. */
+struct lcm_pub {
+    struct lcm_clock c;
+    struct lcm_sample newest;       /* real time: the newest sample not yet published */
+    bool have;                      /* newest holds one */
+    uint64_t seen_s, seen_e;        /* losses already reported */
+};
+
 /* Takes everything out of both rings. Simulated clock: every sample is sent (the servo side
- * has decimated by machine time). Real time: only the newest sample is sent. */
-static void lcm_pub_drain(struct lcm_status *s, struct lcm_clock *c, uint64_t *seen_s,
-                          uint64_t *seen_e)
+ * has decimated by machine time). Real time: the newest sample is kept for the next publish
+ * period (lcm_pub_newest); the ring is still emptied at every look, so a slow rate never
+ * fills it. Fault edges and events are sent at once. */
+static void lcm_pub_drain(struct lcm_status *s, struct lcm_pub *ps)
 {
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
-    c->mono_ns = lcm_mono_ns();
-    c->wall_us = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+    ps->c.mono_ns = lcm_mono_ns();
+    ps->c.wall_us = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 
-    struct lcm_sample newest;
-    bool have = false;
     const struct lcm_sample *p;
     while ((p = ring_spsc_peek(&s->samples))) {
-        c->last_t_ns = p->t_ns;
+        ps->c.last_t_ns = p->t_ns;
         if (p->kind == LCM_SLOT_EDGE) {
-            lcm_pub_edges(s, p, c);
+            lcm_pub_edges(s, p, &ps->c);
         } else if (p->sim) {
-            lcm_pub_status(s, p, c);
+            lcm_pub_status(s, p, &ps->c);
         } else {
-            newest = *p;
-            have = true;
+            ps->newest = *p;
+            ps->have = true;
         }
         ring_spsc_release(&s->samples);
     }
-    if (have)
-        lcm_pub_status(s, &newest, c);
-    atomic_store(&s->samples_done, ring_spsc_popped(&s->samples));
+    /* A kept sample is not done until it is published (lcm_status_flush waits for it). */
+    atomic_store(&s->samples_done, ring_spsc_popped(&s->samples) - (ps->have ? 1 : 0));
 
     struct lcm_event_slot e;
     while (ring_mpsc_pop(&s->events, &e))
-        lcm_pub_event(s, &e, c);
-    lcm_pub_losses(s, c, seen_s, seen_e);
+        lcm_pub_event(s, &e, &ps->c);
+    lcm_pub_losses(s, &ps->c, &ps->seen_s, &ps->seen_e);
     atomic_store(&s->events_done, ring_mpsc_popped(&s->events));
+}
+
+/* Real time, once per publish period: the newest sample, if one came since the last. */
+static void lcm_pub_newest(struct lcm_status *s, struct lcm_pub *ps)
+{
+    if (!ps->have)
+        return;
+    lcm_pub_status(s, &ps->newest, &ps->c);
+    ps->have = false;
+    atomic_store(&s->samples_done, ring_spsc_popped(&s->samples));
 }
 
 /* Sleeps until the absolute CLOCK_MONOTONIC time t_ns. */
@@ -189,25 +205,28 @@ static void lcm_sleep_until(int64_t t_ns)
     }
 }
 
-/* The publisher thread: in real time, a drain every publish period; on the simulated clock
- * every LCM_SIM_POLL_NS; after stop, one last drain so nothing pushed is lost. */
+/* The publisher thread: it empties the rings every LCM_PUB_TICK_NS at most (on the simulated
+ * clock every LCM_SIM_POLL_NS) and, in real time, publishes the newest sample once per
+ * publish period. After stop, one last drain and publish, so nothing taken is lost. */
 static void *lcm_pub_main(void *arg)
 {
     struct lcm_status *s = arg;
-    uint64_t seen_s = 0, seen_e = 0;
-    struct lcm_clock c = { 0, 0, 0 };
+    struct lcm_pub ps;
+    memset(&ps, 0, sizeof ps);
     int64_t next_pub = lcm_mono_ns() + s->period_ns;
     for (;;) {
         bool stop = atomic_load(&s->stop);
         bool sim = atomic_load(&s->sim);
         int64_t now = lcm_mono_ns();
-        if (stop || sim || now >= next_pub) {
-            lcm_pub_drain(s, &c, &seen_s, &seen_e);
-            if (stop)
-                return NULL;
+        lcm_pub_drain(s, &ps);
+        if (stop || now >= next_pub)
+            lcm_pub_newest(s, &ps);
+        if (stop)
+            return NULL;
+        if (now >= next_pub) {
             /* Keep the phase; after a long stall start again from now. */
             next_pub += s->period_ns;
-            if (next_pub < now)
+            if (next_pub <= now)
                 next_pub = now + s->period_ns;
         }
         int64_t wake = sim ? now + LCM_SIM_POLL_NS : next_pub;
