@@ -6,35 +6,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "common/plugin_dirs.h"
 #include "hal/hal_priv.h"
 #include "kins/kins.h"
-
-#ifndef HEXCNC_PREFIX
-#define HEXCNC_PREFIX "/usr/local"
-#endif
-
-#define HAL_PLUGIN_DIRS 3
-
-/* The plugin folders, in search order: $HEXCNC_PLUGIN_DIR, <exe dir>/../lib, the prefix. */
-static int hal_plugin_dirs(char dirs[HAL_PLUGIN_DIRS][PATH_MAX])
-{
-    int n = 0;
-    const char *env = getenv("HEXCNC_PLUGIN_DIR");
-    if (env && *env)
-        snprintf(dirs[n++], PATH_MAX, "%s", env);
-    char exe[PATH_MAX];
-    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (len > 0) {
-        exe[len] = '\0';
-        char *slash = strrchr(exe, '/');
-        if (slash) {
-            *slash = '\0';
-            snprintf(dirs[n++], PATH_MAX, "%.*s/../lib", PATH_MAX - 8, exe);
-        }
-    }
-    snprintf(dirs[n++], PATH_MAX, "%s/lib/hexcnc", HEXCNC_PREFIX);
-    return n;
-}
 
 /* Runs a type's load inside a component record; a failure unwinds what it registered. */
 static int hal_load_type(struct hal *h, const struct hal_comp_type *t, int argc, char **argv)
@@ -149,12 +123,12 @@ int hal_loadrt(struct hal *h, const char *name, int argc, char **argv)
         return hal_load_type(h, t, argc, argv);
     if (!*name || strlen(name) > 64 || strchr(name, '/'))
         return hal_error(h, HAL_ERR_ARG, "loadrt: '%s' is not a component name", name);
-    char dirs[HAL_PLUGIN_DIRS][PATH_MAX];
-    char tried[HAL_PLUGIN_DIRS * (PATH_MAX + 2)] = "";
-    int ndirs = hal_plugin_dirs(dirs);
+    char dirs[PLUGIN_DIRS_MAX][PATH_MAX];
+    char tried[PLUGIN_DIRS_MAX * (PATH_MAX + 2)] = "";
+    int ndirs = plugin_dirs(dirs, "hal");
     for (int i = 0; i < ndirs; i++) {
         char path[PATH_MAX + 80];
-        if (snprintf(path, sizeof path, "%s/hal/%s.so", dirs[i], name) >= (int)sizeof path)
+        if (snprintf(path, sizeof path, "%s/%s.so", dirs[i], name) >= (int)sizeof path)
             continue;
         int st = hal_load_plugin(h, path, name, &t);
         if (st == HAL_OK)

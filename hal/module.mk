@@ -2,8 +2,6 @@
 # generic built-in components.
 LIB_SRCS += hal/hal_core.c hal/hal_map.c hal/hal_pin.c hal/hal_value.c hal/hal_funct.c hal/hal_rt.c \
             hal/hal_ini.c hal/hal_load.c hal/hal_cmd.c hal/hal_file.c hal/hal_show.c
-# Plugins are searched for last under the install prefix.
-$(BUILD)/hal/hal_load.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
 
 # Built-in generic components (hal/components/motion.c adds itself elsewhere).
 LIB_SRCS += hal/components/kins.c hal/components/logic.c hal/components/stream.c

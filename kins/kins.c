@@ -7,10 +7,8 @@
 #include <unistd.h>
 
 #include "kins/kins.h"
+#include "common/plugin_dirs.h"
 
-#ifndef HEXCNC_PREFIX
-#define HEXCNC_PREFIX "/usr/local"
-#endif
 
 /* Longest model name accepted: keeps every path and symbol in fixed buffers. */
 #define KINS_NAME_MAX 64
@@ -60,22 +58,6 @@ int kins_create(const struct kins_ops *ops, const struct kins_config *cfg, struc
     k->plugin_handle = NULL;
     *out = k;
     return KINS_OK;
-}
-
-/* Writes <dir of /proc/self/exe>/../lib/kins into buf; 0 on success. */
-static int kins_exe_plugin_dir(char *buf, size_t len)
-{
-    char exe[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0)
-        return -1;
-    exe[n] = '\0';
-    char *slash = strrchr(exe, '/');
-    if (!slash)
-        return -1;
-    *slash = '\0';
-    int w = snprintf(buf, len, "%s/../lib/kins", exe);
-    return w < 0 || (size_t)w >= len ? -1 : 0;
 }
 
 /* Appends text to the list of tried paths kept for the error message. */
@@ -140,14 +122,8 @@ const struct kins_ops *kins_find(const char *name, void **handle, char *err, siz
         if (*c == '-')
             *c = '_';
 
-    char dirs[3][PATH_MAX];
-    int ndirs = 0;
-    const char *env = getenv("HEXCNC_PLUGIN_DIR");
-    if (env && *env)
-        snprintf(dirs[ndirs++], PATH_MAX, "%s/kins", env);
-    if (kins_exe_plugin_dir(dirs[ndirs], PATH_MAX) == 0)
-        ndirs++;
-    snprintf(dirs[ndirs++], PATH_MAX, "%s/lib/hexcnc/kins", HEXCNC_PREFIX);
+    char dirs[PLUGIN_DIRS_MAX][PATH_MAX];
+    int ndirs = plugin_dirs(dirs, "kins");
 
     char tried[2048] = "";
     for (int i = 0; i < ndirs; i++) {

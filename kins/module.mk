@@ -8,8 +8,6 @@ LIB_SRCS += kins/kins.c kins/kins_cfg.c kins/hexapod.c kins/hexapod_fwd.c kins/h
 LIB_CXXSRCS += kins/kins_svd.cpp
 PLUGINS += $(LIBDIR)/kins/hexapod.so $(LIBDIR)/kins/trivial.so
 
-# The loader's last search place is the install prefix.
-$(BUILD)/kins/kins.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
 
 # Each plugin binds its own symbols first (-Bsymbolic), so a program that also links the
 # same model statically never mixes the two copies; --no-undefined keeps the .so complete.
