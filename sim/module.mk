@@ -21,4 +21,7 @@ run: all
 	    echo; echo "== examples/paper/$$p.ngc"; \
 	    $(RUN_ENV) sh scripts/hexcnc-start configs/sim/tmu-hexapod.ini \
 	        examples/paper/$$p.ngc || exit $$?; \
-	done
+	    mkdir -p $(BUILD)/plots/$$p; \
+	    $(RUN_ENV) $(HEXCNC) check --plot $(BUILD)/plots/$$p configs/sim/tmu-hexapod.ini \
+	        examples/paper/$$p.ngc > $(BUILD)/plots/$$p/check.txt || exit $$?; \
+	done; echo; echo "plots (contour vs tool path, legs, deviation): $(BUILD)/plots/*/*.svg"
