@@ -69,6 +69,9 @@ int hal_ini_int(struct hal *h, const char *section, const char *key, long def, l
 /* The INI file's path and folder (for relative paths in it), or NULL before hal_load_ini. */
 const char *hal_ini_path(const struct hal *h);
 const char *hal_ini_dir(const struct hal *h);
+/* The INI file itself (common/inifile.h), for the line of a key in messages. */
+struct inifile;
+const struct inifile *hal_ini_file(const struct hal *h);
 
 /* ---- components ------------------------------------------------------------------------ */
 

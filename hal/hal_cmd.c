@@ -50,13 +50,13 @@ static int hal_substitute(struct hal *h, const char *in, char *out, size_t len)
         char sec[HAL_NAME_MAX], key[HAL_NAME_MAX];
         snprintf(sec, sizeof sec, "%.*s", (int)sl, c + 1);
         snprintf(key, sizeof key, "%.*s", (int)kl, c + 2 + sl);
-        if (!h->ini_path)
+        if (!hal_ini_path(h))
             return hal_error(h, HAL_ERR_NOT_FOUND, "[%s]%s: no INI file is loaded (give one "
                              "with -i CONFIG.ini)", sec, key);
         const char *v = hal_ini_get(h, sec, key);
         if (!v)
             return hal_error(h, HAL_ERR_NOT_FOUND, "[%s]%s: no such key in %s", sec, key,
-                             h->ini_path);
+                             hal_ini_path(h));
         size_t vl = strlen(v);
         if (n + vl + 1 >= len)
             return hal_error(h, HAL_ERR_SYNTAX, "line longer than %zu characters", len);

@@ -1,6 +1,5 @@
-/* hal_ini.c: the INI file (libinih), every entry kept in order, and typed readers. */
+/* hal_ini.c: the runtime's INI file (common/inifile.c) and typed readers. */
 #include <errno.h>
-#include <ini.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -9,131 +8,47 @@
 /* Frees the INI entries and paths. */
 void hal_ini_free(struct hal *h)
 {
-    for (int i = 0; i < h->nini; i++) {
-        free(h->ini[i].section);
-        free(h->ini[i].key);
-        free(h->ini[i].value);
-    }
-    free(h->ini);
-    free(h->ini_path);
-    free(h->ini_dir);
-    h->ini = NULL;
-    h->nini = h->capini = 0;
-    h->ini_path = h->ini_dir = NULL;
+    inifile_free(&h->ini);
 }
 
-/* libinih callback: keeps every entry, repeated keys included (ini_parse is told to go on). */
-static int hal_ini_handler(void *user, const char *section, const char *key, const char *value)
-{
-    struct hal *h = user;
-    if (h->nini == h->capini) {
-        int cap = h->capini ? h->capini * 2 : 64;
-        struct hal_ini_entry *v = realloc(h->ini, (size_t)cap * sizeof *v);
-        if (!v)
-            return 0;
-        h->ini = v;
-        h->capini = cap;
-    }
-    struct hal_ini_entry *e = &h->ini[h->nini];
-    e->section = hal_strdup(section);
-    e->key = hal_strdup(key);
-    e->value = hal_strdup(value);
-    e->lineno = 0;
-    if (!e->section || !e->key || !e->value) {
-        free(e->section);
-        free(e->key);
-        free(e->value);
-        return 0;
-    }
-    h->nini++;
-    return 1;
-}
-
-/* libinih (as Debian builds it) reads lines of at most INI_MAX_LINE - 1 characters and
- * parses the rest of a longer line as a line of its own; say so instead. Returns the first
- * too-long line's number, 0 if none, -1 if the file cannot be opened. */
-static int hal_ini_long_line(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return -1;
-    char *line = NULL;
-    size_t cap = 0;
-    ssize_t n;
-    int lineno = 0, bad = 0;
-    while (!bad && (n = getline(&line, &cap, f)) >= 0) {
-        lineno++;
-        while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
-            n--;
-        if (n >= INI_MAX_LINE - 1)
-            bad = lineno;
-    }
-    free(line);
-    fclose(f);
-    return bad;
-}
-
-/* Reads an INI file, replacing any read before. */
+/* Reads an INI file, replacing any read before (common/inifile.c: lines kept for messages). */
 int hal_load_ini(struct hal *h, const char *path)
 {
-    hal_ini_free(h);
-    errno = 0;
-    int longl = hal_ini_long_line(path);
-    if (longl == -1)
-        return hal_error(h, HAL_ERR_IO, "cannot open INI file '%s': %s", path,
-                         strerror(errno ? errno : ENOENT));
-    if (longl > 0)
-        return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: line longer than %d characters (the INI "
-                         "reader's limit)", path, longl, INI_MAX_LINE - 2);
-    errno = 0;
-    int r = ini_parse(path, hal_ini_handler, h);
-    if (r == -1)
-        return hal_error(h, HAL_ERR_IO, "cannot open INI file '%s': %s", path,
-                         strerror(errno ? errno : ENOENT));
-    if (r == -2) {
-        hal_ini_free(h);
-        return hal_error(h, HAL_ERR_NOMEM, "out of memory reading INI file '%s'", path);
-    }
-    if (r > 0) {
-        hal_ini_free(h);
-        return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: this line is not a [SECTION] header, a "
-                         "KEY = VALUE line or a comment", path, r);
-    }
-    h->ini_path = hal_strdup(path);
-    const char *slash = strrchr(path, '/');
-    h->ini_dir = slash ? strndup(path, (size_t)(slash - path + (slash == path))) : hal_strdup(".");
-    if (!h->ini_path || !h->ini_dir) {
-        hal_ini_free(h);
-        return hal_error(h, HAL_ERR_NOMEM, "out of memory reading INI file '%s'", path);
-    }
-    return HAL_OK;
+    char err[sizeof h->err];
+    int st = inifile_load(&h->ini, path, err, sizeof err);
+    if (st == INIFILE_OK)
+        return HAL_OK;
+    int hst = st == INIFILE_ERR_NOMEM ? HAL_ERR_NOMEM
+            : st == INIFILE_ERR_SYNTAX ? HAL_ERR_SYNTAX : HAL_ERR_IO;
+    return hal_error(h, hst, "%s", err);
 }
 
 /* The n-th occurrence of [section]key, or NULL. */
 const char *hal_ini_get_n(const struct hal *h, const char *section, const char *key, int n)
 {
-    for (int i = 0; i < h->nini; i++) {
-        const struct hal_ini_entry *e = &h->ini[i];
-        if (!strcmp(e->section, section) && !strcmp(e->key, key) && n-- == 0)
-            return e->value;
-    }
-    return NULL;
+    return inifile_get_n(&h->ini, section, key, n);
 }
 
 /* The first [section]key, or NULL. */
 const char *hal_ini_get(const struct hal *h, const char *section, const char *key)
 {
-    return hal_ini_get_n(h, section, key, 0);
+    return inifile_get(&h->ini, section, key);
 }
 
 const char *hal_ini_path(const struct hal *h)
 {
-    return h->ini_path;
+    return inifile_path(&h->ini);
 }
 
 const char *hal_ini_dir(const struct hal *h)
 {
-    return h->ini_dir;
+    return inifile_dir(&h->ini);
+}
+
+/* The INI file itself, for lines in messages (inifile_line, inifile_locate_msg). */
+const struct inifile *hal_ini_file(const struct hal *h)
+{
+    return &h->ini;
 }
 
 /* The value text, or NULL with out-of-band default handling left to the caller. */
@@ -142,7 +57,7 @@ static const char *hal_ini_value(struct hal *h, const char *section, const char 
     const char *v = hal_ini_get(h, section, key);
     if (!v)
         hal_error(h, HAL_ERR_NOT_FOUND, "%s: [%s]%s is missing",
-                  h->ini_path ? h->ini_path : "(no INI file)", section, key);
+                  hal_ini_path(h) ? hal_ini_path(h) : "(no INI file)", section, key);
     return v;
 }
 
@@ -157,8 +72,8 @@ int hal_ini_double(struct hal *h, const char *section, const char *key, double d
     errno = 0;
     double d = strtod(v, &end);
     if (end == v || *end || errno == ERANGE)
-        return hal_error(h, HAL_ERR_SYNTAX, "%s: [%s]%s = '%s' is not a number", h->ini_path,
-                         section, key, v);
+        return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a number",
+                         hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = d;
     return HAL_OK;
 }
@@ -174,8 +89,8 @@ int hal_ini_int(struct hal *h, const char *section, const char *key, long def, l
     errno = 0;
     long n = strtol(v, &end, 10);
     if (end == v || *end || errno == ERANGE)
-        return hal_error(h, HAL_ERR_SYNTAX, "%s: [%s]%s = '%s' is not a whole number",
-                         h->ini_path, section, key, v);
+        return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a whole number",
+                         hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = n;
     return HAL_OK;
 }

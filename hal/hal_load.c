@@ -66,12 +66,6 @@ static int hal_load_plugin(struct hal *h, const char *path, const char *name,
     return hal_register_type(h, t);
 }
 
-/* INI lookup for the kinematics model's configuration. */
-static const char *hal_kins_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 static void hal_kins_free_cb(void *k)
 {
     kins_free(k);
@@ -88,13 +82,14 @@ static int hal_load_kins(struct hal *h, const char *name, int argc, char **argv)
     if (hal_get_object(h, "kins"))
         return hal_error(h, HAL_ERR_EXISTS, "loadrt %s: a kinematics is already loaded; a "
                          "machine has one", name);
-    struct kins_config cfg = { hal_kins_get, h };
+    struct kins_config cfg = { inifile_config_get, &h->ini };
     struct kins *k = NULL;
-    char err[512];
+    char err[512], where[768];
     int kst = kins_load(name, &cfg, &k, err, sizeof err);
-    if (kst != KINS_OK)
+    if (kst != KINS_OK)   /* "[SECTION] KEY: ..." gets the INI file and the key's line */
         return hal_error(h, HAL_ERR_COMPONENT, "loadrt %s: %s", name,
-                         err[0] ? err : kins_strerror(kst));
+                         inifile_locate_msg(&h->ini, err[0] ? err : kins_strerror(kst), where,
+                                            sizeof where));
     int prev = h->owner;
     int id = hal_comp_begin(h, name);
     if (id < 0) {

@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stdarg.h>
 
+#include "common/inifile.h"
 #include "hal/hal.h"
 
 /* The value a pin, parameter or signal holds. */
@@ -111,11 +112,6 @@ struct hal_object {
     int owner;
 };
 
-struct hal_ini_entry {
-    char *section, *key, *value;
-    int lineno;
-};
-
 struct hal {
     char err[1024];                  /* last error message */
     bool err_located;                /* err already starts with file:line */
@@ -124,10 +120,7 @@ struct hal {
     struct hal_vec comp_list, cleanup_list, object_list, type_list;
     int owner;                       /* component id being loaded (0 = runtime) */
     int next_comp_id;
-    /* INI */
-    struct hal_ini_entry *ini;
-    int nini, capini;
-    char *ini_path, *ini_dir;
+    struct inifile ini;              /* the machine's INI file (empty before hal_load_ini) */
     /* files being sourced, innermost last (for relative paths and messages) */
     const char *source_stack[16];
     int source_depth;

@@ -248,6 +248,40 @@ START_TEST(kinematics_by_name_becomes_the_kins_component)
 }
 END_TEST
 
+/* A kinematics' own config error, through loadrt, names the INI file and the key's line. */
+START_TEST(kinematics_config_error_names_the_ini_line)
+{
+    void *dl = NULL;
+    char err[512];
+    if (!kins_find("hexapod", &dl, err, sizeof err)) {
+        fprintf(stderr, "test_hal_cmd: skipping loadrt of kinematics: %s\n", err);
+        return;
+    }
+    if (dl)
+        dlclose(dl);
+    char path[] = "/tmp/hexcnc-hal-kins-XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    FILE *f = fdopen(fd, "w");
+    fprintf(f, "[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\nPLATFORM_RADIUS = 300\n"
+               "BASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = 10\n");
+    for (int i = 0; i < 6; i++)
+        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\n", i, i == 3 ? "abc" : "980");
+    fclose(f);
+    struct hal *h = new_hal();
+    ck_assert_int_eq(hal_load_ini(h, path), HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "loadrt [KINS]KINEMATICS", "m.hal", 4, NULL),
+                     HAL_ERR_COMPONENT);
+    char want[256];
+    snprintf(want, sizeof want, "m.hal:4: loadrt hexapod: %s:18: [JOINT_3] MAX_LIMIT: 'abc' "
+             "is not a number", path);
+    ck_assert_str_eq(hal_last_error(h), want);
+    ck_assert_ptr_null(hal_get_object(h, "kins"));
+    hal_destroy(h);
+    unlink(path);
+}
+END_TEST
+
 static Suite *hal_cmd_suite(void)
 {
     Suite *s = suite_create("hal_cmd");
@@ -258,6 +292,7 @@ static Suite *hal_cmd_suite(void)
     tcase_add_test(tc, start_runs_the_simulated_clock_and_show_lists);
     tcase_add_test(tc, command_errors);
     tcase_add_test(tc, kinematics_by_name_becomes_the_kins_component);
+    tcase_add_test(tc, kinematics_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);
     return s;
 }

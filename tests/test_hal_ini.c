@@ -56,7 +56,7 @@ START_TEST(typed_readers)
     ck_assert_int_eq(hal_ini_double(h, "TRAJ", "MISSING", 7.5, &d), HAL_ERR_NOT_FOUND);
     ck_assert(d == 7.5);
     ck_assert_int_eq(hal_ini_double(h, "TRAJ", "NOT_A_NUMBER", 7.5, &d), HAL_ERR_SYNTAX);
-    ck_assert_str_eq(hal_last_error(h), "good.ini: [TRAJ]NOT_A_NUMBER = 'fast' is not a "
+    ck_assert_str_eq(hal_last_error(h), "good.ini:12: [TRAJ]NOT_A_NUMBER = 'fast' is not a "
                      "number");
     ck_assert(d == 7.5);
     ck_assert_int_eq(hal_ini_double(h, "TRAJ", "MAX_LINEAR_ACCELERATION", 0, &d),
@@ -64,7 +64,7 @@ START_TEST(typed_readers)
     ck_assert_int_eq(hal_ini_int(h, "TRAJ", "COUNT", 0, &n), HAL_OK);
     ck_assert_int_eq(n, 12);
     ck_assert_int_eq(hal_ini_int(h, "TRAJ", "MAX_LINEAR_VELOCITY", 3, &n), HAL_ERR_SYNTAX);
-    ck_assert_str_eq(hal_last_error(h), "good.ini: [TRAJ]MAX_LINEAR_VELOCITY = '25.5' is not "
+    ck_assert_str_eq(hal_last_error(h), "good.ini:7: [TRAJ]MAX_LINEAR_VELOCITY = '25.5' is not "
                      "a whole number");
     ck_assert_int_eq(n, 3);
     ck_assert_int_eq(hal_ini_int(h, "NOSECTION", "COUNT", 4, &n), HAL_ERR_NOT_FOUND);
