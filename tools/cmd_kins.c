@@ -5,138 +5,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <ini.h>
-
+#include "common/inifile.h"
 #include "kins/kins.h"
 #include "tools/cmd.h"
 
 const char cmd_kins_usage[] =
     "kins CONFIG.ini inverse X Y Z A B C | forward L1..L6   pose (mm, deg) <-> legs (mm)";
-
-/* One INI entry, with the line it came from for messages. */
-struct kins_ini_entry {
-    char *section;
-    char *key;
-    char *value;
-    int line;
-};
-
-/* The whole INI file in memory: the kinematics reads it through kins_config. */
-struct kins_ini {
-    const char *path;              /* file name, for messages */
-    FILE *f;                       /* open while parsing */
-    int line;                      /* line number of the line being parsed */
-    struct kins_ini_entry *items;  /* entries in file order */
-    size_t n, cap;                 /* used and allocated entries */
-    int nomem;                     /* set when an allocation failed */
-};
-
-/* Line reader for inih that counts lines, so entries know where they are. */
-static char *kins_ini_read_line(char *str, int num, void *stream)
-{
-    struct kins_ini *ini = stream;
-    char *s = fgets(str, num, ini->f);
-    if (s)
-        ini->line++;
-    return s;
-}
-
-/* Stores one key; the first of duplicate keys wins, as in LinuxCNC's INI lookup. */
-static int kins_ini_store(void *user, const char *section, const char *key, const char *value)
-{
-    struct kins_ini *ini = user;
-    if (ini->n == ini->cap) {
-        size_t cap = ini->cap ? 2 * ini->cap : 64;
-        struct kins_ini_entry *p = realloc(ini->items, cap * sizeof *p);
-        if (!p) {
-            ini->nomem = 1;
-            return 0;
-        }
-        ini->items = p;
-        ini->cap = cap;
-    }
-    struct kins_ini_entry *e = &ini->items[ini->n];
-    e->section = strdup(section);
-    e->key = strdup(key);
-    e->value = strdup(value);
-    e->line = ini->line;
-    if (!e->section || !e->key || !e->value) {
-        free(e->section);
-        free(e->key);
-        free(e->value);
-        ini->nomem = 1;
-        return 0;
-    }
-    ini->n++;
-    return 1;
-}
-
-/* Finds [section] key (case-sensitive, like LinuxCNC); NULL when absent. */
-static const struct kins_ini_entry *kins_ini_find(const struct kins_ini *ini,
-                                                  const char *section, const char *key)
-{
-    for (size_t i = 0; i < ini->n; i++)
-        if (!strcmp(ini->items[i].section, section) && !strcmp(ini->items[i].key, key))
-            return &ini->items[i];
-    return NULL;
-}
-
-/* The kins_config lookup over the loaded file. */
-static const char *kins_ini_get(void *ctx, const char *section, const char *key)
-{
-    const struct kins_ini_entry *e = kins_ini_find(ctx, section, key);
-    return e ? e->value : NULL;
-}
-
-/* Frees every stored entry. */
-static void kins_ini_free(struct kins_ini *ini)
-{
-    for (size_t i = 0; i < ini->n; i++) {
-        free(ini->items[i].section);
-        free(ini->items[i].key);
-        free(ini->items[i].value);
-    }
-    free(ini->items);
-}
-
-/* Reads the INI file; 0 on success, else prints why. */
-static int kins_ini_load(struct kins_ini *ini, const char *path)
-{
-    memset(ini, 0, sizeof *ini);
-    ini->path = path;
-    ini->f = fopen(path, "r");
-    if (!ini->f) {
-        fprintf(stderr, "hexcnc kins: %s: cannot open: %s\n", path, strerror(errno));
-        return -1;
-    }
-    int rc = ini_parse_stream(kins_ini_read_line, ini, kins_ini_store, ini);
-    fclose(ini->f);
-    ini->f = NULL;
-    if (ini->nomem) {
-        fprintf(stderr, "hexcnc kins: %s: out of memory\n", path);
-        return -1;
-    }
-    if (rc > 0) {
-        fprintf(stderr, "hexcnc kins: %s:%d: not an INI line (expected [SECTION] or "
-                "KEY = VALUE)\n", path, rc);
-        return -1;
-    }
-    return rc == 0 ? 0 : -1;
-}
-
-/* Prints a kinematics message; one that starts "[SECTION] KEY:" gets the key's line. */
-static void kins_report(const struct kins_ini *ini, const char *msg)
-{
-    char section[64], key[64];
-    if (sscanf(msg, "[%63[^]]] %63[^:]:", section, key) == 2) {
-        const struct kins_ini_entry *e = kins_ini_find(ini, section, key);
-        if (e) {
-            fprintf(stderr, "hexcnc kins: %s:%d: %s\n", ini->path, e->line, msg);
-            return;
-        }
-    }
-    fprintf(stderr, "hexcnc kins: %s: %s\n", ini->path, msg);
-}
 
 /* Parses n command-line numbers; prints which one is wrong. */
 static int kins_parse_args(char **argv, int n, const char *const *names, double *out)
@@ -234,34 +108,35 @@ int cmd_kins(int argc, char **argv)
         fprintf(stderr, "usage: hexcnc %s\n", cmd_kins_usage);
         return 2;
     }
-    struct kins_ini ini;
-    if (kins_ini_load(&ini, argv[1]) != 0) {
-        kins_ini_free(&ini);
+    struct inifile ini = { 0 };
+    char err[1024], msg[1536];
+    if (inifile_load(&ini, argv[1], err, sizeof err) != INIFILE_OK) {
+        fprintf(stderr, "hexcnc kins: %s\n", err);
         return 1;
     }
     int rc = 1;
     struct kins *k = NULL;
-    char err[1024];
-    const struct kins_ini_entry *name = kins_ini_find(&ini, "KINS", "KINEMATICS");
+    const char *name = inifile_get(&ini, "KINS", "KINEMATICS");
     if (!name) {
         fprintf(stderr, "hexcnc kins: %s: [KINS] KINEMATICS: missing (e.g. hexapod)\n",
                 ini.path);
         goto done;
     }
-    struct kins_config cfg = { kins_ini_get, &ini };
-    int st = kins_load(name->value, &cfg, &k, err, sizeof err);
+    struct kins_config cfg = { inifile_config_get, &ini };
+    int st = kins_load(name, &cfg, &k, err, sizeof err);
     if (st == KINS_ERR_PLUGIN) {
-        fprintf(stderr, "hexcnc kins: %s:%d: [KINS] KINEMATICS: %s\n", ini.path, name->line,
-                err);
+        fprintf(stderr, "hexcnc kins: %s:%d: [KINS] KINEMATICS: %s\n", ini.path,
+                inifile_line(&ini, "KINS", "KINEMATICS"), err);
         goto done;
     }
-    if (st != KINS_OK) {
-        kins_report(&ini, err[0] ? err : kins_strerror(st));
+    if (st != KINS_OK) {   /* "[SECTION] KEY: ..." is pointed at the key's line */
+        fprintf(stderr, "hexcnc kins: %s\n",
+                inifile_locate_msg(&ini, err[0] ? err : kins_strerror(st), msg, sizeof msg));
         goto done;
     }
     rc = kins_run(k, argv[2], argv + 3, argc - 3);
 done:
     kins_free(k);
-    kins_ini_free(&ini);
+    inifile_free(&ini);
     return rc;
 }
