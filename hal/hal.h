@@ -173,6 +173,28 @@ int hal_newsig(struct hal *h, const char *name, enum hal_type type);
 int hal_unlinkp(struct hal *h, const char *pin);
 int hal_delf(struct hal *h, const char *funct, const char *thread);
 
+/* ---- messages from components ----------------------------------------------------------- */
+
+/* A component's message to the machinist (a drive fault, a lost node, a warning), carried
+ * from any thread, the servo thread included, to the shell that prints it. Posting takes
+ * no lock, allocates nothing and makes no system call; a full queue drops the message and
+ * counts it. The shell (hexcnc run, halcmd) takes them with hal_msg_take(). */
+enum hal_msg_severity { HAL_MSG_INFO = 0, HAL_MSG_WARNING, HAL_MSG_FAULT };
+#define HAL_MSG_TEXT_MAX 240
+struct hal_msg {
+    enum hal_msg_severity severity;
+    char source[32];             /* who says it: "cia402.3", "modbus.0", ... */
+    char text[HAL_MSG_TEXT_MAX]; /* what happened, in words a machinist understands */
+};
+int hal_msg_post(struct hal *h, enum hal_msg_severity sev, const char *source,
+                 const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* One consumer only (the shell): the oldest message; false when none. */
+bool hal_msg_take(struct hal *h, struct hal_msg *out);
+/* Messages dropped because the queue was full. */
+uint64_t hal_msg_dropped(const struct hal *h);
+/* The severity's word: "info", "warning", "fault". */
+const char *hal_msg_severity_name(enum hal_msg_severity sev);
+
 /* ---- the HAL command language ---------------------------------------------------------- */
 
 /* One command line (loadrt, net, setp, sets, getp, addf, newthread, start, stop, show,

@@ -59,6 +59,10 @@ struct hal *hal_create(void)
     if (!h)
         return NULL;
     h->next_comp_id = 1;
+    if (hal_msg_init(h) != HAL_OK) {
+        free(h);
+        return NULL;
+    }
     for (int i = 0; hal_builtin_types[i]; i++) {
         if (hal_register_type(h, hal_builtin_types[i]) != HAL_OK) {
             hal_destroy(h);
@@ -88,6 +92,7 @@ void hal_destroy(struct hal *h)
         return;
     hal_stop(h);
     hal_run_cleanups(h, -1);
+    hal_msg_free(h);
     hal_threads_free(h);
     while (h->funct_list.n)
         hal_funct_remove(h, h->funct_list.v[h->funct_list.n - 1]);

@@ -7,6 +7,7 @@
 
 #include "common/inifile.h"
 #include "hal/hal.h"
+#include "hal/ring.h"
 
 /* The value a pin, parameter or signal holds. */
 union hal_data {
@@ -136,6 +137,7 @@ struct hal {
     pthread_cond_t rt_cond;
     bool rt_go;                      /* the time origin is set: threads may begin */
     bool rt_locked;                  /* this runtime called mlockall (munlockall at stop) */
+    struct ring_mpsc msgs;           /* messages from components to the shell (hal_msg.c) */
 };
 
 /* Internal helpers across files. */
@@ -150,6 +152,8 @@ void hal_pin_remove(struct hal *h, struct hal_pin *p);
 void hal_param_remove(struct hal *h, struct hal_param *p);
 void hal_threads_free(struct hal *h);
 void hal_thread_run(struct hal_thread *t);
+int hal_msg_init(struct hal *h);
+void hal_msg_free(struct hal *h);
 int hal_rt_start(struct hal *h);
 void hal_rt_stop(struct hal *h);
 void hal_ini_free(struct hal *h);

@@ -1,7 +1,8 @@
 # hal/: the component-graph runtime, the HAL command language, the INI reader, and the
 # generic built-in components.
 LIB_SRCS += hal/hal_core.c hal/hal_map.c hal/hal_pin.c hal/hal_value.c hal/hal_funct.c hal/hal_rt.c \
-            hal/hal_ini.c hal/hal_load.c hal/hal_cmd.c hal/hal_file.c hal/hal_show.c
+            hal/hal_ini.c hal/hal_load.c hal/hal_cmd.c hal/hal_file.c hal/hal_show.c \
+            hal/hal_msg.c hal/ring.c
 
 # Built-in generic components (hal/components/motion.c adds itself elsewhere).
 LIB_SRCS += hal/components/kins.c hal/components/logic.c hal/components/stream.c

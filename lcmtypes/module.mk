@@ -23,7 +23,7 @@ $(LIBDIR)/libhexcnc.a: $(LCM_GEN_OBJS)
 .SECONDARY: $(LCM_GEN_C) $(LCM_GEN_H)
 
 # The status component, its publisher thread and the lock-free rings it uses.
-LIB_SRCS += hal/ring.c hal/components/lcm_status.c hal/components/lcm_status_pub.c
+LIB_SRCS += hal/components/lcm_status.c hal/components/lcm_status_pub.c
 HAL_COMPS += lcm_status
 TESTS += test_lcm_ring test_lcm_status
 

@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "hal/hal.h"
 #include "kins/kins.h"
 #include "motion/motion.h"
 
@@ -121,6 +122,10 @@ int runner_plan_info(const struct runner *r, struct motion_plan_info *out);
 
 /* Sets the observer called after every servo period (NULL to remove). */
 void runner_set_observer(struct runner *r, runner_observer_fn fn, void *ctx);
+/* Components' messages (drive faults, lost nodes, warnings), handed to fn from runner_run
+ * as they arrive; the first fault also becomes the cause in runner_run's error message. */
+typedef void (*runner_message_fn)(void *ctx, const struct hal_msg *m);
+void runner_set_message_fn(struct runner *r, runner_message_fn fn, void *ctx);
 
 /* Starts the threads and the loaded program. */
 int runner_start(struct runner *r, char *err, size_t errlen);

@@ -175,11 +175,32 @@ int runner_get_progress(const struct runner *r, struct runner_progress *p)
     return RUNNER_OK;
 }
 
+void runner_set_message_fn(struct runner *r, runner_message_fn fn, void *ctx)
+{
+    r->msg_fn = fn;
+    r->msg_ctx = ctx;
+}
+
+/* Takes the components' messages; the first fault is kept as the cause of a stop. */
+static void runner_drain_messages(struct runner *r)
+{
+    struct hal_msg m;
+    while (hal_msg_take(r->hal, &m)) {
+        if (m.severity == HAL_MSG_FAULT && !r->first_fault[0])
+            snprintf(r->first_fault, sizeof r->first_fault, "%s: %s", m.source, m.text);
+        if (r->msg_fn)
+            r->msg_fn(r->msg_ctx, &m);
+    }
+}
+
 /* How the run ended, as a status and a message. */
 static int runner_outcome(struct runner *r, char *err, size_t errlen)
 {
     enum motion_state s = (enum motion_state)atomic_load(&r->mon_state);
     double t_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
+    if (s == MOTION_FAULT && r->first_fault[0])
+        return runner_fail(err, errlen, RUNNER_ERR_FAULT, "%s (cause: %s)",
+                           motion_hal_fault(r->hal), r->first_fault);
     if (s == MOTION_FAULT)
         return runner_fail(err, errlen, RUNNER_ERR_FAULT, "%s", motion_hal_fault(r->hal));
     if (r->aborting)
@@ -226,6 +247,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
             runner_fail(err, errlen, st, "%s", hal_last_error(r->hal));
             break;
         }
+        runner_drain_messages(r);
         runner_get_progress(r, &p);
         if (fn)
             fn(ctx, &p);
@@ -240,6 +262,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
     }
     if (!r->sim_clock)
         hal_stop(r->hal);
+    runner_drain_messages(r);
     if (st == RUNNER_OK)
         st = runner_outcome(r, err, errlen);
     runner_get_progress(r, &p);

@@ -21,6 +21,9 @@ struct runner {
     bool loaded;                        /* a program is planned */
     bool started;                       /* runner_start succeeded */
     bool aborting;                      /* runner_abort was called */
+    runner_message_fn msg_fn;           /* gets every component message (may be NULL) */
+    void *msg_ctx;
+    char first_fault[300];              /* "source: text" of the first fault message: the cause */
     struct motion_plan_info plan;       /* the loaded program's plan */
     struct interp *interp;              /* the interpreter of the loaded program: it owns the
                                          * file names the plan's moves point at, so it lives

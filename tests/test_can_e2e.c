@@ -115,6 +115,17 @@ START_TEST(test_drive_fault_stops_machine)
     const struct canopen_master *m = hal_get_object(h, CIA402_OBJ_MASTER);
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "CAN node 3 (joint 2)"));
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "error code 0x2310"));
+    /* the same words reach the shell through the runtime's message queue, once */
+    struct hal_msg msg;
+    int faults = 0;
+    while (hal_msg_take(h, &msg)) {
+        if (msg.severity != HAL_MSG_FAULT)
+            continue;
+        faults++;
+        ck_assert_str_eq(msg.source, "cia402.2");
+        ck_assert_ptr_nonnull(strstr(msg.text, "CAN node 3 (joint 2)"));
+    }
+    ck_assert_int_eq(faults, 1);
     double held[NLEGS];
     for (int i = 0; i < NLEGS; i++)
         held[i] = m->node[i].position_fb_mm;

@@ -410,6 +410,41 @@ START_TEST(thread_pins_and_bad_period)
 }
 END_TEST
 
+/* Messages from components reach the shell in order, with source and text; a burst beyond
+ * the queue is dropped and counted, never blocking the poster. */
+START_TEST(messages_in_order_and_overflow_counted)
+{
+    struct hal *h = hal_create();
+    ck_assert_ptr_nonnull(h);
+    struct hal_msg m;
+    ck_assert(!hal_msg_take(h, &m));
+    ck_assert_int_eq(hal_msg_post(h, HAL_MSG_FAULT, "drive.3", "no answer within %d ms", 20),
+                     HAL_OK);
+    ck_assert_int_eq(hal_msg_post(h, HAL_MSG_INFO, "drive.3", "fault cleared"), HAL_OK);
+    ck_assert(hal_msg_take(h, &m));
+    ck_assert_int_eq(m.severity, HAL_MSG_FAULT);
+    ck_assert_str_eq(m.source, "drive.3");
+    ck_assert_str_eq(m.text, "no answer within 20 ms");
+    ck_assert_str_eq(hal_msg_severity_name(m.severity), "fault");
+    ck_assert(hal_msg_take(h, &m));
+    ck_assert_str_eq(m.text, "fault cleared");
+    ck_assert(!hal_msg_take(h, &m));
+    int posted = 0;
+    for (int i = 0; i < 200; i++)
+        posted += hal_msg_post(h, HAL_MSG_WARNING, "burst", "message %d", i) == HAL_OK;
+    ck_assert_int_lt(posted, 200);
+    ck_assert_int_eq((int)hal_msg_dropped(h), 200 - posted);
+    for (int i = 0; i < posted; i++) {  /* the ones kept are the first ones, in order */
+        char want[32];
+        snprintf(want, sizeof want, "message %d", i);
+        ck_assert(hal_msg_take(h, &m));
+        ck_assert_str_eq(m.text, want);
+    }
+    ck_assert(!hal_msg_take(h, &m));
+    hal_destroy(h);
+}
+END_TEST
+
 static Suite *hal_core_suite(void)
 {
     Suite *s = suite_create("hal_core");
@@ -426,6 +461,7 @@ static Suite *hal_core_suite(void)
     tcase_add_test(tc, failed_load_unwinds_everything);
     tcase_add_test(tc, cleanups_run_in_reverse);
     tcase_add_test(tc, thread_pins_and_bad_period);
+    tcase_add_test(tc, messages_in_order_and_overflow_counted);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -10,14 +10,25 @@ const char cmd_halcmd_usage[] =
     "                                  run HAL commands (-s: simulated clock; --run-ms: run\n"
     "                                  the threads N ms after each `start`)";
 
+/* Prints the components' messages (drive faults, warnings) that arrived so far. */
+static void halcmd_messages(struct hal *h)
+{
+    struct hal_msg m;
+    while (hal_msg_take(h, &m))
+        fprintf(stderr, "halcmd: %s: %s: %s\n", hal_msg_severity_name(m.severity), m.source,
+                m.text);
+}
+
 /* Reads commands from stdin, one a line, stopping at the first error. */
 static int halcmd_stdin(struct hal *h)
 {
     char *line = NULL;
     size_t cap = 0;
     int lineno = 0, st = HAL_OK;
-    while (st == HAL_OK && getline(&line, &cap, stdin) >= 0)
+    while (st == HAL_OK && getline(&line, &cap, stdin) >= 0) {
         st = hal_cmd(h, line, "<stdin>", ++lineno, stdout);
+        halcmd_messages(h);
+    }
     free(line);
     return st;
 }
@@ -85,6 +96,7 @@ int cmd_halcmd(int argc, char **argv)
     if (st == HAL_OK)
         st = file ? hal_source(h, file) : i < argc ? halcmd_words(h, argc - i, argv + i)
                                                    : halcmd_stdin(h);
+    halcmd_messages(h);
     if (st != HAL_OK)
         fprintf(stderr, "%s\n", hal_last_error(h));
     fflush(stdout);

@@ -156,6 +156,15 @@ static void run_catch_signals(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
+/* A component's message as it arrives: faults and warnings on stderr, the rest on stdout. */
+static void run_on_message(void *ctx, const struct hal_msg *m)
+{
+    (void)ctx;
+    FILE *f = m->severity == HAL_MSG_INFO ? stdout : stderr;
+    fprintf(f, "hexcnc run: %s: %s: %s\n", hal_msg_severity_name(m->severity), m->source,
+            m->text);
+}
+
 /* Loads, plans, runs and reports; returns the exit status. */
 static int run_machine(struct runner *r, const char *program, int quiet)
 {
@@ -172,6 +181,7 @@ static int run_machine(struct runner *r, const char *program, int quiet)
     if (hal_ini_int(runner_hal(r), "TASK", "PROGRESS_INTERVAL", 5, &every) == HAL_OK &&
         every > 0)
         d.every_s = (double)every;
+    runner_set_message_fn(r, run_on_message, NULL);
     double t0 = run_wall_s();
     if (runner_start(r, err, sizeof err) != RUNNER_OK) {
         fprintf(stderr, "hexcnc run: %s\n", err);

@@ -25,6 +25,7 @@ struct cia402_chan {
 
 /* The component: bus, master core, simulated time and pins. */
 struct cia402_comp {
+    struct hal *h;                          /* for messages to the shell (hal_msg_post) */
     struct can_bus bus;                     /* the socket (and the sim's end) */
     struct canopen_master m;                /* the protocol core */
     int64_t now_ns;                         /* sum of the periods this funct has run */
@@ -69,8 +70,10 @@ static void cia402_update(void *arg, long period_ns)
         *ch->statusword = n->statusword;
         *ch->emcy_code = n->emcy_code;
         any = any || n->fault;
-        if (n->message_new) {  /* once per fault: the machinist's message */
-            fprintf(stderr, "cia402: %s\n", n->message);
+        if (n->message_new) {  /* once per fault: the machinist's message, without blocking */
+            char src[32];
+            snprintf(src, sizeof src, "cia402.%d", i);
+            hal_msg_post(c->h, n->fault ? HAL_MSG_FAULT : HAL_MSG_INFO, src, "%s", n->message);
             n->message_new = false;
         }
     }
@@ -248,6 +251,7 @@ static int cia402_load(struct hal *h, int argc, char **argv)
     struct cia402_comp *c = calloc(1, sizeof *c);
     if (!c)
         return hal_error(h, HAL_ERR_NOMEM, "cia402: out of memory");
+    c->h = h;
     c->bus.fd = c->bus.sim_peer_fd = -1;
     if ((st = hal_on_destroy(h, cia402_free, c))) {
         free(c);

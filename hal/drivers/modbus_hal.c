@@ -22,6 +22,8 @@
 
 /* Pins and link of one drive. */
 struct modbus_hal_drive {
+    struct hal *h;            /* for messages to the shell (hal_msg_post) */
+    char source[24];          /* "modbus.N", the messages' source */
     double *pos_cmd;          /* in: commanded position, mm */
     bool *enable;             /* in: enable the drive */
     bool *fault_reset;        /* in: rising edge clears the fault and reconnects */
@@ -53,11 +55,11 @@ static const char *modbus_hal_ini_get(void *ctx, const char *section, const char
     return hal_ini_get(ctx, section, key);
 }
 
-/* Prints a fault once, when it is raised (on the I/O side, never in the servo thread). */
+/* Hands a fault to the shell once, when it is raised (from the I/O side). */
 static void modbus_hal_report(void *arg, const char *msg)
 {
-    (void)arg;
-    fprintf(stderr, "hexcnc: %s\n", msg);
+    struct modbus_hal_drive *d = arg;
+    hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s", msg);
 }
 
 /* Copies drive d's latest feedback to its pins; returns its fault. */
@@ -176,7 +178,10 @@ static int modbus_hal_drive_new(struct hal *h, struct modbus_hal *c, int i, cons
                          hal_ini_path(h) ? hal_ini_path(h) : "INI", err);
     }
     d->linked = true;
+    d->h = h;
+    snprintf(d->source, sizeof d->source, "modbus.%d", i);
     d->link.report = modbus_hal_report;
+    d->link.report_arg = d;
     return modbus_hal_pins(h, d, i);
 }
 
