@@ -8,6 +8,7 @@
 #include "hal/drivers/canopen_master.h"
 #include "hal/drivers/cia402_hal.h"
 #include "hal/hal.h"
+#include "tests/test_hal_util.h"
 #include "interp/canon.h"
 #include "interp/interp.h"
 #include "motion/motion_hal.h"
@@ -15,30 +16,14 @@
 #define PERIOD_NS 1000000L
 #define NLEGS 6
 
-/* A path under the source tree (tests run with HEXCNC_ROOT set by make, else from it). */
-static void root_path(char *buf, size_t len, const char *rel)
-{
-    const char *root = getenv("HEXCNC_ROOT");
-    snprintf(buf, len, "%s/%s", root ? root : ".", rel);
-}
-
-/* A float or bit pin's value by name. */
-static double val(struct hal *h, const char *name)
-{
-    enum hal_type t;
-    void *p = hal_data_ptr(h, name, &t);
-    ck_assert_msg(p != NULL, "no pin %s", name);
-    return t == HAL_BIT ? (double)*(bool *)p : *(double *)p;
-}
-
 /* The machine of configs/can-sim with the paper's program (10) planned and the e-stop
  * latch reset; the servo thread is started on the simulated clock. */
 static struct hal *machine_with_program(void)
 {
     char ini[512], hal_file[512], prog_path[512];
-    root_path(ini, sizeof ini, "configs/can-sim/tmu-hexapod-can.ini");
-    root_path(hal_file, sizeof hal_file, "configs/can-sim/tmu-hexapod-can.hal");
-    root_path(prog_path, sizeof prog_path, "examples/paper/prog10_g141_d20.ngc");
+    test_root_path(ini, sizeof ini, "configs/can-sim/tmu-hexapod-can.ini");
+    test_root_path(hal_file, sizeof hal_file, "configs/can-sim/tmu-hexapod-can.hal");
+    test_root_path(prog_path, sizeof prog_path, "examples/paper/prog10_g141_d20.ngc");
     struct hal *h = hal_create();
     ck_assert_ptr_nonnull(h);
     ck_assert_msg(hal_load_ini(h, ini) == HAL_OK, "%s", hal_last_error(h));
@@ -73,24 +58,24 @@ START_TEST(test_paper_program_on_can)
     double worst_ferror = 0;
     char name[64];
     int ms = 0;
-    for (; ms < 60000 && val(h, "motion.done") == 0.0; ms++) {
+    for (; ms < 60000 && test_pin_value(h, "motion.done") == 0.0; ms++) {
         ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-        ck_assert_msg(val(h, "motion.fault") == 0.0, "motion fault at %d ms: %s", ms,
+        ck_assert_msg(test_pin_value(h, "motion.fault") == 0.0, "motion fault at %d ms: %s", ms,
                       motion_hal_fault(h));
-        ck_assert_msg(val(h, "cia402.fault-any") == 0.0, "drive fault at %d ms", ms);
-        for (int i = 0; i < NLEGS && val(h, "motion.enable") != 0.0; i++) {
+        ck_assert_msg(test_pin_value(h, "cia402.fault-any") == 0.0, "drive fault at %d ms", ms);
+        for (int i = 0; i < NLEGS && test_pin_value(h, "motion.enable") != 0.0; i++) {
             snprintf(name, sizeof name, "motion.ferror-%d", i);
-            worst_ferror = fmax(worst_ferror, fabs(val(h, name)));
+            worst_ferror = fmax(worst_ferror, fabs(test_pin_value(h, name)));
         }
     }
-    ck_assert_msg(val(h, "motion.done") != 0.0, "program not done after %d ms", ms);
+    ck_assert_msg(test_pin_value(h, "motion.done") != 0.0, "program not done after %d ms", ms);
     ck_assert_double_lt(worst_ferror, 0.1);  /* [JOINT_n]MIN_FERROR */
     ck_assert_int_eq(hal_sim_advance(h, 20 * PERIOD_NS), HAL_OK);
     /* docs/compensation.md: the compensated path ends at X59.975641 Y-20 Z630.697565 */
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-x"), 59.975641, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-y"), -20.0, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-z"), 630.697565, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-b"), -4.0, 0.001);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-x"), 59.975641, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-y"), -20.0, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-z"), 630.697565, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-b"), -4.0, 0.001);
     const struct canopen_master *m = hal_get_object(h, CIA402_OBJ_MASTER);
     ck_assert(canopen_master_all_enabled(m));
     printf("paper program (10) on CAN: %d ms machine time, %u SYNCs, worst following error "
@@ -105,13 +90,13 @@ START_TEST(test_drive_fault_stops_machine)
 {
     struct hal *h = machine_with_program();
     ck_assert_int_eq(hal_sim_advance(h, 1500 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "motion.done") == 0.0);
-    ck_assert(val(h, "motion.path-vel") > 1.0);  /* moving */
+    ck_assert(test_pin_value(h, "motion.done") == 0.0);
+    ck_assert(test_pin_value(h, "motion.path-vel") > 1.0);  /* moving */
     ck_assert_int_eq(hal_setp(h, "cia402-sim.2.inject-fault", "1"), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, 10 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "cia402.2.fault") != 0.0);
-    ck_assert(val(h, "estop-latch.0.ok-out") == 0.0);
-    ck_assert(val(h, "motion.fault") != 0.0);
+    ck_assert(test_pin_value(h, "cia402.2.fault") != 0.0);
+    ck_assert(test_pin_value(h, "estop-latch.0.ok-out") == 0.0);
+    ck_assert(test_pin_value(h, "motion.fault") != 0.0);
     const struct canopen_master *m = hal_get_object(h, CIA402_OBJ_MASTER);
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "CAN node 3 (joint 2)"));
     ck_assert_ptr_nonnull(strstr(m->node[2].message, "error code 0x2310"));
@@ -138,7 +123,7 @@ START_TEST(test_drive_fault_stops_machine)
     ck_assert_int_eq(hal_sets(h, "drive-reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "0"), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, 20 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "cia402.fault-any") == 0.0);
+    ck_assert(test_pin_value(h, "cia402.fault-any") == 0.0);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, 30 * PERIOD_NS), HAL_OK);
     ck_assert(canopen_master_all_enabled(m));

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "hal/hal.h"
+#include "tests/test_hal_util.h"
 #include "interp/canon.h"
 #include "interp/interp.h"
 #include "motion/motion_hal.h"
@@ -16,26 +17,6 @@
 
 #define PERIOD_NS 1000000L
 #define NLEGS 6
-
-/* A path under the source tree (tests run with HEXCNC_ROOT set by make, else from it). */
-static void root_path(char *buf, size_t len, const char *rel)
-{
-    const char *root = getenv("HEXCNC_ROOT");
-    snprintf(buf, len, "%s/%s", root ? root : ".", rel);
-}
-
-/* A float or bit pin's value by name. */
-static double val(struct hal *h, const char *name)
-{
-    enum hal_type t;
-    void *p = hal_data_ptr(h, name, &t);
-    ck_assert_msg(p != NULL, "no pin %s", name);
-    if (t == HAL_BIT)
-        return *(bool *)p;
-    if (t == HAL_U32)
-        return *(uint32_t *)p;
-    return *(double *)p;
-}
 
 /* A free loopback port: bound to port 0, read, released. */
 static int free_port(void)
@@ -72,9 +53,9 @@ static void ini_with_free_ports(const char *ini, char *out, size_t len)
 static struct hal *machine_with_program(void)
 {
     char ini0[512], ini[64], hal_file[512], prog_path[512];
-    root_path(ini0, sizeof ini0, "configs/modbus-sim/tmu-hexapod-modbus.ini");
-    root_path(hal_file, sizeof hal_file, "configs/modbus-sim/tmu-hexapod-modbus.hal");
-    root_path(prog_path, sizeof prog_path, "examples/paper/prog10_g141_d20.ngc");
+    test_root_path(ini0, sizeof ini0, "configs/modbus-sim/tmu-hexapod-modbus.ini");
+    test_root_path(hal_file, sizeof hal_file, "configs/modbus-sim/tmu-hexapod-modbus.hal");
+    test_root_path(prog_path, sizeof prog_path, "examples/paper/prog10_g141_d20.ngc");
     ini_with_free_ports(ini0, ini, sizeof ini);
     struct hal *h = hal_create();
     ck_assert_ptr_nonnull(h);
@@ -116,26 +97,26 @@ START_TEST(test_paper_program_on_modbus)
     double worst_ferror = 0;
     char name[64];
     int ms = 0;
-    for (; ms < 60000 && val(h, "motion.done") == 0.0; ms++) {
+    for (; ms < 60000 && test_pin_value(h, "motion.done") == 0.0; ms++) {
         ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-        ck_assert_msg(val(h, "motion.fault") == 0.0, "motion fault at %d ms: %s", ms,
+        ck_assert_msg(test_pin_value(h, "motion.fault") == 0.0, "motion fault at %d ms: %s", ms,
                       motion_hal_fault(h));
-        ck_assert_msg(val(h, "modbus.fault-any") == 0.0, "drive fault at %d ms", ms);
+        ck_assert_msg(test_pin_value(h, "modbus.fault-any") == 0.0, "drive fault at %d ms", ms);
         for (int i = 0; i < NLEGS; i++) {
             snprintf(name, sizeof name, "motion.ferror-%d", i);
-            worst_ferror = fmax(worst_ferror, fabs(val(h, name)));
+            worst_ferror = fmax(worst_ferror, fabs(test_pin_value(h, name)));
         }
     }
-    ck_assert_msg(val(h, "motion.done") != 0.0, "program not done after %d ms", ms);
+    ck_assert_msg(test_pin_value(h, "motion.done") != 0.0, "program not done after %d ms", ms);
     /* One 4 ms set point and the 1 ms drive lag at up to 21.6 mm/s of leg rate: 0.11 mm,
      * plus the lockstep phase; a lost or unscaled drive would be far beyond. */
     ck_assert_double_lt(worst_ferror, 0.2);
     ck_assert_int_eq(hal_sim_advance(h, 40 * PERIOD_NS), HAL_OK);
     /* docs/compensation.md: the compensated path ends at X59.975641 Y-20 Z630.697565 */
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-x"), 59.975641, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-y"), -20.0, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-z"), 630.697565, 0.002);
-    ck_assert_double_eq_tol(val(h, "kins.pose-fb-b"), -4.0, 0.001);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-x"), 59.975641, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-y"), -20.0, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-z"), 630.697565, 0.002);
+    ck_assert_double_eq_tol(test_pin_value(h, "kins.pose-fb-b"), -4.0, 0.001);
     struct modbus_sim_drive_state st;
     modbus_sim_state(s, 0, &st);
     uint32_t exchanges = st.requests - st0.requests;
@@ -143,7 +124,7 @@ START_TEST(test_paper_program_on_modbus)
     ck_assert_uint_eq(exchanges, (uint32_t)(ms + 40) / 4);
     printf("paper program (10) on Modbus TCP: %d ms machine time, %u exchanges per drive, "
            "worst following error %.4f mm, last round trip %.0f us\n", ms, exchanges,
-           worst_ferror, val(h, "modbus.0.rtt-us"));
+           worst_ferror, test_pin_value(h, "modbus.0.rtt-us"));
     hal_destroy(h);
 }
 END_TEST
@@ -155,15 +136,15 @@ START_TEST(test_drive_timeout_stops_machine)
     struct hal *h = machine_with_program();
     struct modbus_sim *s = hal_get_object(h, "modbus-sim");
     ck_assert_int_eq(hal_sim_advance(h, 1500 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "motion.done") == 0.0);
-    ck_assert(val(h, "motion.path-vel") > 1.0);  /* moving */
+    ck_assert(test_pin_value(h, "motion.done") == 0.0);
+    ck_assert(test_pin_value(h, "motion.path-vel") > 1.0);  /* moving */
     ck_assert_int_eq(modbus_sim_inject(s, 2, MODBUS_SIM_FAULT_NO_ANSWER, 0), MODBUS_SIM_OK);
     ck_assert_int_eq(hal_sim_advance(h, 10 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "modbus.2.fault") != 0.0);
-    ck_assert(val(h, "modbus.1.fault") == 0.0);
-    ck_assert(val(h, "estop-latch.0.ok-out") == 0.0);
-    ck_assert(val(h, "motion.fault") != 0.0);
-    ck_assert(val(h, "motion.amp-enable") == 0.0);
+    ck_assert(test_pin_value(h, "modbus.2.fault") != 0.0);
+    ck_assert(test_pin_value(h, "modbus.1.fault") == 0.0);
+    ck_assert(test_pin_value(h, "estop-latch.0.ok-out") == 0.0);
+    ck_assert(test_pin_value(h, "motion.fault") != 0.0);
+    ck_assert(test_pin_value(h, "motion.amp-enable") == 0.0);
     ck_assert_int_eq(hal_sim_advance(h, 10 * PERIOD_NS), HAL_OK);
     for (int i = 0; i < NLEGS; i++) {          /* the healthy drives got ENABLE cleared */
         struct modbus_sim_drive_state st;
@@ -174,11 +155,11 @@ START_TEST(test_drive_timeout_stops_machine)
     modbus_sim_inject(s, 2, MODBUS_SIM_FAULT_NONE, 0);
     ck_assert_int_eq(hal_sets(h, "estop-reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "estop-latch.0.ok-out") != 0.0);
+    ck_assert(test_pin_value(h, "estop-latch.0.ok-out") != 0.0);
     ck_assert_int_eq(hal_sim_advance(h, 10 * PERIOD_NS), HAL_OK);
-    ck_assert(val(h, "modbus.fault-any") == 0.0);
-    ck_assert(val(h, "modbus.2.connected") != 0.0);
-    ck_assert_uint_eq(val(h, "modbus.2.errors"), 1);
+    ck_assert(test_pin_value(h, "modbus.fault-any") == 0.0);
+    ck_assert(test_pin_value(h, "modbus.2.connected") != 0.0);
+    ck_assert_uint_eq(test_pin_value(h, "modbus.2.errors"), 1);
     hal_destroy(h);
 }
 END_TEST

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "hal/hal.h"
+#include "tests/test_hal_util.h"
 #include "sim/modbus_sim.h"
 
 #define NDRIVES 6
@@ -21,16 +22,6 @@ static void cmd(struct hal *h, const char *line)
 {
     int st = hal_cmd(h, line, "test", 0, stdout);
     ck_assert_msg(st == HAL_OK, "'%s': %s", line, hal_last_error(h));
-}
-
-/* A pin's data pointer of the expected type. */
-static void *pin(struct hal *h, const char *name, enum hal_type want)
-{
-    enum hal_type t;
-    void *p = hal_data_ptr(h, name, &t);
-    ck_assert_msg(p != NULL, "no pin %s", name);
-    ck_assert_int_eq(t, want);
-    return p;
 }
 
 /* Writes an INI with [MODBUS] and a PORT per drive; returns its path in buf. */
@@ -124,7 +115,7 @@ static struct hal *make_graph(const char *ini, bool with_server)
 static void step(struct hal *h, int k)
 {
     ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-    ck_assert_int_eq(*(int32_t *)pin(h, "streamer.0.row", HAL_S32), k + 1);
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "streamer.0.row", HAL_S32), k + 1);
 }
 
 /* Presses and releases the machine reset (one period each). */
@@ -143,11 +134,11 @@ static void follow_motion(struct hal *h, struct modbus_sim *s, const int *ticks)
     char name[64];
     for (int i = 0; i < NDRIVES; i++) {
         snprintf(name, sizeof(name), "modbus.%d.position-fb", i);
-        fb[i] = pin(h, name, HAL_FLOAT);
+        fb[i] = test_pin(h, name, HAL_FLOAT);
     }
     int k = 0;
     press_reset(h, &k);                             /* leave the start-up e-stop */
-    ck_assert(*(bool *)pin(h, "estop-latch.0.ok-out", HAL_BIT));
+    ck_assert(*(bool *)test_pin(h, "estop-latch.0.ok-out", HAL_BIT));
     struct modbus_sim_drive_state st0[NDRIVES];
     for (int i = 0; i < NDRIVES; i++)
         modbus_sim_state(s, i, &st0[i]);
@@ -172,12 +163,12 @@ static void follow_motion(struct hal *h, struct modbus_sim *s, const int *ticks)
         ck_assert_int_eq(st.target_counts, (int32_t)lround(leg_cmd(i, last) * CPM));
         ck_assert_double_eq(*fb[i], lround(st.actual_counts) / CPM);
         snprintf(name, sizeof(name), "modbus.%d.status-word", i);
-        ck_assert_uint_eq(*(uint32_t *)pin(h, name, HAL_U32) & MODBUS_STAT_ENABLED,
+        ck_assert_uint_eq(*(uint32_t *)test_pin(h, name, HAL_U32) & MODBUS_STAT_ENABLED,
                           MODBUS_STAT_ENABLED);
         snprintf(name, sizeof(name), "modbus.%d.rtt-us", i);
-        ck_assert_double_gt(*(double *)pin(h, name, HAL_FLOAT), 0.0);
+        ck_assert_double_gt(*(double *)test_pin(h, name, HAL_FLOAT), 0.0);
         snprintf(name, sizeof(name), "modbus.%d.errors", i);
-        ck_assert_uint_eq(*(uint32_t *)pin(h, name, HAL_U32), 0);
+        ck_assert_uint_eq(*(uint32_t *)test_pin(h, name, HAL_U32), 0);
     }
 }
 
@@ -242,8 +233,8 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
     char ini[64];
     write_ini(ini, sizeof(ini), ports, "");
     struct hal *h = make_graph(ini, false);
-    bool *ok = pin(h, "estop-latch.0.ok-out", HAL_BIT);
-    bool *fault3 = pin(h, "modbus.3.fault", HAL_BIT), *fault2 = pin(h, "modbus.2.fault", HAL_BIT);
+    bool *ok = test_pin(h, "estop-latch.0.ok-out", HAL_BIT);
+    bool *fault3 = test_pin(h, "modbus.3.fault", HAL_BIT), *fault2 = test_pin(h, "modbus.2.fault", HAL_BIT);
     int k = 0;
     press_reset(h, &k);
     for (int n = 0; n < 20; n++)
@@ -254,16 +245,16 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
         step(h, k++);
     ck_assert(*fault3);
     ck_assert(!*fault2);
-    ck_assert(*(bool *)pin(h, "modbus.fault-any", HAL_BIT));
+    ck_assert(*(bool *)test_pin(h, "modbus.fault-any", HAL_BIT));
     ck_assert(!*ok);                                /* e-stop: motion loses enable */
-    ck_assert(!*(bool *)pin(h, "modbus.3.connected", HAL_BIT));
-    ck_assert_uint_eq(*(uint32_t *)pin(h, "modbus.3.errors", HAL_U32), 1);
+    ck_assert(!*(bool *)test_pin(h, "modbus.3.connected", HAL_BIT));
+    ck_assert_uint_eq(*(uint32_t *)test_pin(h, "modbus.3.errors", HAL_U32), 1);
     press_reset(h, &k);
     ck_assert(*ok);                                 /* the chain resets in the same press */
     for (int n = 0; n < 8; n++)
         step(h, k++);
     ck_assert(!*fault3 && *ok);
-    ck_assert(*(bool *)pin(h, "modbus.3.connected", HAL_BIT));
+    ck_assert(*(bool *)test_pin(h, "modbus.3.connected", HAL_BIT));
     struct modbus_sim_drive_state st;
     modbus_sim_state(s, 3, &st);
     ck_assert_uint_eq(st.connections, 2);
@@ -275,7 +266,7 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
     press_reset(h, &k);
     for (int n = 0; n < 8; n++)
         step(h, k++);
-    ck_assert(*(bool *)pin(h, "modbus.1.fault", HAL_BIT));
+    ck_assert(*(bool *)test_pin(h, "modbus.1.fault", HAL_BIT));
     ck_assert(!*ok);
     hal_destroy(h);
     modbus_sim_destroy(s);
@@ -328,15 +319,15 @@ START_TEST(test_rtu_drive_through_hal)
     modbus_sim_set_position(s, 0, -1000);
     cmd(h, "loadrt modbus");
     /* Loading reads the drive once: the feedback is its position before any command. */
-    ck_assert_double_eq(*(double *)pin(h, "modbus.0.position-fb", HAL_FLOAT), -2.0);
+    ck_assert_double_eq(*(double *)test_pin(h, "modbus.0.position-fb", HAL_FLOAT), -2.0);
     cmd(h, "addf modbus.update servo-thread");
     cmd(h, "setp modbus.0.enable 1");
     cmd(h, "setp modbus.0.position-cmd 612.346");
     ck_assert_int_eq(hal_start(h), HAL_OK);
     for (int k = 0; k < 12; k++)
         ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-    ck_assert(!*(bool *)pin(h, "modbus.0.fault", HAL_BIT));
-    ck_assert_double_eq(*(double *)pin(h, "modbus.0.position-fb", HAL_FLOAT), 612.346);
+    ck_assert(!*(bool *)test_pin(h, "modbus.0.fault", HAL_BIT));
+    ck_assert_double_eq(*(double *)test_pin(h, "modbus.0.position-fb", HAL_FLOAT), 612.346);
     struct modbus_sim_drive_state st;
     modbus_sim_state(s, 0, &st);
     ck_assert_int_eq(st.target_counts, 306173);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "hal/hal.h"
+#include "tests/test_hal_util.h"
 #include "motion/motion_hal.h"
 #include "tests/test_motion_util.h"
 
@@ -13,16 +14,6 @@
 
 static const double HOME[6] = {0, 0, 645, 0, 0, 0};
 static const double GOAL[6] = {20, -10, 650, 2, -2, 5};
-
-/* A pin's current data (its signal's when linked). */
-static void *pin(struct hal *h, const char *name, enum hal_type want)
-{
-    enum hal_type t;
-    void *p = hal_data_ptr(h, name, &t);
-    ck_assert_msg(p != NULL, "no pin %s", name);
-    ck_assert_int_eq(t, want);
-    return p;
-}
 
 /* The machine of configs/sim (INI + HAL file) on the simulated clock, with a program
  * HOME -> GOAL -> HOME handed to motion, started. */
@@ -46,8 +37,8 @@ static struct hal *make_machine(struct canon_prog *p)
     ck_assert_int_eq(hal_start(h), HAL_OK);
     /* the machine comes up in e-stop: a reset edge on the latch enables it */
     ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
-    ck_assert(!*(bool *)pin(h, "motion.enable", HAL_BIT));
-    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_IDLE);
+    ck_assert(!*(bool *)test_pin(h, "motion.enable", HAL_BIT));
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.state", HAL_S32), MOTION_IDLE);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "1"), HAL_OK);
     return h;
 }
@@ -55,7 +46,7 @@ static struct hal *make_machine(struct canon_prog *p)
 /* Runs up to n periods or until motion.done / motion.fault. */
 static int advance(struct hal *h, int n)
 {
-    bool *done = pin(h, "motion.done", HAL_BIT), *fault = pin(h, "motion.fault", HAL_BIT);
+    bool *done = test_pin(h, "motion.done", HAL_BIT), *fault = test_pin(h, "motion.fault", HAL_BIT);
     int k = 0;
     for (; k < n && !*done && !*fault; k++)
         ck_assert_int_eq(hal_sim_advance(h, PERIOD_NS), HAL_OK);
@@ -72,26 +63,26 @@ START_TEST(test_hal_run)
     char name[64];
     for (int i = 0; i < 6; i++) {
         snprintf(name, sizeof name, "motion.ferror-%d", i);
-        fe[i] = pin(h, name, HAL_FLOAT);
+        fe[i] = test_pin(h, name, HAL_FLOAT);
     }
-    int32_t *line = pin(h, "motion.program-line", HAL_S32);
-    double *px = pin(h, "motion.pose-cmd-x", HAL_FLOAT), *rem = pin(h, "motion.time-remaining", HAL_FLOAT);
+    int32_t *line = test_pin(h, "motion.program-line", HAL_S32);
+    double *px = test_pin(h, "motion.pose-cmd-x", HAL_FLOAT), *rem = test_pin(h, "motion.time-remaining", HAL_FLOAT);
     int seen3 = 0, seen_goal = 0;
-    for (int k = 0; k < 20000 && !*(bool *)pin(h, "motion.done", HAL_BIT); k++) {
-        ck_assert(!*(bool *)pin(h, "motion.fault", HAL_BIT));
+    for (int k = 0; k < 20000 && !*(bool *)test_pin(h, "motion.done", HAL_BIT); k++) {
+        ck_assert(!*(bool *)test_pin(h, "motion.fault", HAL_BIT));
         advance(h, 1);
         seen3 |= *line == 3;
         seen_goal |= fabs(*px - 20) < 1e-3;
         for (int i = 0; i < 6; i++)
             worst = fmax(worst, fabs(*fe[i]));
     }
-    ck_assert_msg(*(bool *)pin(h, "motion.done", HAL_BIT), "%s", motion_hal_fault(h));
+    ck_assert_msg(*(bool *)test_pin(h, "motion.done", HAL_BIT), "%s", motion_hal_fault(h));
     ck_assert(seen3 && seen_goal);
     ck_assert_int_eq(*line, 4);
     ck_assert_double_eq_tol(*rem, 0, 1e-9);
     ck_assert_msg(worst < 0.01, "following error %.4f mm", worst);
-    ck_assert_double_eq_tol(*(double *)pin(h, "kins.pose-fb-z", HAL_FLOAT), 645, 0.01);
-    ck_assert_double_eq_tol(*(double *)pin(h, "kins.pose-fb-x", HAL_FLOAT), 0, 0.01);
+    ck_assert_double_eq_tol(*(double *)test_pin(h, "kins.pose-fb-z", HAL_FLOAT), 645, 0.01);
+    ck_assert_double_eq_tol(*(double *)test_pin(h, "kins.pose-fb-x", HAL_FLOAT), 0, 0.01);
     hal_destroy(h);
     canon_prog_free(&p);
 }
@@ -103,14 +94,14 @@ START_TEST(test_hal_estop)
     struct canon_prog p;
     struct hal *h = make_machine(&p);
     advance(h, 500);
-    double *px = pin(h, "motion.pose-cmd-x", HAL_FLOAT);
+    double *px = test_pin(h, "motion.pose-cmd-x", HAL_FLOAT);
     ck_assert(*px > 0.1);
     ck_assert_int_eq(hal_setp(h, "motion.estop", "1"), HAL_OK);
     advance(h, 1);
     double held = *px;
-    ck_assert(*(bool *)pin(h, "motion.fault", HAL_BIT));
-    ck_assert(!*(bool *)pin(h, "motion.amp-enable", HAL_BIT));
-    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_FAULT);
+    ck_assert(*(bool *)test_pin(h, "motion.fault", HAL_BIT));
+    ck_assert(!*(bool *)test_pin(h, "motion.amp-enable", HAL_BIT));
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.state", HAL_S32), MOTION_FAULT);
     advance(h, 100);
     ck_assert_double_eq(*px, held);
     ck_assert_msg(strstr(motion_hal_fault(h), "emergency stop"), "%s", motion_hal_fault(h));
@@ -130,11 +121,11 @@ START_TEST(test_hal_runner_calls)
     ck_assert_int_eq(o.state, MOTION_RUNNING);
     double pose[6];
     ck_assert_int_eq(motion_hal_pose(h, pose), MOTION_OK);
-    ck_assert_double_eq(pose[0], *(double *)pin(h, "motion.pose-cmd-x", HAL_FLOAT));
+    ck_assert_double_eq(pose[0], *(double *)test_pin(h, "motion.pose-cmd-x", HAL_FLOAT));
     ck_assert_int_eq(motion_hal_start(h), MOTION_ERR_STATE);      /* already running */
     ck_assert_int_eq(motion_hal_abort(h), MOTION_OK);
     advance(h, 1000);
-    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_IDLE);
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.state", HAL_S32), MOTION_IDLE);
     ck_assert_int_eq(motion_hal_start(h), MOTION_ERR_STATE);      /* program dropped */
     /* a new program from where it stopped, loaded on the core, started through HAL */
     canon_prog_free(&p);
@@ -145,8 +136,8 @@ START_TEST(test_hal_runner_calls)
     ck_assert_int_eq(motion_load(motion_hal_get(h), &p, err, sizeof err), MOTION_OK);
     ck_assert_int_eq(motion_hal_start(h), MOTION_OK);
     advance(h, 20000);
-    ck_assert_int_eq(*(int32_t *)pin(h, "motion.state", HAL_S32), MOTION_DONE);
-    ck_assert_int_eq(*(int32_t *)pin(h, "motion.program-line", HAL_S32), 7);
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.state", HAL_S32), MOTION_DONE);
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.program-line", HAL_S32), 7);
     hal_destroy(h);
     canon_prog_free(&p);
 }
@@ -157,14 +148,14 @@ START_TEST(test_hal_pause)
 {
     struct canon_prog p;
     struct hal *h = make_machine(&p);
-    int32_t *state = pin(h, "motion.state", HAL_S32);
+    int32_t *state = test_pin(h, "motion.state", HAL_S32);
     advance(h, 500);
     ck_assert_int_eq(hal_setp(h, "motion.pause", "1"), HAL_OK);
     advance(h, 300);
     ck_assert_int_eq(*state, MOTION_PAUSED);
-    double x = *(double *)pin(h, "motion.pose-cmd-x", HAL_FLOAT);
+    double x = *(double *)test_pin(h, "motion.pose-cmd-x", HAL_FLOAT);
     advance(h, 100);
-    ck_assert_double_eq(*(double *)pin(h, "motion.pose-cmd-x", HAL_FLOAT), x);
+    ck_assert_double_eq(*(double *)test_pin(h, "motion.pose-cmd-x", HAL_FLOAT), x);
     ck_assert_int_eq(hal_setp(h, "motion.resume", "1"), HAL_OK);
     advance(h, 20000);
     ck_assert_int_eq(*state, MOTION_DONE);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "hal/hal.h"
+#include "tests/test_hal_util.h"
 #include "sim/stepgen.h"
 
 #define PERIOD_NS 1000000L
@@ -15,16 +16,6 @@ static void cmd(struct hal *h, const char *line)
 {
     int st = hal_cmd(h, line, "test", 0, stdout);
     ck_assert_msg(st == HAL_OK, "'%s': %s", line, hal_last_error(h));
-}
-
-/* A pin's current data (its signal's when linked). */
-static void *pin(struct hal *h, const char *name, enum hal_type want)
-{
-    enum hal_type t;
-    void *p = hal_data_ptr(h, name, &t);
-    ck_assert_msg(p != NULL, "no pin %s", name);
-    ck_assert_int_eq(t, want);
-    return p;
 }
 
 /* Two channels on a 1 kHz simulated thread; channel 0 at 400 steps/mm, 1 at 1000. */
@@ -57,9 +48,9 @@ static struct hal *make_graph(void)
 START_TEST(test_hal_matches_core)
 {
     struct hal *h = make_graph();
-    double *fb0 = pin(h, "stepgen.0.position-fb", HAL_FLOAT);
-    int32_t *counts0 = pin(h, "stepgen.0.counts", HAL_S32);
-    double *vel0 = pin(h, "stepgen.0.velocity-fb", HAL_FLOAT);
+    double *fb0 = test_pin(h, "stepgen.0.position-fb", HAL_FLOAT);
+    int32_t *counts0 = test_pin(h, "stepgen.0.counts", HAL_S32);
+    double *vel0 = test_pin(h, "stepgen.0.velocity-fb", HAL_FLOAT);
     struct stepgen_limits lim = { 400.0, 50.0, 500.0 };
     struct stepgen_state ref;
     stepgen_state_init(&ref, 0.0);
@@ -84,8 +75,8 @@ END_TEST
 START_TEST(test_hal_step_limits)
 {
     struct hal *h = make_graph();
-    double *vel1 = pin(h, "stepgen.1.velocity-fb", HAL_FLOAT);
-    int32_t *counts1 = pin(h, "stepgen.1.counts", HAL_S32);
+    double *vel1 = test_pin(h, "stepgen.1.velocity-fb", HAL_FLOAT);
+    int32_t *counts1 = test_pin(h, "stepgen.1.counts", HAL_S32);
     cmd(h, "sets cmd1 10");
     double v_prev = 0.0;
     int arrived = -1;
@@ -107,7 +98,7 @@ END_TEST
 START_TEST(test_hal_enable_and_args)
 {
     struct hal *h = make_graph();
-    int32_t *counts0 = pin(h, "stepgen.0.counts", HAL_S32);
+    int32_t *counts0 = test_pin(h, "stepgen.0.counts", HAL_S32);
     cmd(h, "sets cmd0 1");
     ck_assert_int_eq(hal_sim_advance(h, 500 * PERIOD_NS), HAL_OK);
     ck_assert_int_eq(*counts0, 400);
@@ -145,9 +136,9 @@ START_TEST(test_hal_ctrl_type)
     ck_assert_int_eq(hal_start(h), HAL_OK);
     ck_assert_int_eq(hal_sim_advance(h, 1000 * PERIOD_NS), HAL_OK);
     /* 0.02 s ramp to 2 mm/s (0.02 mm), then 0.98 s at 2 mm/s (1.96 mm): 1.98 mm */
-    int32_t *counts1 = pin(h, "stepgen.1.counts", HAL_S32);
+    int32_t *counts1 = test_pin(h, "stepgen.1.counts", HAL_S32);
     ck_assert_msg(abs(*counts1 - 1980) <= 2, "counts %d, expected about 1980", *counts1);
-    ck_assert(fabs(*(double *)pin(h, "stepgen.1.velocity-fb", HAL_FLOAT) - 2.0) < 1e-9);
+    ck_assert(fabs(*(double *)test_pin(h, "stepgen.1.velocity-fb", HAL_FLOAT) - 2.0) < 1e-9);
     hal_destroy(h);
     h = hal_create();
     ck_assert_int_ne(hal_cmd(h, "loadrt stepgen ctrl_type=p,x", "y.hal", 1, stdout), HAL_OK);
