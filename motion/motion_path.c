@@ -62,6 +62,16 @@ static const char *intern_file(struct motion_plan *p, const char *name)
     return nf[p->nfiles++];
 }
 
+/* Grows one per-knot array to cap entries; the old array stays valid on failure. */
+static int motion_grow(double **a, size_t cap)
+{
+    double *n = realloc(*a, cap * sizeof *n);
+    if (!n)
+        return -1;
+    *a = n;
+    return 0;
+}
+
 /* Room for one more segment and n more knots. */
 static int grow(struct motion_plan *p, size_t nknots)
 {
@@ -76,28 +86,10 @@ static int grow(struct motion_plan *p, size_t nknots)
         size_t cap = p->capknot ? 2 * p->capknot : 1024;
         while (cap < p->nknot + nknots)
             cap *= 2;
-        double *ks = realloc(p->ks, cap * sizeof *ks);
-        if (ks)
-            p->ks = ks;
-        double *kv = realloc(p->kv, cap * sizeof *kv);
-        if (kv)
-            p->kv = kv;
-        double *kt = realloc(p->kt, cap * sizeof *kt);
-        if (kt)
-            p->kt = kt;
-        double *kr = realloc(p->krho, cap * sizeof *kr);
-        if (kr)
-            p->krho = kr;
-        double *ia = realloc(p->iacc, cap * sizeof *ia);
-        if (ia)
-            p->iacc = ia;
-        double *ir = realloc(p->irho, cap * sizeof *ir);
-        if (ir)
-            p->irho = ir;
-        double *iv = realloc(p->ivp, cap * sizeof *iv);
-        if (iv)
-            p->ivp = iv;
-        if (!ks || !kv || !kt || !kr || !ia || !ir || !iv)
+        /* capknot grows only once every array has: a failure leaves the plan consistent */
+        if (motion_grow(&p->ks, cap) || motion_grow(&p->kv, cap) || motion_grow(&p->kt, cap) ||
+            motion_grow(&p->krho, cap) || motion_grow(&p->iacc, cap) ||
+            motion_grow(&p->irho, cap) || motion_grow(&p->ivp, cap))
             return -1;
         p->capknot = cap;
     }
