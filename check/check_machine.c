@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "check/check_priv.h"
+#include "common/inifile.h"
 #include "hal/hal.h"
 #include "interp/interp.h"
 #include "interp/tooltable.h"
@@ -48,16 +49,6 @@ static const char *ini_get(void *ctx, const char *section, const char *key)
     return hal_ini_get(ctx, section, key);
 }
 
-/* A path from the INI, relative to the INI's folder unless absolute. */
-static void ini_path(const struct check_machine *mc, const char *value, char *out, size_t len)
-{
-    const char *dir = hal_ini_dir(mc->hal);
-    if (value[0] == '/' || !dir || !dir[0])
-        snprintf(out, len, "%s", value);
-    else
-        snprintf(out, len, "%s/%s", dir, value);
-}
-
 /* [KINS] TOOL_AXIS as a unit vector (default 0 0 -1, as the kinematics reads it). */
 static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, size_t errlen)
 {
@@ -74,23 +65,26 @@ static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, 
     return CHECK_OK;
 }
 
-/* Reads the interpreter's settings: FEED_UNITS and TOOL_TABLE. */
+/* Reads the interpreter's settings (interp_settings_read, as the runner does) and applies
+ * them once to a scratch interpreter, so that a missing tool table or a bad parameter file
+ * is a configuration error now; then the drives' [JOINT_n] figures. */
 static int read_interp_settings(struct check_machine *mc, const char *ini, char *err,
                                 size_t errlen)
 {
-    const char *units = hal_ini_get(mc->hal, "RS274NGC", "FEED_UNITS");
-    mc->feed_factor = 1.0;
-    if (units && interp_feed_units_parse(units, &mc->feed_factor) != 0)
-        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [RS274NGC] FEED_UNITS = %s: expected "
-                    "mm/min or m/min", ini, units);
-    const char *table = hal_ini_get(mc->hal, "RS274NGC", "TOOL_TABLE");
-    if (table && table[0]) {
-        char path[1024], msg[512];
-        ini_path(mc, table, path, sizeof path);
-        if (tooltable_load(mc->tt, path, msg, sizeof msg) != TOOLTABLE_OK)
-            return fail(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
-        mc->have_tt = 1;
-    }
+    char msg[1024], where[1536];
+    int st = interp_settings_read(&mc->interp, ini_get, mc->hal, hal_ini_dir(mc->hal), msg,
+                                  sizeof msg);
+    if (st != INTERP_OK)
+        return fail(err, errlen, CHECK_ERR_CONFIG, "%s",
+                    inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
+    struct interp *probe = interp_create();
+    if (!probe)
+        return fail(err, errlen, CHECK_ERR_NOMEM, "out of memory");
+    st = interp_settings_apply(probe, &mc->interp, mc->tt, INTERP_SETUP_PARAMS_READ_ONLY, msg,
+                               sizeof msg);
+    interp_destroy(probe);
+    if (st != INTERP_OK)
+        return fail(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
@@ -187,7 +181,7 @@ double check_machine_scale(const struct check_machine *mc, int joint)
 double check_machine_tool_radius(struct check_machine *mc, int tool)
 {
     double r;
-    if (!mc->have_tt || tooltable_radius(mc->tt, tool, &r) != TOOLTABLE_OK)
+    if (!mc->interp.tool_table[0] || tooltable_radius(mc->tt, tool, &r) != TOOLTABLE_OK)
         return -1;
     return r;
 }
@@ -209,9 +203,11 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
     }
     interp_set_start(in, mc->kins->home);
     memcpy(prog->start, mc->kins->home, sizeof prog->start);
-    interp_set_feed_factor(in, mc->feed_factor);
-    if (mc->have_tt)
-        interp_set_tooltable(in, mc->tt);
+    mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
+    /* the runner's settings, but the machine's parameter file is never written */
+    if (interp_settings_apply(in, &mc->interp, mc->tt, INTERP_SETUP_PARAMS_READ_ONLY,
+                              pb->message, sizeof pb->message) != INTERP_OK)
+        return CHECK_ERR_CONFIG;
     int st = CHECK_OK;
     int ist = text ? interp_run_text(in, path, text, len, canon_prog_sink, prog)
                    : interp_run_file(in, path, canon_prog_sink, prog);
@@ -222,7 +218,6 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
         interp_error_format(e, pb->message, sizeof pb->message);
         st = CHECK_ERR_VIOLATION;
     }
-    mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
     return st;
 }
 

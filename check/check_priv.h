@@ -3,6 +3,7 @@
 #define HEXCNC_CHECK_PRIV_H
 
 #include "check/check.h"
+#include "interp/interp_setup.h"
 
 struct hal;
 struct tooltable;
@@ -15,8 +16,9 @@ struct check_machine {
     struct motion *motion;           /* the planner and interpolator the machine runs */
     struct motion_config mcfg;       /* its limits, from [EMCMOT] [TRAJ] [JOINT_n] */
     struct tooltable *tt;            /* [RS274NGC] TOOL_TABLE (empty when none) */
-    int have_tt;
-    double feed_factor;              /* mm/min per F unit ([RS274NGC] FEED_UNITS) */
+    struct interp_settings interp;   /* [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE,
+                                      * applied to each program's interpreter as the runner
+                                      * applies them (the parameter file read-only) */
     double cond_limit;               /* [KINS] SINGULAR_CONDITION */
     double scale[KINS_MAX_JOINTS];   /* [JOINT_n] SCALE, steps per mm (0 = none) */
     double drive_vel[KINS_MAX_JOINTS]; /* [JOINT_n] STEPGEN_MAXVEL, mm/s (0 = none) */

@@ -23,6 +23,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_TOOL] = "tool error",
     [INTERP_ERR_COMP5] = "G141/G142 compensation error",
     [INTERP_ERR_SINK] = "stopped by the command consumer",
+    [INTERP_ERR_CONFIG] = "bad interpreter setting in the INI file",
 };
 
 /* The fixed text of a status (the message of a run is in struct interp_error). */
@@ -124,6 +125,15 @@ int interp_set_param_file(struct interp *in, const char *path)
     for (int i = 0; i < 6; i++)
         in->g92[i] = in->params[PARAM_G92_ON] != 0.0 ? in->params[PARAM_G92 + i] : 0.0;
     return 0;
+}
+
+/* The same load with no file remembered: nothing is written when a run ends. */
+int interp_load_param_file(struct interp *in, const char *path)
+{
+    int st = interp_set_param_file(in, path);
+    free(in->param_path);
+    in->param_path = NULL;
+    return st;
 }
 
 /* Tool table used by T, G43 H, G10 L1 and G141/G142 D. */

@@ -25,6 +25,7 @@ enum interp_status {
     INTERP_ERR_TOOL,          /* a tool number not in the tool table, or a tool table error */
     INTERP_ERR_COMP5,         /* G141/G142 compensation refused the path */
     INTERP_ERR_SINK,          /* the canon sink asked to stop */
+    INTERP_ERR_CONFIG,        /* a bad interpreter setting in the machine's INI file */
     INTERP_STATUS_COUNT
 };
 const char *interp_strerror(int status);
@@ -50,6 +51,9 @@ void interp_set_start(struct interp *in, const double pose[6]);
  * the persistent parameters (5161..5390) are written back, atomically, when a run ends.
  * NULL: no file. Returns INTERP_OK or an error (details in interp_last_error). */
 int interp_set_param_file(struct interp *in, const char *path);
+/* Loads a parameter file as interp_set_param_file() does but never writes it back, so that
+ * an offline check leaves the machine's offsets as they are. */
+int interp_load_param_file(struct interp *in, const char *path);
 /* Tool table for T/M6, G43 H and the D word of G141/G142; not owned. NULL: no table. */
 void interp_set_tooltable(struct interp *in, struct tooltable *tt);
 /* F multiplier for metric programs: 1 for FEED_UNITS = mm/min, 1000 for m/min. */

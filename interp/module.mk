@@ -9,3 +9,4 @@ SCRIPT_TESTS += tests/paper_programs.sh
 TESTS += test_interp test_interp_number test_interp_motion
 BENCHES += bench_interp
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh
+LIB_SRCS += interp/interp_setup.c

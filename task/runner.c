@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/inifile.h"
 #include "interp/interp.h"
+#include "interp/interp_setup.h"
 #include "interp/tooltable.h"
 #include "motion/motion_hal.h"
 
@@ -183,36 +185,26 @@ const char *runner_default_program(const struct runner *r)
     return r->default_program[0] ? r->default_program : NULL;
 }
 
-/* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE to the interpreter. */
+/* The INI lookup interp_setup reads through. */
+static const char *runner_ini_get(void *ctx, const char *section, const char *key)
+{
+    return hal_ini_get(ctx, section, key);
+}
+
+/* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE (interp_setup: the same code
+ * hexcnc check and hexcnc interp use); a bad value is pointed at its INI line. */
 static int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt,
                                char *err, size_t errlen)
 {
-    const char *ini = hal_ini_path(r->hal);
-    const char *units = hal_ini_get(r->hal, "RS274NGC", "FEED_UNITS");
-    double factor = 1.0;
-    if (units && interp_feed_units_parse(units, &factor) != 0)
-        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s: [RS274NGC] FEED_UNITS = %s: "
-                           "expected mm/min or m/min", ini, units);
-    interp_set_feed_factor(in, factor);
-    char path[1024];
-    const char *table = hal_ini_get(r->hal, "RS274NGC", "TOOL_TABLE");
-    if (table && table[0]) {
-        runner_ini_path(r, table, path, sizeof path);
-        char msg[512];
-        if (tooltable_load(tt, path, msg, sizeof msg) != TOOLTABLE_OK)
-            return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", msg);
-        interp_set_tooltable(in, tt);
-    }
-    const char *params = hal_ini_get(r->hal, "RS274NGC", "PARAMETER_FILE");
-    if (params && params[0]) {
-        runner_ini_path(r, params, path, sizeof path);
-        if (interp_set_param_file(in, path) != INTERP_OK) {
-            char msg[600];
-            return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s",
-                               interp_error_format(interp_last_error(in), msg, sizeof msg));
-        }
-    }
-    return RUNNER_OK;
+    char msg[1024];
+    int st = interp_setup(in, tt, runner_ini_get, r->hal, hal_ini_dir(r->hal), 0, msg,
+                          sizeof msg);
+    if (st == INTERP_OK)
+        return RUNNER_OK;
+    char where[1536];
+    return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", st == INTERP_ERR_CONFIG
+                       ? inifile_locate_msg(hal_ini_file(r->hal), msg, where, sizeof where)
+                       : msg);
 }
 
 /* Interprets the whole program into prog, starting from the machine's present pose. */

@@ -1,0 +1,96 @@
+/* interp_setup.c: reads [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE and applies them. */
+#include "interp/interp_setup.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "interp/interp.h"
+#include "interp/tooltable.h"
+
+/* Formats err (when given) and returns status: every error path is one line. */
+static int setup_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static int setup_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+/* A path from [section]key made relative to the INI's folder unless absolute; "" when the
+ * key is absent or empty. */
+static int setup_path(const char *section, const char *key, const char *value, const char *dir,
+                      char *out, size_t len, char *err, size_t errlen)
+{
+    out[0] = '\0';
+    if (!value || !value[0])
+        return INTERP_OK;
+    int n = value[0] == '/' || !dir || !dir[0] ? snprintf(out, len, "%s", value)
+                                               : snprintf(out, len, "%s/%s", dir, value);
+    if (n < 0 || (size_t)n >= len)
+        return setup_fail(err, errlen, INTERP_ERR_CONFIG, "[%s] %s = %s: the path is longer "
+                          "than %zu characters", section, key, value, len - 1);
+    return INTERP_OK;
+}
+
+/* Reads the three settings; LinuxCNC also takes the tool table from [EMCIO]. */
+int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, void *ctx,
+                         const char *dir, char *err, size_t errlen)
+{
+    memset(s, 0, sizeof *s);
+    s->feed_factor = 1.0;
+    const char *units = get(ctx, "RS274NGC", "FEED_UNITS");
+    if (units && units[0] && interp_feed_units_parse(units, &s->feed_factor) != 0)
+        return setup_fail(err, errlen, INTERP_ERR_CONFIG, "[RS274NGC] FEED_UNITS = %s: use "
+                          "mm/min or m/min", units);
+    const char *table_section = "RS274NGC";
+    const char *table = get(ctx, "RS274NGC", "TOOL_TABLE");
+    if (!table || !table[0]) {
+        table_section = "EMCIO";
+        table = get(ctx, "EMCIO", "TOOL_TABLE");
+    }
+    int st = setup_path(table_section, "TOOL_TABLE", table, dir, s->tool_table,
+                        sizeof s->tool_table, err, errlen);
+    if (st == INTERP_OK)
+        st = setup_path("RS274NGC", "PARAMETER_FILE", get(ctx, "RS274NGC", "PARAMETER_FILE"),
+                        dir, s->param_file, sizeof s->param_file, err, errlen);
+    return st;
+}
+
+/* Feed factor, tool table, parameter file, in that order. */
+int interp_settings_apply(struct interp *in, const struct interp_settings *s,
+                          struct tooltable *tt, unsigned flags, char *err, size_t errlen)
+{
+    interp_set_feed_factor(in, s->feed_factor);
+    if (tt && s->tool_table[0]) {
+        char msg[600];
+        if (tooltable_load(tt, s->tool_table, msg, sizeof msg) != TOOLTABLE_OK)
+            return setup_fail(err, errlen, INTERP_ERR_TOOL, "%s", msg);
+        interp_set_tooltable(in, tt);
+    }
+    if (s->param_file[0]) {
+        int st = flags & INTERP_SETUP_PARAMS_READ_ONLY
+                     ? interp_load_param_file(in, s->param_file)
+                     : interp_set_param_file(in, s->param_file);
+        if (st != INTERP_OK) {
+            char msg[600];
+            return setup_fail(err, errlen, st, "%s",
+                              interp_error_format(interp_last_error(in), msg, sizeof msg));
+        }
+    }
+    return INTERP_OK;
+}
+
+/* Reads the INI's settings and applies them. */
+int interp_setup(struct interp *in, struct tooltable *tt, interp_setup_get_fn get, void *ctx,
+                 const char *dir, unsigned flags, char *err, size_t errlen)
+{
+    struct interp_settings s;
+    int st = interp_settings_read(&s, get, ctx, dir, err, errlen);
+    return st != INTERP_OK ? st : interp_settings_apply(in, &s, tt, flags, err, errlen);
+}
