@@ -3,6 +3,8 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include "check/check.h"
 #include "task/runner.h"
@@ -13,8 +15,14 @@
 static void compare(const char *ini_rel, const char *prog_rel)
 {
     char ini[1024], prog[1024], err[1024];
-    tc_path(ini_rel, ini, sizeof ini);
-    tc_path(prog_rel, prog, sizeof prog);
+    if (ini_rel[0] == '/')   /* absolute paths are taken as they are */
+        snprintf(ini, sizeof ini, "%s", ini_rel);
+    else
+        tc_path(ini_rel, ini, sizeof ini);
+    if (prog_rel[0] == '/')
+        snprintf(prog, sizeof prog, "%s", prog_rel);
+    else
+        tc_path(prog_rel, prog, sizeof prog);
     struct check_machine *mc;
     struct check_result c;
     ck_assert_msg(check_machine_open(ini, &mc, err, sizeof err) == 0, "%s", err);
@@ -54,6 +62,85 @@ START_TEST(test_check_agrees_with_run)
 }
 END_TEST
 
+/* Writes text to dir/name; out receives the path. */
+static void put_file(const char *dir, const char *name, const char *text, char *out, size_t len)
+{
+    snprintf(out, len, "%s/%s", dir, name);
+    FILE *f = fopen(out, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Copies the simulated TMU's INI into dir with its files made absolute (they stay in
+ * configs/sim), adding [RS274NGC] PARAMETER_FILE = params.var (relative: beside the copy). */
+static void copy_ini_with_params(const char *dir, char *ini, size_t len)
+{
+    char src[1024], simdir[1024], line[1024];
+    tc_path("configs/sim/tmu-hexapod.ini", src, sizeof src);
+    tc_path("configs/sim", simdir, sizeof simdir);
+    FILE *in = fopen(src, "r");
+    ck_assert_ptr_nonnull(in);
+    snprintf(ini, len, "%s/machine.ini", dir);
+    FILE *out = fopen(ini, "w");
+    ck_assert_ptr_nonnull(out);
+    while (fgets(line, sizeof line, in)) {
+        char key[64], value[512];
+        if (sscanf(line, " %63[A-Z_] = %511s", key, value) == 2 &&
+            (!strcmp(key, "HALFILE") || !strcmp(key, "TOOL_TABLE")))
+            fprintf(out, "%s = %s/%s\n", key, simdir, value);
+        else if (strncmp(line, "OPEN_FILE", 9) != 0)
+            fputs(line, out);
+        if (!strncmp(line, "[RS274NGC]", 10))
+            fputs("PARAMETER_FILE = params.var\n", out);
+    }
+    fclose(in);
+    fclose(out);
+}
+
+/* A G54 work offset stored in the parameter file moves the check's path exactly as it moves
+ * the run's: the check reads [RS274NGC] PARAMETER_FILE as the runner does, never writing it. */
+START_TEST(test_check_uses_the_parameter_file)
+{
+    char dir[] = "/tmp/hexcnc-params-XXXXXX", ini[1024], params[1024], prog[1024], err[1024];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    copy_ini_with_params(dir, ini, sizeof ini);
+    /* G54 (parameters 5221..5223): X +40, Y -30, Z -12 mm */
+    const char *param_text = "5220\t1.000000\n5221\t40.000000\n5222\t-30.000000\n"
+                             "5223\t-12.000000\n";
+    put_file(dir, "params.var", param_text, params, sizeof params);
+    put_file(dir, "g54.ngc", "G21 G90 G54\nG1 X10 Y5 Z640 A0 B0 C0 F1\nG1 X-10 Y-5 Z635\n"
+             "M2\n", prog, sizeof prog);
+
+    struct check_machine *mc;
+    ck_assert_msg(check_machine_open(ini, &mc, err, sizeof err) == 0, "%s", err);
+    struct canon_prog cp;
+    struct check_problem pb;
+    canon_prog_init(&cp);
+    ck_assert_msg(check_machine_interpret(mc, prog, &cp, &pb) == CHECK_OK, "%s", pb.message);
+    const struct canon_cmd *first = NULL;
+    for (size_t i = 0; i < cp.count && !first; i++)
+        if (cp.cmds[i].type == CANON_FEED)
+            first = &cp.cmds[i];
+    ck_assert_ptr_nonnull(first);
+    ck_assert_double_eq_tol(first->end[0], 50.0, 1e-9);   /* 10 + 40 */
+    ck_assert_double_eq_tol(first->end[1], -25.0, 1e-9);  /* 5 - 30 */
+    ck_assert_double_eq_tol(first->end[2], 628.0, 1e-9);  /* 640 - 12 */
+    canon_prog_free(&cp);
+    check_machine_close(mc);
+
+    compare(ini, prog);   /* the same leg ranges, time and rates as the run */
+
+    char names[3][1024];
+    snprintf(names[0], sizeof names[0], "%s", prog);
+    snprintf(names[1], sizeof names[1], "%s", params);
+    snprintf(names[2], sizeof names[2], "%s", ini);
+    for (int i = 0; i < 3; i++)
+        unlink(names[i]);
+    rmdir(dir);
+}
+END_TEST
+
 /* The test case. */
 static Suite *suite(void)
 {
@@ -61,6 +148,7 @@ static Suite *suite(void)
     TCase *tc = tcase_create("check_runner");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_check_agrees_with_run);
+    tcase_add_test(tc, test_check_uses_the_parameter_file);
     suite_add_tcase(s, tc);
     return s;
 }
