@@ -122,14 +122,17 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
                   "kinematics does the machine have?", ini);
         goto fail;
     }
+    char where[1024];   /* "[SECTION] KEY: ..." messages get the key's INI line */
     if (kins_load(name, &kc, &mc->kins, msg, sizeof msg) != KINS_OK) {
-        st = fail(err, errlen, CHECK_ERR_KINS, "%s: %s", ini, msg);
+        st = fail(err, errlen, CHECK_ERR_KINS, "%s",
+                  inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
         goto fail;
     }
     motion_config_default(&mc->mcfg);
     if (motion_config_read(&mc->mcfg, &kc, mc->kins->njoints, msg, sizeof msg) != MOTION_OK ||
         motion_create(&mc->mcfg, mc->kins, &mc->motion, msg, sizeof msg) != MOTION_OK) {
-        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s: %s", ini, msg);
+        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s",
+                  inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
         goto fail;
     }
     mc->cond_limit = 100;
