@@ -303,6 +303,27 @@ START_TEST(test_plots_written)
 }
 END_TEST
 
+/* A bad kinematics value in the INI: the message names the file and the key's line. */
+START_TEST(test_config_error_names_the_ini_line)
+{
+    char path[] = "/tmp/hexcnc-check-ini-XXXXXX", err[1024], want[256];
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    FILE *f = fdopen(fd, "w");
+    fprintf(f, "[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\nPLATFORM_RADIUS = 300\n"
+               "BASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = 10\n");
+    for (int i = 0; i < 6; i++)
+        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\n", i, i == 3 ? "abc" : "980");
+    fclose(f);
+    struct check_machine *mc = NULL;
+    ck_assert_int_eq(check_machine_open(path, &mc, err, sizeof err), CHECK_ERR_KINS);
+    snprintf(want, sizeof want, "%s:18: [JOINT_3] MAX_LIMIT: 'abc' is not a number", path);
+    ck_assert_str_eq(err, want);
+    ck_assert_ptr_null(mc);
+    unlink(path);
+}
+END_TEST
+
 START_TEST(test_strip_compensation)
 {
     const char in[] = "G141 X50 Y-80 Z630 A0 B-4 W10 F2;\ng142 x1 D3\nG1 X1 (G1410)\n";
@@ -331,6 +352,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_json_reader_rejects_bad_text);
     tcase_add_test(tc, test_plots_written);
     tcase_add_test(tc, test_strip_compensation);
+    tcase_add_test(tc, test_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);
     return s;
 }
