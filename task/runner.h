@@ -122,6 +122,16 @@ int runner_plan_info(const struct runner *r, struct motion_plan_info *out);
 
 /* Sets the observer called after every servo period (NULL to remove). */
 void runner_set_observer(struct runner *r, runner_observer_fn fn, void *ctx);
+/* Event codes the runner posts on HEXCNC_EVENT (source "task") when lcm-status is loaded;
+ * components' messages are forwarded with RUNNER_EVENT_MESSAGE and their own source. */
+enum runner_event_code {
+    RUNNER_EVENT_STARTED = 100,     /* the program started moving */
+    RUNNER_EVENT_FINISHED = 101,    /* the program ran to its end */
+    RUNNER_EVENT_FAULT = 102,       /* the machine stopped on a fault (text: the cause) */
+    RUNNER_EVENT_ABORTED = 103,     /* the operator stopped the program */
+    RUNNER_EVENT_MESSAGE = 110,     /* a component's message */
+};
+
 /* Components' messages (drive faults, lost nodes, warnings), handed to fn from runner_run
  * as they arrive; the first fault also becomes the cause in runner_run's error message. */
 typedef void (*runner_message_fn)(void *ctx, const struct hal_msg *m);

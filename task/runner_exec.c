@@ -1,4 +1,5 @@
 /* runner_exec.c: runs a planned program: start, the per-period monitor, stop, summary. */
+#include "hal/components/lcm_status.h"
 #include "task/runner_priv.h"
 
 #include <math.h>
@@ -125,6 +126,9 @@ int runner_start(struct runner *r, char *err, size_t errlen)
         r->started = false;
         return runner_fail(err, errlen, RUNNER_ERR_RT, "%s", hal_last_error(r->hal));
     }
+    lcm_status_post_event(r->hal, LCM_SEV_INFO, RUNNER_EVENT_STARTED, "task", 0,
+                          "program started: %.3f s and %.3f mm planned", r->plan.time_s,
+                          r->plan.length_mm);
     return RUNNER_OK;
 }
 
@@ -181,16 +185,37 @@ void runner_set_message_fn(struct runner *r, runner_message_fn fn, void *ctx)
     r->msg_ctx = ctx;
 }
 
-/* Takes the components' messages; the first fault is kept as the cause of a stop. */
+/* Takes the components' messages; the first fault is kept as the cause of a stop. Each
+ * also goes out on HEXCNC_EVENT when lcm-status is loaded (else the post does nothing). */
 static void runner_drain_messages(struct runner *r)
 {
+    static const enum lcm_status_severity sev[] = {
+        [HAL_MSG_INFO] = LCM_SEV_INFO, [HAL_MSG_WARNING] = LCM_SEV_WARNING,
+        [HAL_MSG_FAULT] = LCM_SEV_FAULT,
+    };
     struct hal_msg m;
     while (hal_msg_take(r->hal, &m)) {
         if (m.severity == HAL_MSG_FAULT && !r->first_fault[0])
             snprintf(r->first_fault, sizeof r->first_fault, "%s: %s", m.source, m.text);
+        lcm_status_post_event(r->hal, sev[m.severity], RUNNER_EVENT_MESSAGE, m.source, -1, "%s",
+                              m.text);
         if (r->msg_fn)
             r->msg_fn(r->msg_ctx, &m);
     }
+}
+
+/* The run's outcome as an event: finished, aborted or faulted (with the error text). */
+static void runner_post_outcome(struct runner *r, int st, const char *err)
+{
+    if (st == RUNNER_OK)
+        lcm_status_post_event(r->hal, LCM_SEV_INFO, RUNNER_EVENT_FINISHED, "task", -1,
+                              "program finished");
+    else if (st == RUNNER_ERR_ABORTED)
+        lcm_status_post_event(r->hal, LCM_SEV_WARNING, RUNNER_EVENT_ABORTED, "task", -1, "%s",
+                              err);
+    else
+        lcm_status_post_event(r->hal, LCM_SEV_FAULT, RUNNER_EVENT_FAULT, "task", -1, "%s: %s",
+                              runner_strerror(st), err);
 }
 
 /* How the run ended, as a status and a message. */
@@ -265,6 +290,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
     runner_drain_messages(r);
     if (st == RUNNER_OK)
         st = runner_outcome(r, err, errlen);
+    runner_post_outcome(r, st, err);
     runner_get_progress(r, &p);
     if (fn)
         fn(ctx, &p);

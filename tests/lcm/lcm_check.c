@@ -140,6 +140,19 @@ static int check_run(const char *path, int period_ms, struct check *c)
     double first_x = NAN, moved = 0;
     while ((ev = lcm_eventlog_read_next_event(log)) && !c->error[0]) {
         hexcnc_status_t m;
+        hexcnc_event_t e;
+        if (!strcmp(ev->channel, "HEXCNC_EVENT") &&
+            hexcnc_event_t_decode(ev->data, 0, (int)ev->datalen, &e) >= 0) {
+            /* the runner's own events: started (100) before any other, finished (101) */
+            if (!strcmp(e.source, "task") && e.code == 100 && c->events == 0)
+                c->events = 1;
+            else if (!strcmp(e.source, "task") && e.code == 101 && c->events == 1)
+                c->events = 2;
+            else if (e.severity == HEXCNC_EVENT_T_FAULT)
+                snprintf(c->error, sizeof c->error, "fault event from %s: %s", e.source,
+                         e.text);
+            hexcnc_event_t_decode_cleanup(&e);
+        }
         if (!strcmp(ev->channel, "HEXCNC_STATUS") &&
             hexcnc_status_t_decode(ev->data, 0, (int)ev->datalen, &m) >= 0) {
             int64_t want_ms = m.seq == 0 ? 1 : (int64_t)period_ms * m.seq;
@@ -169,6 +182,9 @@ static int check_run(const char *path, int period_ms, struct check *c)
     if (!c->error[0] && (c->status < 2 || moved < 1.0))
         snprintf(c->error, sizeof c->error, "%d status messages, X moved %g mm", c->status,
                  moved);
+    if (!c->error[0] && c->events != 2)
+        snprintf(c->error, sizeof c->error, "the runner's 'program started' and 'program "
+                 "finished' events are missing or out of order (%d of 2 seen)", c->events);
     return c->error[0] ? -1 : c->status;
 }
 
@@ -181,7 +197,8 @@ int main(int argc, char **argv)
             return 1;
         }
         printf("ok   %s: %d status messages of a program run, on the machine-time grid, "
-               "feedback following the command\n", argv[2], c.status);
+               "feedback following the command; started and finished events\n", argv[2],
+               c.status);
         return 0;
     }
     struct check c = { .last_seq = -1 };
