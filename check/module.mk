@@ -8,7 +8,8 @@ LIB_SRCS += check/experiment.c
 EXP_BIN := $(BUILD)/check/hexcnc-experiment
 $(EXP_BIN): check/experiment_main.c $(LIBDIR)/libhexcnc.a
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBDIR)/libhexcnc.a $(LDLIBS) -o $@
+	$(call say,LINK,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -rdynamic $< $(LIBDIR)/libhexcnc.a $(LDLIBS) -o $@
 EXP_PROGS := run1_g141:1 run2_g141:1 run3_g141:2 run4_g141:2 run1_g142:1
 experiment: all $(EXP_BIN)
 	@mkdir -p $(BUILD)/experiment

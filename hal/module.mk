@@ -15,8 +15,10 @@ SCRIPT_TESTS += tests/hal/halcmd.sh
 HAL_TEST_PLUGINS := $(BUILD)/tests/plugins/hal/demo-plugin.so $(BUILD)/tests/plugins/hal/nosym.so
 $(BUILD)/tests/plugins/hal/demo-plugin.so: tests/hal/plugin_demo.c hal/hal.h
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
+	$(call say,SO,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
 $(BUILD)/tests/plugins/hal/nosym.so: tests/hal/plugin_nosym.c
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
+	$(call say,SO,$@)
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
 $(BUILD)/tests/test_hal_plugin: $(HAL_TEST_PLUGINS)

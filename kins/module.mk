@@ -14,10 +14,12 @@ PLUGINS += $(LIBDIR)/kins/hexapod.so $(LIBDIR)/kins/trivial.so
 KINS_SO_LDFLAGS := -shared -Wl,-Bsymbolic -Wl,--no-undefined
 $(LIBDIR)/kins/hexapod.so: $(KINS_HEXAPOD_SRCS:%.c=$(BUILD)/%.o) $(BUILD)/kins/kins_svd.o
 	@mkdir -p $(@D)
-	$(CXX) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
+	$(call say,SO,$@)
+	$(Q)$(CXX) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
 $(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
 	@mkdir -p $(@D)
-	$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
+	$(call say,SO,$@)
+	$(Q)$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
 
 TESTS += test_kins test_kins_plugin
 BENCHES += bench_kins
