@@ -1,4 +1,5 @@
-/* cycles.c: the drilling cycles G73 G81 G82 G83 G85 G89 in G17, with G98/G99, as LinuxCNC. */
+/* cycles.c: the drilling cycles G73 G81 G82 G83 G85 G89 in G17, G18 and G19, with G98/G99,
+ * as LinuxCNC. */
 #include <math.h>
 #include <string.h>
 
@@ -12,21 +13,42 @@
 #define CYCLE_MAX_REPEATS 100000 /* L: more would only be a typing error */
 #define CYCLE_MAX_PECKS 1000000  /* depth / Q, all repeats together */
 
-/* One cycle in program units (X Y Z only), with the words it uses. */
+/* The axes of a plane's cycles, as LinuxCNC maps them: two in the plane (the hole position)
+ * and the drilling axis along which R, the depth, the pecks and the retract are measured. */
+struct cycle_axes {
+    int u, v, w;                 /* AX_X/Y/Z: first and second in the plane, drilling axis */
+};
+
+/* G17 drills along Z, G18 along Y (holes in Z X), G19 along X (holes in Y Z). */
+static struct cycle_axes plane_axes(int plane)
+{
+    if (plane == 18)
+        return (struct cycle_axes){AX_Z, AX_X, AX_Y};
+    if (plane == 19)
+        return (struct cycle_axes){AX_Y, AX_Z, AX_X};
+    return (struct cycle_axes){AX_X, AX_Y, AX_Z};
+}
+
+/* One cycle in program units, in the plane's axes, with the words it uses. */
 struct cycle {
     int g;
-    double x, y;                 /* hole position */
-    double r;                    /* retract (R) plane */
-    double bottom;               /* Z depth */
-    double clear;                /* where the tool goes between holes: R (G99) or old Z (G98) */
+    struct cycle_axes ax;
+    double x, y;                 /* hole position on the plane's axes u, v */
+    double r;                    /* retract (R) plane, on the drilling axis */
+    double bottom;               /* hole depth on the drilling axis */
+    double clear;                /* where the tool goes between holes: R (G99) or old level (G98) */
     double q;                    /* peck depth */
     double p_s;                  /* dwell, seconds */
 };
 
-/* A move to program point (x, y, z), A B C unchanged. */
-static int cyc_move(struct interp *in, enum canon_type t, double x, double y, double z)
+/* A move to (x, y) in the plane at level z on the drilling axis, A B C unchanged. */
+static int cyc_move(struct interp *in, const struct cycle *c, enum canon_type t, double x,
+                    double y, double z)
 {
-    double p[3] = {x, y, z}, m[6];
+    double p[3], m[6];
+    p[c->ax.u] = x;
+    p[c->ax.v] = y;
+    p[c->ax.w] = z;
     for (int i = 0; i < 3; i++)
         m[i] = interp_len_mm(in, p[i]) + in->g5x[i] + in->g92[i] + in->tool[i];
     for (int i = 3; i < 6; i++)
@@ -51,45 +73,48 @@ static int cycle_hole(struct interp *in, const struct cycle *c)
     case 830:
     case 730:
         for (double d = c->r - c->q; d > c->bottom; d -= c->q) {
-            CHP(cyc_move(in, CANON_FEED, c->x, c->y, d));
+            CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, d));
             if (c->g == 830) {
-                CHP(cyc_move(in, CANON_TRAVERSE, c->x, c->y, c->r));
-                CHP(cyc_move(in, CANON_TRAVERSE, c->x, c->y, d + lift));
+                CHP(cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, c->r));
+                CHP(cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, d + lift));
             } else {
-                CHP(cyc_move(in, CANON_TRAVERSE, c->x, c->y, d + lift));
+                CHP(cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, d + lift));
             }
         }
-        CHP(cyc_move(in, CANON_FEED, c->x, c->y, c->bottom));
-        return cyc_move(in, CANON_TRAVERSE, c->x, c->y, c->clear);
+        CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, c->bottom));
+        return cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, c->clear);
     case 850:
-        CHP(cyc_move(in, CANON_FEED, c->x, c->y, c->bottom));
-        CHP(cyc_move(in, CANON_FEED, c->x, c->y, c->r));
-        return cyc_move(in, CANON_TRAVERSE, c->x, c->y, c->clear);
+        CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, c->bottom));
+        CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, c->r));
+        return cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, c->clear);
     case 890:
-        CHP(cyc_move(in, CANON_FEED, c->x, c->y, c->bottom));
+        CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, c->bottom));
         CHP(dwell(in, c->p_s));
-        return cyc_move(in, CANON_FEED, c->x, c->y, c->clear);
+        return cyc_move(in, c, CANON_FEED, c->x, c->y, c->clear);
     default: /* G81, G82 */
-        CHP(cyc_move(in, CANON_FEED, c->x, c->y, c->bottom));
+        CHP(cyc_move(in, c, CANON_FEED, c->x, c->y, c->bottom));
         if (c->g == 820)
             CHP(dwell(in, c->p_s));
-        return cyc_move(in, CANON_TRAVERSE, c->x, c->y, c->clear);
+        return cyc_move(in, c, CANON_TRAVERSE, c->x, c->y, c->clear);
     }
 }
 
-/* R, Z, P and Q are sticky while the same cycle repeats; the first block must give them. */
-static int cycle_words(struct interp *in, int g, int first)
+/* R, the depth, P and Q are sticky while the same cycle repeats; the first block must give
+ * them. The depth is the word of the drilling axis: Z in G17, Y in G18, X in G19. */
+static int cycle_words(struct interp *in, int g, int first, char depth)
 {
-    static const struct { char w; const char *what; } need[] = {
-        {'r', "R (retract plane)"}, {'z', "Z (hole depth)"}};
-    for (int i = 0; i < 2; i++)
-        if (first && !W(need[i].w))
-            return interp_fail(in, INTERP_ERR_CYCLE, in->blk.gcol[1], "G%d needs %s in its first "
-                               "block", g / 10, need[i].what);
+    if (first && !W('r'))
+        return interp_fail(in, INTERP_ERR_CYCLE, in->blk.gcol[1], "G%d needs R (retract plane) "
+                           "in its first block", g / 10);
+    if (first && !W(depth))
+        return interp_fail(in, INTERP_ERR_CYCLE, in->blk.gcol[1], "G%d needs %c (hole depth%s) "
+                           "in its first block", g / 10, depth - 32,
+                           in->plane == 18 ? ": G18 drills along Y"
+                           : in->plane == 19 ? ": G19 drills along X" : "");
     if (W('r'))
         in->cycle_r = V('r');
-    if (W('z'))
-        in->cycle_z = V('z');
+    if (W(depth))
+        in->cycle_depth = V(depth);
     if (g == 820 || g == 890) {
         if (W('p'))
             in->cycle_p = V('p');
@@ -117,7 +142,8 @@ static int cycle_check(struct interp *in, const struct cycle *c, int reps)
 {
     if (c->r < c->bottom)
         return interp_fail(in, INTERP_ERR_CYCLE, W('r') ? W('r') : in->blk.gcol[1], "R (retract "
-                           "plane, %g) is below Z (hole bottom, %g)", c->r, c->bottom);
+                           "plane, %g) is below %c (hole bottom, %g)", c->r,
+                           'X' + c->ax.w, c->bottom);
     if ((c->g == 730 || c->g == 830) && (c->r - c->bottom) / c->q * reps > CYCLE_MAX_PECKS)
         return interp_fail(in, INTERP_ERR_CYCLE, W('q'), "Q (peck depth) %g is too small for "
                            "%d hole(s) %g deep (more than %d pecks)", c->q, reps,
@@ -135,54 +161,65 @@ static int path_mode(struct interp *in, int mode, double tol_mm)
     return interp_emit(in, &pm);
 }
 
+/* The hole position, R and depth of this block in the plane's axes: G90 takes the words
+ * (an absent plane word keeps the current position), G91 steps from the current position
+ * once per repeat with R counted from the series' start level and the depth from R. */
+static void cycle_place(struct interp *in, struct cycle *c, const double cur[6], double step[2])
+{
+    static const char letter[3] = {'x', 'y', 'z'};
+    char u = letter[c->ax.u], v = letter[c->ax.v];
+    step[0] = step[1] = 0;
+    if (in->incremental) {
+        step[0] = W(u) ? V(u) : 0;
+        step[1] = W(v) ? V(v) : 0;
+        c->x = cur[c->ax.u];
+        c->y = cur[c->ax.v];
+        c->r = in->cycle_r + in->cycle_il;
+        c->bottom = c->r + in->cycle_depth;
+    } else {
+        c->x = W(u) ? V(u) : cur[c->ax.u];
+        c->y = W(v) ? V(v) : cur[c->ax.v];
+        c->r = in->cycle_r;
+        c->bottom = in->cycle_depth;
+    }
+}
+
 /* A drilling cycle block: LinuxCNC's CYCLE_MACRO, one hole per repeat. */
 int interp_cycle(struct interp *in, int g)
 {
-    if (in->plane != 17)
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, in->blk.gcol[1], "canned cycles in G%d "
-                           "are not supported yet (only G17)", in->plane);
     if (W('a') || W('b') || W('c'))
         return interp_fail(in, INTERP_ERR_CYCLE, W('a') ? W('a') : W('b') ? W('b') : W('c'),
                            "A, B or C words in a canned cycle block");
     CHP(interp_need_feed(in, "a canned cycle"));
+    struct cycle c = {.g = g, .ax = plane_axes(in->plane)};
     int first = in->cycle_mode != g, reps = 1;
-    CHP(cycle_words(in, g, first));
+    CHP(cycle_words(in, g, first, (char)('x' + c.ax.w)));
     if (W('l')) {
         CHP(interp_to_int(in, V('l'), W('l'), "L (repeats)", &reps));
         if (reps < 1 || reps > CYCLE_MAX_REPEATS)
             return interp_fail(in, INTERP_ERR_CYCLE, W('l'), "L (repeats) must be 1 to %d, not "
                                "%d", CYCLE_MAX_REPEATS, reps);
     }
-    double cur[6], ai = 0, bi = 0;
+    double cur[6], step[2];
     interp_prog_pos(in, cur);
-    /* The Z a series of cycle blocks started from (LinuxCNC's "initial level"): G98 returns
-     * there and G91 R counts from it, until a motion that is not a cycle ends the series. */
+    /* The level a series of cycle blocks started from on the drilling axis (LinuxCNC's
+     * "initial level"): G98 returns there and G91 R counts from it, until a motion that is
+     * not a cycle ends the series. */
     if (!in->cycle_il_on) {
-        in->cycle_il = cur[AX_Z];
+        in->cycle_il = cur[c.ax.w];
         in->cycle_il_on = 1;
     }
-    double old_z = in->cycle_il, cur_z = cur[AX_Z];
-    struct cycle c = {.g = g, .q = in->cycle_q, .p_s = in->cycle_p};
-    if (in->incremental) {
-        ai = W('x') ? V('x') : 0;
-        bi = W('y') ? V('y') : 0;
-        c.x = cur[AX_X];
-        c.y = cur[AX_Y];
-        c.r = in->cycle_r + old_z;
-        c.bottom = c.r + in->cycle_z;
-    } else {
-        c.x = W('x') ? V('x') : cur[AX_X];
-        c.y = W('y') ? V('y') : cur[AX_Y];
-        c.r = in->cycle_r;
-        c.bottom = in->cycle_z;
-    }
+    double old_z = in->cycle_il, cur_z = cur[c.ax.w];
+    c.q = in->cycle_q;
+    c.p_s = in->cycle_p;
+    cycle_place(in, &c, cur, step);
     /* cur comes back from machine coordinates: within rounding of R is at R */
     if (fabs(cur_z - c.r) <= 1e-9 * fmax(1.0, fabs(c.r)))
         cur_z = c.r;
     CHP(cycle_check(in, &c, reps));
     in->cycle_mode = g;
     if (old_z < c.r) { /* below R: straight up to it first */
-        CHP(cyc_move(in, CANON_TRAVERSE, cur[AX_X], cur[AX_Y], c.r));
+        CHP(cyc_move(in, &c, CANON_TRAVERSE, cur[c.ax.u], cur[c.ax.v], c.r));
         old_z = cur_z = c.r;
     }
     c.clear = in->retract_old_z ? old_z : c.r;
@@ -190,12 +227,12 @@ int interp_cycle(struct interp *in, int g)
     if (restore)
         CHP(path_mode(in, 610, 0.0));
     for (int i = 0; i < reps; i++) {
-        c.x += ai;
-        c.y += bi;
+        c.x += step[0];
+        c.y += step[1];
         double over = i == 0 && cur_z > c.r ? cur_z : c.clear; /* level of the rapid over */
-        CHP(cyc_move(in, CANON_TRAVERSE, c.x, c.y, over));
+        CHP(cyc_move(in, &c, CANON_TRAVERSE, c.x, c.y, over));
         if (over > c.r)
-            CHP(cyc_move(in, CANON_TRAVERSE, c.x, c.y, c.r));
+            CHP(cyc_move(in, &c, CANON_TRAVERSE, c.x, c.y, c.r));
         CHP(cycle_hole(in, &c));
     }
     if (restore)

@@ -83,10 +83,12 @@ struct interp {
     double tool[6];              /* active tool length offset */
     double feed_mm_min;          /* F in force, converted */
     double f_word;               /* F as programmed (for printers) */
-    double cycle_r, cycle_q, cycle_p, cycle_z; /* sticky canned cycle words, program units */
+    double cycle_r, cycle_q, cycle_p; /* sticky canned cycle words, program units */
+    double cycle_depth;          /* sticky hole depth: the drilling axis word (Z in G17) */
     int cycle_mode;              /* the cycle (x10) whose words are sticky, 0 = none */
     int cycle_il_on;             /* a series of cycle blocks is going on */
-    double cycle_il;             /* the Z (program units) that series started from */
+    double cycle_il;             /* the level on the drilling axis (program units) that series
+                                  * started from */
     int current_tool, selected_tool;
     int spindle_dir;             /* 1, -1, 0 */
     double spindle_rpm;

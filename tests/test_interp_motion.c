@@ -1,4 +1,5 @@
-/* test_interp_motion.c: moves, arcs, offsets, units, tool length, canned cycles, G141/G142 hand-off. */
+/* test_interp_motion.c: moves, arcs, offsets, units, tool length, machine words, G141/G142 hand-off
+ * (canned cycles: test_interp_cycles.c). */
 #include <check.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -207,39 +208,6 @@ START_TEST(tool_length)
 }
 END_TEST
 
-/* The moves of one G81 hole, then G83 pecks, G98 against G99, L with G91. */
-START_TEST(canned_cycles)
-{
-    struct canon_prog p;
-    ok("G0 X0 Y0 Z-1\nG81 X5 Y5 Z-2 R1 F50\nG80\nM2\n", &p);
-    ck_assert_int_eq(count_type(&p, CANON_TRAVERSE) + count_type(&p, CANON_FEED), 5);
-    ck_assert_pose(nth(&p, CANON_TRAVERSE, 1)->end, 0, 0, 1, 0, 0, 0, TOL); /* up to R */
-    ck_assert_pose(nth(&p, CANON_TRAVERSE, 2)->end, 5, 5, 1, 0, 0, 0, TOL);
-    ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 5, 5, -2, 0, 0, 0, TOL);
-    ck_assert_pose(nth(&p, CANON_TRAVERSE, 3)->end, 5, 5, 1, 0, 0, 0, TOL);
-    canon_prog_free(&p);
-    ok("G0 Z10\nG98 G83 X1 Z-5 R1 Q2 F50\nM2\n", &p);
-    ck_assert_int_eq(count_type(&p, CANON_FEED), 3);   /* pecks to -1, -3, then -5 */
-    ck_assert_double_eq_tol(nth(&p, CANON_FEED, 0)->end[2], -1, TOL);
-    ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 4)->end[2], -0.746, TOL);
-    ck_assert_double_eq_tol(last_move(&p)->end[2], 10, TOL); /* G98: back to old Z */
-    canon_prog_free(&p);
-    ok("G0 Z10\nG91 G99 G82 X5 Z-4 R-2 P0.5 L3 F50\nM2\n", &p);
-    ck_assert_int_eq(count_type(&p, CANON_DWELL), 3);
-    ck_assert_double_eq(nth(&p, CANON_DWELL, 0)->value, 0.5);
-    ck_assert_pose(nth(&p, CANON_FEED, 2)->end, 15, 0, 4, 0, 0, 0, TOL);
-    ck_assert_double_eq_tol(last_move(&p)->end[2], 8, TOL); /* G99: R plane */
-    canon_prog_free(&p);
-    ok("G0 Z5\nG85 X1 Z-3 R2 F50\nG89 X2 Z-3 R2 P1\nG73 X3 Z-1 R2 Q1\nM2\n", &p);
-    ck_assert_int_eq(count_type(&p, CANON_DWELL), 1);
-    canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G0 Z5\nG81 X1 Z-3 F50\nM2\n"), INTERP_ERR_CYCLE);
-    ck_assert_int_eq(status_of("G0 Z5\nG83 X1 Z-3 R1 F50\nM2\n"), INTERP_ERR_CYCLE);
-    ck_assert_int_eq(status_of("G0 Z5\nG81 X1 Z3 R1 F50\nM2\n"), INTERP_ERR_CYCLE);
-    ck_assert_int_eq(status_of("G18 G81 X1 Z-3 R1 F50\nM2\n"), INTERP_ERR_UNSUPPORTED);
-}
-END_TEST
-
 START_TEST(machine_words)
 {
     struct canon_prog p;
@@ -303,7 +271,6 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, offsets_work_and_g92);
     tcase_add_test(tc, offsets_g10_l20_and_homes);
     tcase_add_test(tc, tool_length);
-    tcase_add_test(tc, canned_cycles);
     tcase_add_test(tc, machine_words);
     tcase_add_test(tc, g141_hand_off);
     suite_add_tcase(s, tc);

@@ -3,8 +3,9 @@
 
 Used once to make the mix*.ngc and cyc*.ngc programs of this folder, whose .out files
 LinuxCNC's rs274 -g printed; with rs274 installed it serves to compare many more:
-python3 gen_mix.py [--cycles] FIRST_SEED LAST_SEED, then run tests/interp_expected.sh with
-REGEN=1 in a scratch copy of the folder."""
+python3 gen_mix.py [--cycles | --planes] FIRST_SEED LAST_SEED, then run
+tests/interp_expected.sh with REGEN=1 in a scratch copy of the folder. --planes writes
+cycles in G17, G18 and G19 (planeSEED.ngc)."""
 import random
 import sys
 
@@ -80,6 +81,48 @@ def cycle_block():
     return lines
 
 
+PLANE_AXES = {17: 'XYZ', 18: 'ZXY', 19: 'YZX'}  # two axes of the plane, then the drilling axis
+
+
+def plane_cycle_block(plane):
+    """A drilling cycle in the plane's axes: G90 or G91, G98 or G99, sometimes a second hole."""
+    u, v, w = PLANE_AXES[plane]
+    cyc = random.choice(['G81', 'G82 P0.5', 'G83 Q%s' % num(0.5, 3), 'G73 Q%s' % num(0.5, 3),
+                         'G85', 'G89 P1'])
+    lines = ['%s G%d %s %s%s %s%s %s%s R%s L%d' % (
+        random.choice(['G90', 'G91', '']), random.choice([98, 99]), cyc, u, num(-20, 20), v,
+        num(-20, 20), w, num(-10, -1), num(-3, 5), random.randint(1, 3))]
+    if random.random() < 0.5:
+        lines.append('%s%s' % (random.choice([u, v]), num(-20, 20)))
+    return lines
+
+
+def plane_program(seed):
+    """Cycles in G17, G18 and G19, with retracts, offsets, inch and G91 now and then."""
+    random.seed(seed)
+    plane = random.choice([17, 18, 19])
+    lines = ['(generated drilling cycles in the three planes, seed %d)' % seed,
+             'G21 G90 G%d G94' % plane, 'G0 X10 Y10 Z10 F300']
+    for _ in range(30):
+        r = random.random()
+        if r < 0.5:
+            lines += plane_cycle_block(plane)
+        elif r < 0.6:
+            lines.append('G80')
+        elif r < 0.7:
+            lines.append('G90 G0 %s%s' % (PLANE_AXES[plane][2], num(-5, 30)))
+        elif r < 0.8:
+            plane = random.choice([17, 18, 19])
+            lines += ['G80', 'G%d' % plane]
+        elif r < 0.85:
+            lines.append(random.choice(['G20', 'G21']))
+        elif r < 0.9:
+            lines.append('G10 L2 P1 ' + axes())
+        else:
+            lines.append('G92 ' + axes() if random.random() < 0.7 else 'G92.1')
+    return '\n'.join(lines + ['M2']) + '\n'
+
+
 def cycle_program(seed):
     """Cycles back to back (the series LinuxCNC keeps an initial level for), G80 now and then."""
     random.seed(seed)
@@ -102,8 +145,10 @@ def program(seed):
 
 
 if __name__ == '__main__':
-    cycles = sys.argv[1] == '--cycles'
-    first, last = int(sys.argv[1 + cycles]), int(sys.argv[2 + cycles])
+    kind = sys.argv[1] if sys.argv[1] in ('--cycles', '--planes') else ''
+    first, last = int(sys.argv[1 + bool(kind)]), int(sys.argv[2 + bool(kind)])
+    make, prefix = {'--cycles': (cycle_program, 'cyc'), '--planes': (plane_program, 'plane'),
+                    '': (program, 'mix')}[kind]
     for seed in range(first, last):
-        with open('%s%d.ngc' % ('cyc' if cycles else 'mix', seed), 'w') as f:
-            f.write(cycle_program(seed) if cycles else program(seed))
+        with open('%s%d.ngc' % (prefix, seed), 'w') as f:
+            f.write(make(seed))
