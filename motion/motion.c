@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "motion/motion_blend.h"
 #include "motion/motion_priv.h"
 
 /* Formats the instance's message. */
@@ -102,9 +103,19 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     m->msg[0] = 0;
     m->state = MOTION_IDLE;
     m->fault_status = MOTION_OK;
-    int st = motion_path_build(m, prog, m->msg, sizeof m->msg);
+    /* G64 P corners become tangent arcs first (motion_blend.c); the planner then treats
+     * them like any programmed arc */
+    struct canon_prog blended;
+    size_t nblends = 0;
+    int st = motion_blend_program(&m->cfg, prog, &blended, &nblends);
+    if (st)
+        motion_set_msg(m, "out of memory planning the program");
+    if (!st)
+        st = motion_path_build(m, nblends ? &blended : prog, m->msg, sizeof m->msg);
+    canon_prog_free(&blended);
     if (!st)
         st = motion_plan_profile(m, m->msg, sizeof m->msg);
+    m->plan.info.blends = nblends;
     double L[KINS_MAX_JOINTS];
     if (!st && m->plan.nseg == 0 && kins_inverse(m->kins, prog->start, L) != KINS_OK) {
         motion_set_msg(m, "the program's start position is outside the machine's "

@@ -117,6 +117,7 @@ struct motion_plan_info {
     double max_leg_vel_mm_s[KINS_MAX_JOINTS]; /* largest planned leg rate per leg, mm/s */
     int limited_by_legs;     /* samples where leg limits lowered the speed below the feed */
     int limited_by_kin_tol;  /* samples where the kinematic-error bound lowered it */
+    size_t blends;           /* G64 P corners rounded by a tangent arc (motion_blend.h) */
 };
 int motion_plan_info(const struct motion *m, struct motion_plan_info *out);
 

@@ -280,3 +280,23 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     }
     return v;
 }
+
+/* The share of one period's acceleration that passing the joint between samples A and B at
+ * speed v uses for its velocity jump (the largest over X Y Z, A B C and the legs, as in
+ * motion_junction_speed; at most JUMP_SHARE): the moves on either side give up that share
+ * of their path acceleration. A tangent joint (a G64 blend arc meeting its lines) uses
+ * next to none, so the moves around it keep their full acceleration. */
+double motion_junction_share(const struct motion *m, const struct motion_sample *A,
+                             const struct motion_sample *B, double v)
+{
+    const struct motion_config *c = &m->cfg;
+    double T = c->servo_period_s, dx = 0, f = 0;
+    for (int i = 0; i < 3; i++)
+        dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
+    f = v * sqrt(dx) / (c->max_lin_acc_mm_s2 * T);
+    for (int i = 3; i < 6; i++)
+        f = fmax(f, v * fabs(B->dp[i] - A->dp[i]) / (c->max_ang_acc_deg_s2 * T));
+    for (int i = 0; i < m->nj; i++)
+        f = fmax(f, v * fabs(B->dL[i] - A->dL[i]) / (0.5 * c->joint[i].max_acc_mm_s2 * T));
+    return fmin(f, JUMP_SHARE);
+}

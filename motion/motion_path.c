@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "motion/motion_blend.h"
 #include "motion/motion_priv.h"
 
 #define EPS_LEN 1e-9           /* mm or deg: shorter moves are skipped */
@@ -299,7 +300,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err
         if (p->nseg > nseg0)
             set_speed(m, &p->segs[p->nseg - 1], c, blend);
         if (c->type == CANON_PATH_MODE)  /* G64 (ivalue 640) without P: BLEND_TOLERANCE */
-            blend = c->value > 0 ? c->value : c->ivalue == 640 ? m->cfg.blend_tol_mm : 0;
+            blend = motion_blend_tolerance(&m->cfg, c);
         if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
             memcpy(at, c->end, sizeof at);
         if (c->type == CANON_PROGRAM_END)

@@ -83,9 +83,12 @@ static int all_caps(struct motion *m, double *gain, char *err, size_t errlen)
         p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
         if (j > 0)
             p->kv[pk] = fmin(p->kv[pk], vin);
-        if (vin > 0) {                 /* the jump's share of the acceleration, both sides */
-            p->iacc[sg->k0] *= 1 - JUMP_SHARE;
-            p->iacc[pk] *= 1 - JUMP_SHARE;
+        if (vin > 0) {                 /* the jump's share of the acceleration, both sides,
+                                        * at the fastest the joint may be passed (hard caps) */
+            double vmax = fmin(vin, fmin(p->kt[sg->k0], p->kt[pk]));
+            double share = motion_junction_share(m, &prev_end, &first, vmax);
+            p->iacc[sg->k0] *= 1 - share;
+            p->iacc[pk] *= 1 - share;
         }
         p->kv[lk] = j + 1 < p->nseg ? p->kv[lk] : 0;
         prev_end = last;

@@ -152,6 +152,10 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
 double motion_junction_speed(struct motion *m, const struct motion_seg *a,
                              const struct motion_seg *b, const struct motion_sample *A,
                              const struct motion_sample *B);
+/* Share of one period's acceleration (<= JUMP_SHARE) the velocity jump at a joint passed at
+ * speed v uses; the moves on either side give it up. */
+double motion_junction_share(const struct motion *m, const struct motion_sample *A,
+                             const struct motion_sample *B, double v);
 /* 6x6 inverse with partial pivoting (a is destroyed); 0 on success, -1 when singular. */
 int motion_invert6(double a[6][6], double inv[6][6]);
 

@@ -331,18 +331,16 @@ static double joint_speed(double blend, int gcode, const double *second)
 }
 
 /* G61 stops at every joint; G64 (with P, or without: [TRAJ]BLEND_TOLERANCE) passes a
- * collinear joint at the feed and slows to a near stop at a square corner (the velocity jump
- * there must stay within half a period's acceleration). */
+ * collinear joint at the feed and rounds a square corner (motion_blend.c) with an arc of
+ * radius P / (sqrt 2 - 1), run at its centripetal limit sqrt(a r / 2). */
 START_TEST(test_blend)
 {
     double straight[6] = {20, 0, 0, 0, 0, 0}, corner[6] = {10, 10, 0, 0, 0, 0};
     ck_assert_double_eq_tol(joint_speed(0, 610, straight), 0, 1e-9);
     ck_assert_msg(joint_speed(0.01, 640, straight) > 20 * (1 - 1e-9), "collinear joint slowed");
     ck_assert_msg(joint_speed(0, 640, straight) > 20 * (1 - 1e-9), "G64 without P stopped");
-    double v = joint_speed(0.01, 640, corner);
-    /* the joint speed plus what half the acceleration adds within the period sampled */
-    ck_assert_msg(v <= 0.5 * 1000 * 0.001 / sqrt(2) + 0.5 * 1000 * DT, "corner passed at %.3f "
-                  "mm/s", v);
+    double v = joint_speed(0.01, 640, corner), r = 0.01 / (sqrt(2) - 1);
+    ck_assert_msg(fabs(v - sqrt(0.5 * 1000 * r)) < 0.01, "corner passed at %.3f mm/s", v);
 }
 END_TEST
 

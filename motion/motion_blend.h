@@ -1,0 +1,59 @@
+/* motion_blend.h: G64 P corner rounding: straight feed moves joined by tangent arcs within P. */
+#ifndef HEXCNC_MOTION_BLEND_H
+#define HEXCNC_MOTION_BLEND_H
+
+#include <stddef.h>
+
+#include "interp/canon.h"
+#include "motion/motion.h"
+
+/*
+ * Where G64 with a tolerance P is in force and two straight feed moves meet at a corner, the
+ * corner is replaced by a circular arc tangent to both lines, in the plane of the two
+ * directions, passing at distance P from the programmed corner point (LinuxCNC's meaning of
+ * P: the path stays within P of the programmed end point). Each line gives up at most half
+ * of its length to a blend, so a short line makes a smaller blend (closer than P).
+ *
+ *            corner
+ *      ───────●  ─┐            turning angle theta between the directions d1, d2;
+ *        T1 ╲ |   |  P         radius r, trim t = r tan(theta/2) along each line,
+ *            ╲|  ─┘            corner to arc midpoint: r / cos(theta/2) - r = P
+ *             │╲ T2
+ *             │
+ */
+
+/* One corner's blend. */
+struct motion_blend_geom {
+    double turn_rad;         /* angle between the two XYZ directions, rad */
+    double radius_mm;        /* arc radius, mm */
+    double trim_mm;          /* length taken from the end of the first line and from the
+                              * start of the second, mm */
+    double dev_mm;           /* distance from the programmed corner to the arc's midpoint
+                              * (the largest distance from the corner point), mm: P, or
+                              * less when a line is too short */
+};
+
+/* Corners turning less than this are left to the joint-speed rule (nearly tangent). */
+#define MOTION_BLEND_MIN_TURN_RAD 1e-3
+/* Blends smaller than this radius are not made (near reversals): the joint stops instead. */
+#define MOTION_BLEND_MIN_RADIUS_MM 1e-3
+
+/* The blend of a corner between unit directions d1 (incoming) and d2 (outgoing) of lines
+ * len1_mm and len2_mm long, tolerance tol_mm. Returns 1 and fills g when the corner is to
+ * be rounded, 0 when not (collinear, near reversal, lines too short, no tolerance). */
+int motion_blend_corner(const double d1[3], const double d2[3], double len1_mm, double len2_mm,
+                        double tol_mm, struct motion_blend_geom *g);
+
+/* The G64 tolerance a PATH_MODE command sets: its P (value), BLEND_TOLERANCE for G64 without
+ * P (ivalue 640), 0 (no blending) for G61 and G61.1. */
+double motion_blend_tolerance(const struct motion_config *c, const struct canon_cmd *pm);
+
+/* A copy of `in` with every G64 corner between two straight feed moves rounded: the lines
+ * trimmed and a plane-0 CANON_ARC inserted (canon.h's convention, as G141/G142 make them).
+ * out is initialised here and holds the copy only when *nblends > 0 (else it stays empty and
+ * `in` is to be used as is); the caller frees it with canon_prog_free. MOTION_ERR_NOMEM when
+ * memory runs out (out is then empty). */
+int motion_blend_program(const struct motion_config *c, const struct canon_prog *in,
+                         struct canon_prog *out, size_t *nblends);
+
+#endif

@@ -1,0 +1,545 @@
+/* test_motion_blend.c: G64 P corner blending: arc geometry, the executed path, speed, G61, hexapod. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "motion/motion_blend.h"
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+#define TOL 0.05               /* G64 P, mm */
+
+/* The executed path: every period's pose. */
+struct run_log {
+    double (*pose)[6];
+    size_t n, cap;
+    double t_s;
+    enum motion_state state;
+};
+
+/* Runs the started program to its end, logging every period's commanded pose. */
+static void run_log(struct motion *m, double dt, struct run_log *r)
+{
+    struct motion_out o;
+    memset(r, 0, sizeof *r);
+    for (int k = 0; k < 2000000; k++) {
+        motion_step(m, dt, &o);
+        if (r->n == r->cap) {
+            r->cap = r->cap ? 2 * r->cap : 4096;
+            r->pose = realloc(r->pose, r->cap * sizeof *r->pose);
+            ck_assert_ptr_nonnull(r->pose);
+        }
+        memcpy(r->pose[r->n++], o.pose, sizeof o.pose);
+        if (o.state == MOTION_DONE || o.state == MOTION_FAULT)
+            break;
+    }
+    r->t_s = o.time_elapsed_s;
+    r->state = o.state;
+}
+
+static double dist3(const double *a, const double *b)
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/* Distance from p to the segment a-b (X Y Z). */
+static double dist_seg(const double *p, const double *a, const double *b)
+{
+    double d[3], w[3], dd = 0, u = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], w[i] = p[i] - a[i], dd += d[i] * d[i], u += w[i] * d[i];
+    u = dd > 0 ? fmin(1, fmax(0, u / dd)) : 0;
+    double q[3] = {a[0] + u * d[0], a[1] + u * d[1], a[2] + u * d[2]};
+    return dist3(p, q);
+}
+
+/* Distance from p to the polyline pts[0..n-1]. */
+static double dist_poly(const double *p, const double (*pts)[6], int n)
+{
+    double best = HUGE_VAL;
+    for (int i = 0; i + 1 < n; i++)
+        best = fmin(best, dist_seg(p, pts[i], pts[i + 1]));
+    return best;
+}
+
+/* A program: path mode (gcode 640 with P = tol, or 610), then feed moves through pts[1..n-1]
+ * from pts[0], lines 10, 11, ... */
+static void polyline_prog(struct canon_prog *p, const double (*pts)[6], int n, int gcode,
+                          double tol, double feed_mm_min)
+{
+    canon_prog_init(p);
+    memcpy(p->start, pts[0], sizeof p->start);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "test.ngc",
+                           .value = tol, .ivalue = gcode};
+    ck_assert_int_eq(canon_prog_sink(p, &pm), 0);
+    for (int i = 1; i < n; i++)
+        tm_add(p, CANON_FEED, 9 + i, pts[i], feed_mm_min, 0);
+}
+
+/* Loads and starts; fails the test with the planner's message. */
+static void load_start(struct motion *m, const struct canon_prog *p)
+{
+    char err[512] = "";
+    ck_assert_msg(motion_load(m, p, err, sizeof err) == MOTION_OK, "load: %s", err);
+    ck_assert_int_eq(motion_start(m), MOTION_OK);
+}
+
+/* Lowest XYZ speed (from successive poses) while the path is within `near` mm of c. */
+static double min_speed_near(const struct run_log *r, const double *c, double near)
+{
+    double v = HUGE_VAL;
+    for (size_t k = 1; k < r->n; k++)
+        if (dist3(r->pose[k], c) < near)
+            v = fmin(v, dist3(r->pose[k], r->pose[k - 1]) / DT);
+    return v;
+}
+
+/* Runs a square corner X0 -> X20 -> X20 Y20 at 600 mm/min in G64 P0.05 or G61. */
+static void square_corner(int gcode, struct run_log *r, size_t *blends)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {20, 0, 0, 0, 0, 0}, {20, 20, 0, 0, 0, 0}};
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    struct canon_prog p;
+    polyline_prog(&p, pts, 3, gcode, gcode == 640 ? TOL : 0, 600);
+    load_start(mc.m, &p);
+    struct motion_plan_info info;
+    motion_plan_info(mc.m, &info);
+    *blends = info.blends;
+    run_log(mc.m, DT, r);
+    ck_assert_int_eq(r->state, MOTION_DONE);
+    const double *end = r->pose[r->n - 1];
+    ck_assert_double_eq_tol(end[0], 20, 1e-9);
+    ck_assert_double_eq_tol(end[1], 20, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+
+/* G64 P0.05 on a square corner: the executed path stays within P of the programmed lines,
+ * comes within P (not closer than 0.9 P, not further than P) of the corner point, keeps
+ * moving through the corner at over half the feed and finishes sooner than G61, which stops
+ * at the corner and passes exactly through it. */
+START_TEST(test_square_corner)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {20, 0, 0, 0, 0, 0}, {20, 20, 0, 0, 0, 0}};
+    struct run_log g64, g61;
+    size_t b64, b61;
+    square_corner(640, &g64, &b64);
+    square_corner(610, &g61, &b61);
+    ck_assert_int_eq(b64, 1);
+    ck_assert_int_eq(b61, 0);
+    double off = 0, closest = HUGE_VAL, off61 = 0, closest61 = HUGE_VAL;
+    for (size_t k = 0; k < g64.n; k++) {
+        off = fmax(off, dist_poly(g64.pose[k], pts, 3));
+        closest = fmin(closest, dist3(g64.pose[k], pts[1]));
+    }
+    for (size_t k = 0; k < g61.n; k++) {
+        off61 = fmax(off61, dist_poly(g61.pose[k], pts, 3));
+        closest61 = fmin(closest61, dist3(g61.pose[k], pts[1]));
+    }
+    ck_assert_msg(off <= TOL + 1e-9, "G64 P0.05 left the lines by %.9f mm", off);
+    /* the arc's midpoint is exactly P from the corner; samples 1 ms apart land near it */
+    ck_assert_msg(closest >= TOL - 1e-9 && closest <= 1.01 * TOL, "corner passed at %.9f mm",
+                  closest);
+    ck_assert_msg(off >= 0.9 * TOL * sqrt(0.5), "lines left by only %.9f mm", off);
+    ck_assert_msg(off61 <= 1e-9 && closest61 <= 1e-9, "G61: %.3g mm off, corner at %.3g mm",
+                  off61, closest61);
+    double v64 = min_speed_near(&g64, pts[1], 0.5), v61 = min_speed_near(&g61, pts[1], 0.5);
+    ck_assert_msg(v64 > 0.5 * 10, "G64 P0.05 corner at %.3f mm/s (feed 10)", v64);
+    ck_assert_msg(v61 < 0.1 * 10, "G61 did not stop at the corner (%.3f mm/s)", v61);
+    ck_assert_msg(g64.t_s < g61.t_s - 0.005, "G64 %.3f s, G61 %.3f s", g64.t_s, g61.t_s);
+    printf("square corner, P0.05, 600 mm/min: G64 %.6f mm from the corner, slowest %.3f mm/s, "
+           "%.3f s; G61 %.3g mm, slowest %.3f mm/s, %.3f s\n", closest, v64, g64.t_s,
+           closest61, v61, g61.t_s);
+    free(g64.pose);
+    free(g61.pose);
+}
+END_TEST
+
+/* Two lines turning by turn_deg in a plane tilted out of every axis plane, from P0 through
+ * the corner at (5, -3, 2); fills pts. */
+static void tilted_corner(double turn_deg, double len_mm, double pts[3][6])
+{
+    double u[3] = {0.6, 0.48, 0.64}, w[3] = {-0.8, 0.36, 0.48};   /* orthonormal */
+    double t = turn_deg * M_PI / 180, c0[3] = {5, -3, 2};
+    memset(pts, 0, 3 * sizeof pts[0]);
+    for (int i = 0; i < 3; i++) {
+        pts[1][i] = c0[i];
+        pts[0][i] = c0[i] - len_mm * u[i];
+        pts[2][i] = c0[i] + len_mm * (cos(t) * u[i] + sin(t) * w[i]);
+    }
+}
+
+/* The arc that replaces 30, 90 and 150 degree turns in a tilted plane: tangent to both lines
+ * (its direction equals theirs at both ends to 1e-6), radius as derived, its midpoint at P
+ * from the corner, start and end P-trimmed line ends; then executed, the direction of motion
+ * never turns by more than one period's arc angle between periods (no kink). */
+START_TEST(test_arc_geometry)
+{
+    static const double turns[3] = {30, 90, 150};
+    for (int k = 0; k < 3; k++) {
+        double pts[3][6];
+        tilted_corner(turns[k], 10, pts);
+        struct canon_prog p, out;
+        polyline_prog(&p, (const double (*)[6])pts, 3, 640, TOL, 600);
+        struct motion_config cfg;
+        motion_config_default(&cfg);
+        size_t nb = 0;
+        ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+        ck_assert_int_eq(nb, 1);
+        ck_assert_int_eq((int)out.count, 4);      /* path mode, line, arc, line */
+        const struct canon_cmd *l1 = &out.cmds[1], *a = &out.cmds[2], *l2 = &out.cmds[3];
+        ck_assert_int_eq(a->type, CANON_ARC);
+        ck_assert_int_eq(a->arc.plane, 0);
+        ck_assert_int_eq(a->line, 11);             /* the move it enters */
+        double th = turns[k] * M_PI / 180, half = th / 2;
+        double r = TOL * cos(half) / (1 - cos(half)), t = r * tan(half);
+        double rs[3], re[3], d1[3], d2[3], ts[3], te[3], mid[3], rm = 0;
+        for (int i = 0; i < 3; i++) {
+            rs[i] = l1->end[i] - a->arc.center[i];
+            re[i] = a->end[i] - a->arc.center[i];
+            d1[i] = (pts[1][i] - pts[0][i]) / 10;
+            d2[i] = (pts[2][i] - pts[1][i]) / 10;
+            mid[i] = rs[i] + re[i];
+            rm += mid[i] * mid[i];
+        }
+        ck_assert_double_eq_tol(dist3(l1->end, pts[1]), t, 1e-9);
+        ck_assert_double_eq_tol(dist3(a->end, pts[1]), t, 1e-9);
+        ck_assert_double_eq_tol(dist3(l2->end, pts[2]), 0, 1e-12);
+        ck_assert_double_eq_tol(sqrt(rs[0] * rs[0] + rs[1] * rs[1] + rs[2] * rs[2]), r, 1e-9);
+        ck_assert_double_eq_tol(sqrt(re[0] * re[0] + re[1] * re[1] + re[2] * re[2]), r, 1e-9);
+        /* tangents of a counter-clockwise arc about n: n x (radius vector) / r */
+        const double *n = a->arc.normal;
+        ts[0] = n[1] * rs[2] - n[2] * rs[1], ts[1] = n[2] * rs[0] - n[0] * rs[2];
+        ts[2] = n[0] * rs[1] - n[1] * rs[0];
+        te[0] = n[1] * re[2] - n[2] * re[1], te[1] = n[2] * re[0] - n[0] * re[2];
+        te[2] = n[0] * re[1] - n[1] * re[0];
+        for (int i = 0; i < 3; i++) {
+            ck_assert_double_eq_tol(ts[i] / r, d1[i], 1e-6);
+            ck_assert_double_eq_tol(te[i] / r, d2[i], 1e-6);
+            mid[i] = a->arc.center[i] + r * mid[i] / sqrt(rm);   /* the arc's midpoint */
+        }
+        ck_assert_double_eq_tol(dist3(mid, pts[1]), TOL, 1e-9);
+        canon_prog_free(&out);
+
+        /* executed: successive chords turn by at most the arc angle of one chord */
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+        load_start(mc.m, &p);
+        struct run_log rl;
+        run_log(mc.m, DT, &rl);
+        ck_assert_int_eq(rl.state, MOTION_DONE);
+        double kink = 0, prev[3] = {0, 0, 0};
+        int have = 0;
+        for (size_t s = 1; s < rl.n; s++) {
+            double d[3], len = dist3(rl.pose[s], rl.pose[s - 1]);
+            if (len < 1e-9)
+                continue;
+            for (int i = 0; i < 3; i++)
+                d[i] = (rl.pose[s][i] - rl.pose[s - 1][i]) / len;
+            if (have) {
+                double c = fmin(1, prev[0] * d[0] + prev[1] * d[1] + prev[2] * d[2]);
+                kink = fmax(kink, acos(c) - len / r);
+            }
+            memcpy(prev, d, sizeof prev);
+            have = 1;
+        }
+        ck_assert_msg(kink < 1e-3, "%g deg turn: the direction jumps by %.6f rad", turns[k],
+                      kink);
+        free(rl.pose);
+        tm_close(&mc);
+        canon_prog_free(&p);
+    }
+}
+END_TEST
+
+/* A zigzag of 0.1 mm steps at 90 degrees: the blends would need 0.12 mm of each line, so
+ * they are limited to half a line (0.05 mm): the trims never overlap, the corner is passed
+ * closer than P, and the executed path stays within P of the programmed zigzag. */
+START_TEST(test_short_segments)
+{
+    double pts[9][6];
+    memset(pts, 0, sizeof pts);
+    for (int i = 0; i < 9; i++)
+        pts[i][0] = 0.1 * ((i + 1) / 2), pts[i][1] = 0.1 * (i / 2);
+    struct canon_prog p, out;
+    polyline_prog(&p, (const double (*)[6])pts, 9, 640, TOL, 300);
+    struct motion_config cfg;
+    motion_config_default(&cfg);
+    size_t nb = 0;
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 7);
+    double at[6];
+    memcpy(at, out.start, sizeof at);
+    for (size_t i = 1; i < out.count; i++) {
+        const struct canon_cmd *c = &out.cmds[i];
+        double len = dist3(at, c->end);
+        if (c->type == CANON_ARC) {
+            double r = dist3(at, c->arc.center);
+            ck_assert_double_eq_tol(r, 0.05, 1e-9);            /* t = r at 90 degrees */
+            ck_assert_double_eq_tol(dist3(c->end, c->arc.center), r, 1e-9);
+        } else {
+            ck_assert_msg(len <= 0.1 - 0.05 + 1e-9, "line %zu keeps %.9f mm", i, len);
+        }
+        memcpy(at, c->end, sizeof at);
+    }
+    canon_prog_free(&out);
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    load_start(mc.m, &p);
+    struct run_log rl;
+    run_log(mc.m, DT, &rl);
+    ck_assert_int_eq(rl.state, MOTION_DONE);
+    double off = 0, closest = HUGE_VAL;
+    for (size_t k = 0; k < rl.n; k++) {
+        off = fmax(off, dist_poly(rl.pose[k], (const double (*)[6])pts, 9));
+        closest = fmin(closest, dist3(rl.pose[k], pts[4]));
+    }
+    double dev = 0.05 * (sqrt(2) - 1);          /* r (1 / cos 45 - 1) */
+    ck_assert_msg(off < TOL, "left the zigzag by %.6f mm", off);
+    ck_assert_msg(closest >= dev - 1e-9 && closest < TOL, "corner passed at %.6f mm", closest);
+    ck_assert_double_eq_tol(rl.pose[rl.n - 1][0], 0.4, 1e-9);
+    ck_assert_double_eq_tol(rl.pose[rl.n - 1][1], 0.4, 1e-9);
+    free(rl.pose);
+    tm_close(&mc);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* A B C change on both lines: along the arc they go linearly with the arc angle from the
+ * first line's pose at its trim point to the second's, so orientation is continuous and
+ * each sample on the arc carries the interpolated A B C. */
+START_TEST(test_orientation)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {10, 0, 0, 10, -4, 2},
+                                     {10, 10, 0, 10, 16, -3}};
+    struct canon_prog p, out;
+    polyline_prog(&p, pts, 3, 640, TOL, 600);
+    struct motion_config cfg;
+    motion_config_default(&cfg);
+    size_t nb = 0;
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 1);
+    double T1[6], T2[6], C[3], r;
+    memcpy(T1, out.cmds[1].end, sizeof T1);
+    memcpy(T2, out.cmds[2].end, sizeof T2);
+    memcpy(C, out.cmds[2].arc.center, sizeof C);
+    r = dist3(T1, C);
+    double t = 10 - T1[0];                       /* trim length along the first line */
+    ck_assert_double_eq_tol(T1[3], 10 * (1 - t / 10), 1e-9);   /* first line's pose there */
+    ck_assert_double_eq_tol(T2[4], -4 + 20 * t / 10, 1e-9);    /* second line's */
+    canon_prog_free(&out);
+
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    load_start(mc.m, &p);
+    struct run_log rl;
+    run_log(mc.m, DT, &rl);
+    ck_assert_int_eq(rl.state, MOTION_DONE);
+    int on_arc = 0;
+    double jump = 0;
+    for (size_t k = 0; k < rl.n; k++) {
+        const double *q = rl.pose[k];
+        if (k > 0)
+            for (int i = 3; i < 6; i++)
+                jump = fmax(jump, fabs(q[i] - rl.pose[k - 1][i]));
+        if (q[0] <= T1[0] + 1e-12 || q[1] <= 1e-12 || q[1] >= T2[1] - 1e-12)
+            continue;                            /* on a line */
+        double a0 = atan2(T1[1] - C[1], T1[0] - C[0]), a = atan2(q[1] - C[1], q[0] - C[0]);
+        double u = (a - a0) / (M_PI / 2);
+        ck_assert_double_eq_tol(hypot(q[0] - C[0], q[1] - C[1]), r, 1e-9);
+        for (int i = 3; i < 6; i++)
+            ck_assert_double_eq_tol(q[i], T1[i] + u * (T2[i] - T1[i]), 1e-6);
+        on_arc++;
+    }
+    ck_assert_int_gt(on_arc, 3);
+    /* no step in A B C: within one period at the angular speed limit (90 deg/s) */
+    ck_assert_msg(jump <= 90 * DT * (1 + 1e-6), "A B C stepped by %.6f deg", jump);
+    free(rl.pose);
+    tm_close(&mc);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* G61 and G64 P0 with a zero BLEND_TOLERANCE make no blend; a G0 corner and a corner after
+ * M0 are left sharp even under G64 P. */
+START_TEST(test_no_blend)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {10, 0, 0, 0, 0, 0}, {10, 10, 0, 0, 0, 0}};
+    struct motion_config cfg;
+    motion_config_default(&cfg);
+    struct canon_prog p, out;
+    size_t nb = 9;
+    polyline_prog(&p, pts, 3, 610, 0, 600);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 0);
+    ck_assert_int_eq((int)out.count, 0);
+    canon_prog_free(&p);
+    polyline_prog(&p, pts, 3, 640, 0, 600);     /* G64 without P: BLEND_TOLERANCE */
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 1);
+    ck_assert_double_eq_tol(dist3(out.cmds[1].end, pts[1]) * (sqrt(2) - 1), 0.01, 1e-9);
+    canon_prog_free(&out);
+    cfg.blend_tol_mm = 0;
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 0);
+    canon_prog_free(&p);
+    cfg.blend_tol_mm = 0.01;
+    canon_prog_init(&p);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .value = TOL, .ivalue = 640};
+    canon_prog_sink(&p, &pm);
+    tm_add(&p, CANON_TRAVERSE, 2, pts[1], 0, 0);
+    tm_add(&p, CANON_TRAVERSE, 3, pts[2], 0, 0);
+    tm_add(&p, CANON_FEED, 4, pts[0], 600, 0);
+    tm_add(&p, CANON_PAUSE, 5, NULL, 0, 0);
+    tm_add(&p, CANON_FEED, 6, pts[1], 600, 0);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 0);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* Distance from q to the blended path (lines and plane-0 arcs of prog). */
+static double dist_blended(const double *q, const struct canon_prog *p)
+{
+    double at[6], best = HUGE_VAL;
+    memcpy(at, p->start, sizeof at);
+    for (size_t i = 0; i < p->count; i++) {
+        const struct canon_cmd *c = &p->cmds[i];
+        if (c->type == CANON_FEED) {
+            best = fmin(best, dist_seg(q, at, c->end));
+        } else if (c->type == CANON_ARC) {
+            const double *n = c->arc.normal, *o = c->arc.center;
+            double v[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
+            double h = v[0] * n[0] + v[1] * n[1] + v[2] * n[2], w[3], e1[3], e2[3];
+            double r = dist3(at, o), sw = 0;
+            for (int k = 0; k < 3; k++)
+                w[k] = v[k] - h * n[k], e1[k] = (at[k] - o[k]) / r;
+            e2[0] = n[1] * e1[2] - n[2] * e1[1], e2[1] = n[2] * e1[0] - n[0] * e1[2];
+            e2[2] = n[0] * e1[1] - n[1] * e1[0];
+            double ang = atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
+                               w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+            double ee[3] = {c->end[0] - o[0], c->end[1] - o[1], c->end[2] - o[2]};
+            sw = atan2(ee[0] * e2[0] + ee[1] * e2[1] + ee[2] * e2[2],
+                       ee[0] * e1[0] + ee[1] * e1[1] + ee[2] * e1[2]);
+            double rho = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+            if (ang >= 0 && ang <= sw)
+                best = fmin(best, hypot(h, rho - r));
+            best = fmin(best, fmin(dist3(q, at), dist3(q, c->end)));
+        }
+        if (c->type == CANON_FEED || c->type == CANON_ARC)
+            memcpy(at, c->end, sizeof at);
+    }
+    return best;
+}
+
+/* A five-axis zigzag on the TMU hexapod under G64 P0.05 */
+static const double ZIG[6][6] = {
+    {-30, -20, 640, -4, 3, -5}, {-15, 20, 645, 4, -3, 5}, {0, -20, 650, -4, 3, -5},
+    {15, 20, 645, 4, -3, 5}, {30, -20, 640, -4, 3, -5}, {30, 20, 635, 0, 0, 0},
+};
+
+/* On the hexapod with tight legs (20 mm/s, 200 mm/s^2) the blended zigzag keeps every leg
+ * within its limits (measured from successive leg commands); programmed at 500 mm/s with
+ * fast limits, the tool point, through the forward kinematics of legs interpolated linearly
+ * between 1 kHz set points, stays within KINEMATIC_TOLERANCE of the blended path, hence
+ * within P + that of the programmed zigzag. */
+START_TEST(test_hexapod_zigzag)
+{
+    double t_g[2];
+    for (int g = 0; g < 2; g++) {
+        struct tk_cfg *c = tm_hexapod_cfg();
+        ck_assert_ptr_nonnull(c);
+        for (int i = 0; i < 6; i++) {
+            char sec[24];
+            snprintf(sec, sizeof sec, "JOINT_%d", i);
+            tk_set(c, sec, "MAX_VELOCITY", "20");
+            tk_set(c, sec, "MAX_ACCELERATION", "200");
+        }
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+        struct canon_prog p;
+        polyline_prog(&p, ZIG, 6, g ? 610 : 640, g ? 0 : TOL, 3000);
+        load_start(mc.m, &p);
+        struct motion_plan_info info;
+        motion_plan_info(mc.m, &info);
+        ck_assert_int_eq(info.blends, g ? 0 : 4);
+        struct tm_stats s;
+        tm_run(mc.m, DT, 1000000, &s, NULL, NULL);
+        ck_assert_int_eq(s.last.state, MOTION_DONE);
+        for (int i = 0; i < 6; i++) {
+            ck_assert_msg(s.max_leg_v[i] <= 20 * (1 + 1e-9), "leg %d at %.4f mm/s", i + 1,
+                          s.max_leg_v[i]);
+            ck_assert_msg(s.max_leg_a[i] <= 200 * 1.001, "leg %d at %.2f mm/s^2", i + 1,
+                          s.max_leg_a[i]);
+            ck_assert_double_eq_tol(s.last.pose[i], ZIG[5][i], 1e-9);
+        }
+        t_g[g] = s.t_s;
+        canon_prog_free(&p);
+        tm_close(&mc);
+    }
+    printf("hexapod zigzag, legs 20 mm/s: G64 P0.05 %.3f s, G61 %.3f s\n", t_g[0], t_g[1]);
+
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_fast_hexapod_cfg(DT, 0.001), &kins_hexapod_ops), 0);
+    struct canon_prog p, out;
+    polyline_prog(&p, ZIG, 6, 640, TOL, 30000);
+    size_t nb;
+    ck_assert_int_eq(motion_blend_program(&mc.mc, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(nb, 4);
+    load_start(mc.m, &p);
+    struct motion_out a, b;
+    double worst = 0, worst_prog = 0;
+    motion_step(mc.m, DT, &a);
+    while (a.state != MOTION_DONE) {
+        motion_step(mc.m, DT, &b);
+        double guess[6];
+        memcpy(guess, a.pose, sizeof guess);
+        for (int j = 1; j < 10; j++) {
+            double L[KINS_MAX_JOINTS], P[6];
+            for (int i = 0; i < 6; i++)
+                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+            memcpy(P, guess, sizeof P);
+            ck_assert_int_eq(kins_forward(mc.kins, L, P, NULL), KINS_OK);
+            memcpy(guess, P, sizeof guess);
+            worst = fmax(worst, dist_blended(P, &out));
+            worst_prog = fmax(worst_prog, dist_poly(P, ZIG, 6));
+        }
+        a = b;
+    }
+    ck_assert_msg(worst <= 0.001, "off the blended path by %.6f mm", worst);
+    ck_assert_msg(worst_prog <= TOL + 0.001, "off the zigzag by %.6f mm", worst_prog);
+    printf("hexapod zigzag at 500 mm/s, 1 kHz set points: %.6f mm off the blended path, %.6f mm off "
+           "the programmed zigzag\n", worst, worst_prog);
+    canon_prog_free(&out);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+static Suite *blend_suite(void)
+{
+    Suite *s = suite_create("motion_blend");
+    TCase *tc = tcase_create("blend");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, test_square_corner);
+    tcase_add_test(tc, test_arc_geometry);
+    tcase_add_test(tc, test_short_segments);
+    tcase_add_test(tc, test_orientation);
+    tcase_add_test(tc, test_no_blend);
+    tcase_add_test(tc, test_hexapod_zigzag);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(blend_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
