@@ -52,6 +52,77 @@ static void long_program(struct canon_prog *p, int n)
     }
 }
 
+/* Simulated run time (1 kHz) of the polyline pts[0..n-1] at feed_mm_min on the TMU hexapod,
+ * in G61 (tol_mm 0) or G64 P tol_mm; the slowest speed after the first and before the last
+ * 5 % of the time into *vmin. -1 on failure. */
+static double polyline_time(const double (*pts)[6], int n, double tol_mm, double feed_mm_min,
+                            double *vmin)
+{
+    struct tm_machine mc;
+    if (tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops))
+        return -1;
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, pts[0], sizeof p.start);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "bench.ngc",
+                           .value = tol_mm, .ivalue = tol_mm > 0 ? 640 : 610};
+    canon_prog_sink(&p, &pm);
+    for (int i = 1; i < n; i++)
+        tm_add(&p, CANON_FEED, i + 1, pts[i], feed_mm_min, 0);
+    char err[512];
+    double t = -1;
+    if (motion_load(mc.m, &p, err, sizeof err) == MOTION_OK && motion_start(mc.m) == MOTION_OK) {
+        struct motion_plan_info info;
+        motion_plan_info(mc.m, &info);
+        struct motion_out o;
+        *vmin = HUGE_VAL;
+        for (int k = 0; k < 10000000; k++) {
+            motion_step(mc.m, 0.001, &o);
+            if (o.state == MOTION_DONE)
+                break;
+            if (o.time_elapsed_s > 0.05 * info.time_s && o.time_elapsed_s < 0.95 * info.time_s)
+                *vmin = fmin(*vmin, o.path_vel);
+        }
+        t = o.time_elapsed_s;
+    }
+    canon_prog_free(&p);
+    tm_close(&mc);
+    return t;
+}
+
+/* G64 P0.05 against G61 on three paths: a square wave (90 degree corners), a 72-sided polygon
+ * (5 degree corners, as CAM output approximates a circle), a five-axis zigzag whose A B C
+ * reverse at every corner. */
+static int blend_figures(void)
+{
+    double sq[21][6], pg[73][6], zz[11][6];
+    memset(sq, 0, sizeof sq), memset(pg, 0, sizeof pg), memset(zz, 0, sizeof zz);
+    for (int i = 0; i < 21; i++)
+        sq[i][0] = -50 + 5 * ((i + 1) / 2), sq[i][1] = (i / 2) % 2 ? 10 : -10, sq[i][2] = 645;
+    for (int i = 0; i < 73; i++)
+        pg[i][0] = 40 * cos(i * M_PI / 36), pg[i][1] = 40 * sin(i * M_PI / 36), pg[i][2] = 645;
+    for (int i = 0; i < 11; i++) {
+        zz[i][0] = -50 + 10 * i, zz[i][1] = i % 2 ? 20 : -20, zz[i][2] = 640 + (i % 2) * 5;
+        zz[i][3] = i % 2 ? 4 : -4, zz[i][4] = i % 2 ? -3 : 3;
+    }
+    static const char *names[3] = {"square wave, 20 x 10 mm steps", "72-gon, radius 40 mm",
+                                   "five-axis zigzag, A B C reversing"};
+    const double (*paths[3])[6] = {sq, pg, zz};
+    const int counts[3] = {21, 73, 11};
+    const double feeds[2] = {1200, 3000};
+    printf("G64 P0.05 corner blending against G61 (TMU hexapod, its own limits, 1 kHz):\n");
+    for (int k = 0; k < 3; k++)
+        for (int f = 0; f < 2; f++) {
+            double v64, v61, t64 = polyline_time(paths[k], counts[k], 0.05, feeds[f], &v64);
+            double t61 = polyline_time(paths[k], counts[k], 0, feeds[f], &v61);
+            if (t64 < 0 || t61 < 0)
+                return -1;
+            printf("  %s, F%.0f: G64 %.3f s (slowest %.2f mm/s), G61 %.3f s (slowest %.2f "
+                   "mm/s): ratio %.2f\n", names[k], feeds[f], t64, v64, t61, v61, t61 / t64);
+        }
+    return 0;
+}
+
 int main(void)
 {
     static const double S[6] = {-60, -40, 630, -8, 6, -12}, E[6] = {60, 40, 660, 8, -6, 12};
@@ -117,5 +188,5 @@ int main(void)
            "(%s)\n", 1e9 * t_step, 1e9 * t_ik, t_step / t_ik, sink != 0 ? "ok" : "?");
     canon_prog_free(&p);
     tm_close(&mc);
-    return 0;
+    return blend_figures() ? 1 : 0;
 }
