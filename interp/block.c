@@ -150,7 +150,7 @@ static int check_axis_users(struct interp *in)
         if ((m != 0 && m != 10) || !has_axis(b))
             return interp_fail(in, INTERP_ERR_MODAL, b->gcol[0], "G53 needs G0 or G1 and axis "
                                "words in its block");
-        if (in->incremental || b->g[3] == 910)
+        if (b->g[3] >= 0 ? b->g[3] == 910 : in->incremental) /* G90 in the block counts */
             return interp_fail(in, INTERP_ERR_MODAL, b->gcol[0], "G53 cannot be used in "
                                "incremental distance mode (G91)");
     }

@@ -139,8 +139,11 @@ static int exec_machine_words(struct interp *in)
         in->spindle_dir = 0;
         CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
     }
-    if (b->m[8] >= 0)
+    if (b->m[8] >= 0) {
+        in->mist = b->m[8] == 7 || (b->m[8] == 8 && in->mist);
+        in->flood = b->m[8] == 8 || (b->m[8] == 7 && in->flood);
         CHP(emit_simple(in, CANON_COOLANT, 0, b->m[8]));
+    }
     if (b->g[0] == 40) {
         if (!W('p') || V('p') < 0)
             return interp_fail(in, INTERP_ERR_WORD, b->gcol[0], "G4 needs a P word: the dwell "
@@ -294,6 +297,7 @@ static int exec_stop(struct interp *in)
     in->spindle_dir = 0;
     CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
     CHP(emit_simple(in, CANON_COOLANT, 0, 9));
+    in->flood = in->mist = 0;
     in->ended = 1;
     return emit_simple(in, CANON_PROGRAM_END, 0, m);
 }
@@ -318,8 +322,12 @@ int interp_execute(struct interp *in)
 {
     struct interp_block *b = &in->blk;
     CHP(interp_check_block(in));
-    for (int i = 0; i < b->nassign; i++)
-        in->params[b->assign_idx[i]] = b->assign_val[i];
+    for (int i = 0; i < b->nassign; i++) {
+        if (b->assign_named[i])
+            interp_named_set(in, b->assign_idx[i], b->assign_val[i]);
+        else
+            in->params[b->assign_idx[i]] = b->assign_val[i];
+    }
     int g0 = b->g[0];
     int comp = g0 == 1410 || g0 == 1420;
     if (!comp && !block_empty(b))

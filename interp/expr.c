@@ -138,6 +138,32 @@ static int read_expression(struct interp *in, int *pos, double *out)
     return rc;
 }
 
+/* EXISTS[#<name>]: 1 when the name can be read now, else 0 (EXISTS[#n] is 1, as LinuxCNC).
+ * *pos is at the '['. */
+static int read_exists(struct interp *in, int *pos, int col, double *out)
+{
+    const char *name;
+    int len, pcol = in->normcol[*pos + 1];
+    if (in->norm[*pos + 1] != '#')
+        return interp_fail(in, INTERP_ERR_SYNTAX, pcol, "EXISTS takes a parameter: "
+                           "EXISTS[#<name>]");
+    if (in->norm[*pos + 2] == '<') {
+        *pos += 2;
+        CHP(interp_read_name(in, pos, pcol, &name, &len));
+        *out = interp_named_exists(in, name, len);
+    } else {
+        double v;
+        (*pos)++;
+        CHP(interp_read_value(in, pos, &v)); /* a bad number is still an error */
+        *out = 1.0;
+    }
+    if (in->norm[*pos] != ']')
+        return interp_fail(in, INTERP_ERR_SYNTAX, in->normcol[*pos], "']' expected to close "
+                           "EXISTS[ opened at column %d", col);
+    (*pos)++;
+    return 0;
+}
+
 /* Reads a function call: NAME[arg] (ATAN[y]/[x]) at norm[*pos]. */
 static int read_function(struct interp *in, int *pos, double *out)
 {
@@ -156,8 +182,7 @@ static int read_function(struct interp *in, int *pos, double *out)
     if (f < 0)
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "unknown word or function at '%.8s'", s);
     if (f == 13)
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
-                           "EXISTS (named parameters) is not supported yet");
+        return read_exists(in, pos, col, out);
     double a;
     CHP(read_expression(in, pos, &a));
     switch (f) {
@@ -201,14 +226,18 @@ static int read_function(struct interp *in, int *pos, double *out)
     }
 }
 
-/* Reads #n (n itself a value: #[1+2], ##1) and returns the parameter's current value. */
+/* Reads #n (n itself a value: #[1+2], ##1) or #<name> and returns the parameter's current
+ * value. */
 static int read_parameter(struct interp *in, int *pos, double *out)
 {
     int col = in->normcol[*pos], idx;
     (*pos)++;
-    if (in->norm[*pos] == '<')
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
-                           "named parameters (#<name>) are not supported yet");
+    if (in->norm[*pos] == '<') {
+        const char *name;
+        int len;
+        CHP(interp_read_name(in, pos, col, &name, &len));
+        return interp_named_get(in, name, len, col, out);
+    }
     double v;
     CHP(interp_read_value(in, pos, &v));
     CHP(interp_to_int(in, v, col, "parameter number", &idx));

@@ -94,6 +94,7 @@ void interp_destroy(struct interp *in)
 {
     if (!in)
         return;
+    interp_named_free(in);
     free(in->param_path);
     free(in);
 }
@@ -250,6 +251,7 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     in->sink = sink;
     in->sink_ctx = ctx;
     comp5_init(&in->comp);
+    interp_named_clear_locals(in); /* #<name> belongs to one program, #<_name> stays */
     int rc = run_lines(in, text, len);
     int save = interp_params_save(in);
     return rc ? rc : save;

@@ -9,7 +9,8 @@
 
 #define INTERP_NPARAMS 5603      /* #1 .. #5602, as LinuxCNC */
 #define INTERP_LINE_MAX 4096     /* characters in one program line */
-#define INTERP_MAX_ASSIGN 64     /* #n= settings in one block */
+#define INTERP_MAX_ASSIGN 64     /* #n= and #<name>= settings in one block */
+#define INTERP_NAME_MAX 255      /* characters in a #<name> */
 #define INTERP_GROUPS 15         /* G modal groups 0..14 (LinuxCNC numbering) */
 #define INTERP_MGROUPS 10        /* M modal groups 0..9 */
 #define MM_PER_INCH 25.4
@@ -37,12 +38,29 @@ struct interp_block {
     int m[INTERP_MGROUPS];       /* M code per group, -1 = none */
     int mcol[INTERP_MGROUPS];
     int nassign;
-    int assign_idx[INTERP_MAX_ASSIGN];
+    int assign_idx[INTERP_MAX_ASSIGN];   /* parameter number, or named table entry */
+    unsigned char assign_named[INTERP_MAX_ASSIGN]; /* 1: assign_idx is a named entry */
     double assign_val[INTERP_MAX_ASSIGN];
     int n_present;               /* the block has an N word */
     int n_number;
     int has_comment;
     char comment[256];           /* last ( ) comment of the line, as written */
+};
+
+/* One named parameter; entries keep their place, so a block can refer to them by number. */
+struct named_entry {
+    char *name;                  /* lowercase, without spaces, as the line was normalised */
+    int len;
+    unsigned hash;
+    double value;                /* mm and deg for lengths and angles, as numbered ones */
+};
+
+/* The named parameters set so far: entries in order, and an open-addressing hash index. */
+struct named_table {
+    struct named_entry *e;
+    size_t n, cap;
+    int *slot;                   /* entry number or -1; nslot is a power of two */
+    size_t nslot;
 };
 
 struct interp {
@@ -65,6 +83,7 @@ struct interp {
 
     /* numbered parameters, mm and deg for lengths and angles */
     double params[INTERP_NPARAMS];
+    struct named_table named;    /* #<name> (local to a program) and #<_name> (global) */
 
     /* modal state */
     double pos[6];               /* current machine pose, mm/deg */
@@ -91,6 +110,7 @@ struct interp {
                                   * started from */
     int current_tool, selected_tool;
     int spindle_dir;             /* 1, -1, 0 */
+    int flood, mist;             /* M8, M7 on (M9 turns both off) */
     double spindle_rpm;
     double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
 
@@ -111,6 +131,18 @@ int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind);
 int interp_read_value(struct interp *in, int *pos, double *out);
 /* Reads an integer-valued parameter index or code (within 1e-4 of an integer). */
 int interp_to_int(struct interp *in, double v, int column, const char *what, int *out);
+
+/* named.c: #<name> parameters. interp_read_name reads "<name>" at norm[*pos] == '<' (col is
+ * the '#' column for errors); name points into in->norm. */
+int interp_read_name(struct interp *in, int *pos, int col, const char **name, int *len);
+int interp_named_get(struct interp *in, const char *name, int len, int col, double *out);
+int interp_named_exists(struct interp *in, const char *name, int len);
+int interp_named_target(struct interp *in, const char *name, int len, int col, int *entry);
+void interp_named_set(struct interp *in, int entry, double v);
+void interp_named_clear_locals(struct interp *in);
+void interp_named_free(struct interp *in);
+/* predef.c: 1 and *out = its value when name is one of the read-only #<_...> parameters. */
+int interp_predefined(const struct interp *in, const char *name, int len, double *out);
 
 /* block.c: files a G or M code into its group; checks the block as a whole. */
 int interp_add_g(struct interp *in, double v, int column);

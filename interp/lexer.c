@@ -1,4 +1,5 @@
-/* lexer.c: one program line to a block: spaces and case removed, comments, words, #n= settings. */
+/* lexer.c: one program line to a block: spaces and case removed, comments, words, #n= and
+ * #<name>= settings. */
 #include <math.h>
 #include <string.h>
 
@@ -68,27 +69,39 @@ static int normalise(struct interp *in, const char *raw, size_t len, size_t i, i
     return 0;
 }
 
-/* Reads "#n=value" at norm[*pos] == '#'. The setting takes effect after the whole line. */
+/* Reads "#n=value" or "#<name>=value" at norm[*pos] == '#'. The setting takes effect after the
+ * whole line; a new name exists (as 0) from here on, as in LinuxCNC. */
 static int read_assignment(struct interp *in, int *pos)
 {
     struct interp_block *b = &in->blk;
-    int col = in->normcol[*pos];
-    (*pos)++;
-    if (in->norm[*pos] == '<')
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
-                           "named parameters (#<name>) are not supported yet");
+    int col = in->normcol[*pos], named = 0, idx, nlen = 0;
+    const char *name = NULL;
     double iv, v;
-    int idx;
-    CHP(interp_read_value(in, pos, &iv));
-    CHP(interp_to_int(in, iv, col, "parameter number", &idx));
-    if (idx < 1 || idx >= INTERP_NPARAMS)
-        return interp_fail(in, INTERP_ERR_PARAM, col,
-                           "parameter number #%d out of range (1 to %d)", idx, INTERP_NPARAMS - 1);
-    if (in->norm[*pos] != '=')
+    (*pos)++;
+    if (in->norm[*pos] == '<') {
+        named = 1;
+        CHP(interp_read_name(in, pos, col, &name, &nlen));
+        CHP(interp_named_target(in, name, nlen, col, &idx));
+    } else {
+        CHP(interp_read_value(in, pos, &iv));
+        CHP(interp_to_int(in, iv, col, "parameter number", &idx));
+        if (idx < 1 || idx >= INTERP_NPARAMS)
+            return interp_fail(in, INTERP_ERR_PARAM, col, "parameter number #%d out of range "
+                               "(1 to %d)", idx, INTERP_NPARAMS - 1);
+    }
+    if (in->norm[*pos] != '=') {
+        if (named)
+            return interp_fail(in, INTERP_ERR_SYNTAX, in->normcol[*pos], "'=' expected after "
+                               "#<%.*s> (a parameter setting is #<name>=value)",
+                               nlen > 60 ? 60 : nlen, name);
         return interp_fail(in, INTERP_ERR_SYNTAX, in->normcol[*pos],
                            "'=' expected after #%d (a parameter setting is #n=value)", idx);
+    }
     (*pos)++;
     CHP(interp_read_value(in, pos, &v));
+    if (!isfinite(v) && named)
+        return interp_fail(in, INTERP_ERR_EXPR, col, "value for #<%.*s> is not a finite number "
+                           "(overflow)", nlen > 60 ? 60 : nlen, name);
     if (!isfinite(v))
         return interp_fail(in, INTERP_ERR_EXPR, col, "value for #%d is not a finite number "
                            "(overflow)", idx);
@@ -96,6 +109,7 @@ static int read_assignment(struct interp *in, int *pos)
         return interp_fail(in, INTERP_ERR_PARAM, col, "more than %d parameter settings in one block",
                            INTERP_MAX_ASSIGN);
     b->assign_idx[b->nassign] = idx;
+    b->assign_named[b->nassign] = (unsigned char)named;
     b->assign_val[b->nassign] = v;
     b->nassign++;
     return 0;

@@ -3,9 +3,10 @@
 
 Used once to make the mix*.ngc and cyc*.ngc programs of this folder, whose .out files
 LinuxCNC's rs274 -g printed; with rs274 installed it serves to compare many more:
-python3 gen_mix.py [--cycles | --planes] FIRST_SEED LAST_SEED, then run
+python3 gen_mix.py [--cycles | --planes | --named] FIRST_SEED LAST_SEED, then run
 tests/interp_expected.sh with REGEN=1 in a scratch copy of the folder. --planes writes
-cycles in G17, G18 and G19 (planeSEED.ngc)."""
+cycles in G17, G18 and G19 (planeSEED.ngc); --named the mix with named parameters set and
+read between its blocks, the predefined ones too (namedSEED.ngc)."""
 import random
 import sys
 
@@ -123,6 +124,36 @@ def plane_program(seed):
     return '\n'.join(lines + ['M2']) + '\n'
 
 
+PREDEFINED = ['_x', '_y', '_z', '_a', '_b', '_c', '_abs_x', '_abs_y', '_abs_z', '_abs_a',
+              '_abs_b', '_abs_c', '_metric', '_imperial', '_absolute', '_incremental', '_plane',
+              '_coord_system', '_retract_r_plane', '_retract_old_z', '_motion_mode', '_feed',
+              '_line', '_inverse_time', '_units_per_minute', '_ijk_absolute_mode']
+
+
+def named_block(names):
+    """Sets a local or global name from state, or moves by one: names holds those set."""
+    r = random.random()
+    src = '#<%s>' % random.choice(PREDEFINED + names) if names else '#<_x>'
+    if r < 0.4:
+        name = random.choice(['a', 'b', 'Depth', 'safe z', '_g1', '_G2'])
+        names.append(name.lower().replace(' ', ''))
+        return ['#<%s> = [%s %s %s]' % (name, src, random.choice(['+', '-', '*']), num(-3, 3))]
+    if r < 0.8:
+        return ['G90 G0 %s[%s + %s]' % (random.choice('XYZ'), src, num(-5, 5))]
+    return ['G91 G1 %s%s F[#<_feed> + 100]' % (random.choice('XYZ'), src), 'G90']
+
+
+def named_program(seed):
+    """The mix with named parameters read and set between its blocks."""
+    random.seed(seed)
+    lines = ['(generated mix with named parameters, seed %d)' % seed,
+             'G21 G90 G17 G94', 'G0 X0 Y0 Z10 F300']
+    names = []
+    for _ in range(40):
+        lines += named_block(names) if random.random() < 0.4 else block()
+    return '\n'.join(lines + ['M2']) + '\n'
+
+
 def cycle_program(seed):
     """Cycles back to back (the series LinuxCNC keeps an initial level for), G80 now and then."""
     random.seed(seed)
@@ -145,10 +176,10 @@ def program(seed):
 
 
 if __name__ == '__main__':
-    kind = sys.argv[1] if sys.argv[1] in ('--cycles', '--planes') else ''
+    kind = sys.argv[1] if sys.argv[1] in ('--cycles', '--planes', '--named') else ''
     first, last = int(sys.argv[1 + bool(kind)]), int(sys.argv[2 + bool(kind)])
     make, prefix = {'--cycles': (cycle_program, 'cyc'), '--planes': (plane_program, 'plane'),
-                    '': (program, 'mix')}[kind]
+                    '--named': (named_program, 'named'), '': (program, 'mix')}[kind]
     for seed in range(first, last):
         with open('%s%d.ngc' % (prefix, seed), 'w') as f:
             f.write(make(seed))

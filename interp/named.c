@@ -1,0 +1,186 @@
+/* named.c: named parameters #<name> (local) and #<_name> (global), kept as LinuxCNC keeps them. */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interp/interp_int.h"
+
+#define NAMED_MAX 100000         /* distinct names in one interpreter: more is a runaway program */
+
+/* FNV-1a over the name's bytes (names are already lowercase and without spaces). */
+static uint32_t name_hash(const char *s, int len)
+{
+    uint32_t h = 2166136261u;
+    for (int i = 0; i < len; i++)
+        h = (h ^ (unsigned char)s[i]) * 16777619u;
+    return h;
+}
+
+/* The slot of the hash index holding name, or the empty slot where it would go. */
+static size_t find_slot(const struct named_table *t, const char *s, int len, uint32_t h)
+{
+    size_t mask = t->nslot - 1, i = h & mask;
+    for (;;) {
+        int e = t->slot[i];
+        if (e < 0)
+            return i;
+        const struct named_entry *en = &t->e[e];
+        if (en->hash == h && en->len == len && memcmp(en->name, s, (size_t)len) == 0)
+            return i;
+        i = (i + 1) & mask;
+    }
+}
+
+/* The entry of name, or -1 when it was never set. */
+static int lookup(const struct named_table *t, const char *s, int len)
+{
+    if (t->n == 0)
+        return -1;
+    return t->slot[find_slot(t, s, len, name_hash(s, len))];
+}
+
+/* Empties the hash index and enters every name again. */
+static void fill_index(struct named_table *t)
+{
+    for (size_t i = 0; i < t->nslot; i++)
+        t->slot[i] = -1;
+    for (size_t e = 0; e < t->n; e++)
+        t->slot[find_slot(t, t->e[e].name, t->e[e].len, t->e[e].hash)] = (int)e;
+}
+
+/* A new hash index of nslot slots (a power of two, more than twice the names). */
+static int reindex(struct named_table *t, size_t nslot)
+{
+    int *slot = malloc(nslot * sizeof *slot);
+    if (!slot)
+        return -1;
+    free(t->slot);
+    t->slot = slot;
+    t->nslot = nslot;
+    fill_index(t);
+    return 0;
+}
+
+/* Adds name with value 0 and returns its entry (entries never move: the index refers to them
+ * by number, so a setting read earlier on the line still lands after the table grew). */
+static int add(struct interp *in, const char *s, int len, int col, int *entry)
+{
+    struct named_table *t = &in->named;
+    if (t->n >= NAMED_MAX)
+        return interp_fail(in, INTERP_ERR_PARAM, col, "more than %d named parameters",
+                           NAMED_MAX);
+    if (t->n == t->cap) {
+        size_t cap = t->cap ? t->cap * 2 : 16;
+        struct named_entry *e = realloc(t->e, cap * sizeof *e);
+        if (!e)
+            return interp_fail(in, INTERP_ERR_NOMEM, col, "out of memory for named parameters");
+        t->e = e;
+        t->cap = cap;
+    }
+    if ((t->n + 1) * 2 > t->nslot && reindex(t, t->nslot ? t->nslot * 2 : 32))
+        return interp_fail(in, INTERP_ERR_NOMEM, col, "out of memory for named parameters");
+    char *name = malloc((size_t)len + 1);
+    if (!name)
+        return interp_fail(in, INTERP_ERR_NOMEM, col, "out of memory for named parameters");
+    memcpy(name, s, (size_t)len);
+    name[len] = 0;
+    struct named_entry *en = &t->e[t->n];
+    en->name = name;
+    en->len = len;
+    en->hash = name_hash(s, len);
+    en->value = 0.0;
+    t->slot[find_slot(t, s, len, en->hash)] = (int)t->n;
+    *entry = (int)t->n++;
+    return 0;
+}
+
+/* Reads "<name>" at norm[*pos] == '<' (after a '#' at column col): name points into the line. */
+int interp_read_name(struct interp *in, int *pos, int col, const char **name, int *len)
+{
+    const char *s = in->norm + *pos + 1;
+    const char *end = strchr(s, '>');
+    if (!end)
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "named parameter not closed: '>' missing "
+                           "after #<%.40s", s);
+    if (end == s)
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "named parameter without a name: #<> "
+                           "(write #<name>, or #<_name> for a global one)");
+    if (end - s > INTERP_NAME_MAX)
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "named parameter name longer than %d "
+                           "characters", INTERP_NAME_MAX);
+    *name = s;
+    *len = (int)(end - s);
+    *pos += *len + 2;
+    return 0;
+}
+
+/* The value of #<name>: a predefined one, or one set before; reading any other is an error. */
+int interp_named_get(struct interp *in, const char *name, int len, int col, double *out)
+{
+    if (name[0] == '_' && interp_predefined(in, name, len, out))
+        return 0;
+    int e = lookup(&in->named, name, len);
+    if (e < 0)
+        return interp_fail(in, INTERP_ERR_PARAM, col, "named parameter #<%.*s> is not defined "
+                           "(set it first, e.g. #<%.*s>=0)", len > 60 ? 60 : len, name,
+                           len > 60 ? 60 : len, name);
+    *out = in->named.e[e].value;
+    return 0;
+}
+
+/* Whether #<name> can be read now (EXISTS[#<name>]). */
+int interp_named_exists(struct interp *in, const char *name, int len)
+{
+    double v;
+    if (name[0] == '_' && interp_predefined(in, name, len, &v))
+        return 1;
+    return lookup(&in->named, name, len) >= 0;
+}
+
+/* The entry a setting #<name>=... will write. As in LinuxCNC a new name exists (as 0) from
+ * here on, its value landing after the line; predefined names are read-only. */
+int interp_named_target(struct interp *in, const char *name, int len, int col, int *entry)
+{
+    double v;
+    if (name[0] == '_' && interp_predefined(in, name, len, &v))
+        return interp_fail(in, INTERP_ERR_PARAM, col, "#<%.*s> is read-only (it tells the "
+                           "interpreter's state and cannot be set)", len, name);
+    *entry = lookup(&in->named, name, len);
+    if (*entry >= 0)
+        return 0;
+    return add(in, name, len, col, entry);
+}
+
+/* Writes a setting's value (after its line has been read). */
+void interp_named_set(struct interp *in, int entry, double v)
+{
+    in->named.e[entry].value = v;
+}
+
+/* Forgets the local names (those not starting with '_') at the start of a program. */
+void interp_named_clear_locals(struct interp *in)
+{
+    struct named_table *t = &in->named;
+    size_t k = 0;
+    for (size_t i = 0; i < t->n; i++) {
+        if (t->e[i].name[0] == '_')
+            t->e[k++] = t->e[i];
+        else
+            free(t->e[i].name);
+    }
+    if (k == t->n)
+        return;
+    t->n = k;
+    fill_index(t);
+}
+
+/* Frees every name. */
+void interp_named_free(struct interp *in)
+{
+    struct named_table *t = &in->named;
+    for (size_t i = 0; i < t->n; i++)
+        free(t->e[i].name);
+    free(t->e);
+    free(t->slot);
+    memset(t, 0, sizeof *t);
+}
