@@ -106,13 +106,15 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     /* G64 P corners become tangent arcs first (motion_blend.c); the planner then treats
      * them like any programmed arc */
     struct canon_prog blended;
+    struct motion_blend_abc *abc = NULL;
     size_t nblends = 0;
-    int st = motion_blend_program(&m->cfg, prog, &blended, &nblends);
+    int st = motion_blend_program(&m->cfg, prog, &blended, &nblends, &abc);
     if (st)
         motion_set_msg(m, "out of memory planning the program");
     if (!st)
-        st = motion_path_build(m, nblends ? &blended : prog, m->msg, sizeof m->msg);
+        st = motion_path_build(m, nblends ? &blended : prog, abc, m->msg, sizeof m->msg);
     canon_prog_free(&blended);
+    free(abc);
     if (!st)
         st = motion_plan_profile(m, m->msg, sizeof m->msg);
     m->plan.info.blends = nblends;

@@ -175,8 +175,17 @@ static void blend_arc(const struct canon_prog *in, const struct blend_rec *rec, 
     a->arc.plane = 0;
 }
 
-/* Writes the blended program: trimmed lines, each followed by its blend arc. */
-static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct canon_prog *out)
+/* A B C rate of a straight feed move, deg per mm of XYZ path. */
+static void abc_rate(const struct blend_rec *b, const struct canon_cmd *c, double rate[3])
+{
+    for (int k = 0; k < 3; k++)
+        rate[k] = (c->end[3 + k] - b->from[3 + k]) / b->len_mm;
+}
+
+/* Writes the blended program: trimmed lines, each followed by its blend arc; abc (out->count
+ * entries) marks the arcs and the lines' A B C rates at their ends. */
+static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct canon_prog *out,
+                struct motion_blend_abc *abc)
 {
     memcpy(out->start, in->start, sizeof out->start);
     for (size_t i = 0; i < in->count; i++) {
@@ -196,6 +205,10 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
         if (b->next) {
             struct canon_cmd a;
             blend_arc(in, rec, i, t1, &a);
+            struct motion_blend_abc *ab = &abc[out->count];
+            ab->blend = 1;
+            abc_rate(b, &in->cmds[i], ab->rate0);
+            abc_rate(&rec[b->next], &in->cmds[b->next], ab->rate1);
             if (canon_prog_sink(out, &a))
                 return MOTION_ERR_NOMEM;
         }
@@ -205,10 +218,12 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
 
 /* See motion_blend.h. */
 int motion_blend_program(const struct motion_config *c, const struct canon_prog *in,
-                         struct canon_prog *out, size_t *nblends)
+                         struct canon_prog *out, size_t *nblends, struct motion_blend_abc **abc)
 {
     canon_prog_init(out);
     *nblends = 0;
+    if (abc)
+        *abc = NULL;
     if (in->count == 0)
         return MOTION_OK;
     struct blend_rec *rec = calloc(in->count, sizeof *rec);
@@ -216,12 +231,17 @@ int motion_blend_program(const struct motion_config *c, const struct canon_prog 
         return MOTION_ERR_NOMEM;
     scan(c, in, rec);
     size_t n = find_blends(in, rec);
-    int st = n ? emit(in, rec, out) : MOTION_OK;
+    struct motion_blend_abc *ab = n ? calloc(in->count + n, sizeof *ab) : NULL;
+    int st = n && !ab ? MOTION_ERR_NOMEM : n ? emit(in, rec, out, ab) : MOTION_OK;
     free(rec);
+    if (st || !abc)
+        free(ab);
     if (st) {
         canon_prog_free(out);
         return st;
     }
+    if (abc)
+        *abc = ab;
     *nblends = n;
     return MOTION_OK;
 }

@@ -48,12 +48,22 @@ int motion_blend_corner(const double d1[3], const double d2[3], double len1_mm, 
  * P (ivalue 640), 0 (no blending) for G61 and G61.1. */
 double motion_blend_tolerance(const struct motion_config *c, const struct canon_cmd *pm);
 
+/* How A B C turn along a blend arc: the rates of the two lines at its ends, so that the
+ * orientation follows a cubic in the arc's angle whose rate joins both lines' without a step
+ * (motion_path.c). One per command of the blended program; blend = 0 for the others. */
+struct motion_blend_abc {
+    int blend;               /* 1: the command is a blend arc */
+    double rate0[3];         /* d(A B C)/ds at its start: the line left, deg/mm */
+    double rate1[3];         /* d(A B C)/ds at its end: the line entered, deg/mm */
+};
+
 /* A copy of `in` with every G64 corner between two straight feed moves rounded: the lines
  * trimmed and a plane-0 CANON_ARC inserted (canon.h's convention, as G141/G142 make them).
  * out is initialised here and holds the copy only when *nblends > 0 (else it stays empty and
- * `in` is to be used as is); the caller frees it with canon_prog_free. MOTION_ERR_NOMEM when
- * memory runs out (out is then empty). */
+ * `in` is to be used as is); the caller frees it with canon_prog_free. When abc is not NULL
+ * and there are blends, *abc receives out->count entries (free() them), else NULL.
+ * MOTION_ERR_NOMEM when memory runs out (out is then empty). */
 int motion_blend_program(const struct motion_config *c, const struct canon_prog *in,
-                         struct canon_prog *out, size_t *nblends);
+                         struct canon_prog *out, size_t *nblends, struct motion_blend_abc **abc);
 
 #endif

@@ -225,8 +225,17 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     int st = reach_check(m, sg, S, hs, sample_at(m, sg, s, S), err, errlen);
     if (st)
         return st;
-    double vm, am, vl;
+    double vm, am, vl, kabc = motion_seg_abc_curvature(&m->plan, sg, s);
     machine_caps(m, sg, S, &vm, &am);
+    if (kabc > 1e-12) {        /* A B C bend along a blend arc: half the angular acceleration
+                                * for the bend (abc'' v^2), half for the path's (abc' a) */
+        double w = 0;
+        for (int i = 3; i < 6; i++)
+            w = fmax(w, fabs(S->dp[i]));
+        vm = fmin(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
+        if (w > 1e-12)
+            am = fmin(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
+    }
     leg_caps(m, S, hs, &vl, &am);
     double vk = kin_tol_cap(m, sg, S);
     if (vk < 0) {

@@ -14,6 +14,36 @@
 #define MAX_INTERVALS 4000     /* knots per segment are capped (very long moves) */
 
 
+/* A B C on a blend arc: the cubic (Hermite) in u from the start to the end orientation with
+ * slopes m0, m1, so the rate joins the lines' on both sides. d = 0: value, 1: d/du, 2: d2/du2. */
+static void abc_cubic(const struct motion_seg *sg, const struct motion_arc *a, double u, int d,
+                      double out[3])
+{
+    double u2 = u * u, u3 = u2 * u, h00, h10, h01, h11;
+    if (d == 0)
+        h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = 3 * u2 - 2 * u3, h11 = u3 - u2;
+    else if (d == 1)
+        h00 = 6 * u2 - 6 * u, h10 = 3 * u2 - 4 * u + 1, h01 = 6 * u - 6 * u2, h11 = 3 * u2 - 2 * u;
+    else
+        h00 = 12 * u - 6, h10 = 6 * u - 4, h01 = 6 - 12 * u, h11 = 6 * u - 2;
+    for (int k = 0; k < 3; k++)
+        out[k] = h00 * sg->start[3 + k] + h10 * a->abc_m0[k] + h01 * sg->end[3 + k] +
+                 h11 * a->abc_m1[k];
+}
+
+/* Largest |d2(A B C)/ds2| at s, deg/mm^2: 0 except on blend arcs. */
+double motion_seg_abc_curvature(const struct motion_plan *p, const struct motion_seg *sg,
+                                double s)
+{
+    if (sg->kind != SEG_ARC || !p->arcs[sg->arc].abc_cubic || !(sg->len > 0))
+        return 0;
+    double c[3], w = 0;
+    abc_cubic(sg, &p->arcs[sg->arc], s / sg->len, 2, c);
+    for (int k = 0; k < 3; k++)
+        w = fmax(w, fabs(c[k]));
+    return w / (sg->len * sg->len);
+}
+
 /* Pose at s on a segment (s may lie slightly outside [0, len]: the geometry extends). */
 void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, double s,
                      double pose[KINS_POSE_DIM])
@@ -28,6 +58,8 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
     double c = cos(ang), sn = sin(ang);
     for (int i = 0; i < 3; i++)
         pose[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
+    if (a->abc_cubic)
+        abc_cubic(sg, a, u, 0, pose + 3);
 }
 
 /* d pose / ds at s, analytic. */
@@ -44,6 +76,11 @@ void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg
     for (int i = 0; i < 3; i++)
         dp[i] = il * (a->dr_mm * (c * a->e1[i] + sn * a->e2[i])
                       + r * a->sweep_rad * (-sn * a->e1[i] + c * a->e2[i]) + a->dh_mm * a->n[i]);
+    if (a->abc_cubic) {
+        abc_cubic(sg, a, u, 1, dp + 3);
+        for (int k = 3; k < 6; k++)
+            dp[k] *= il;
+    }
 }
 
 /* The file name, copied once per distinct name so the plan owns it. */
@@ -214,6 +251,7 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
                    char *err, size_t errlen)
 {
     struct motion_arc a;
+    memset(&a, 0, sizeof a);
     if (arc_geometry(c, from, &a, err, errlen) < 0)
         return -2;
     if (p->narc == p->caparc) {
@@ -269,9 +307,22 @@ static void set_speed(const struct motion *m, struct motion_seg *sg, const struc
         sg->feed = m->cfg.default_lin_vel_mm_s;
 }
 
+/* The last segment, a blend arc, turns A B C along the cubic whose rates at both ends are
+ * the lines' (slopes per unit of u: rate per mm times the arc's length). */
+static void blend_abc(struct motion_plan *p, const struct motion_blend_abc *b)
+{
+    struct motion_seg *sg = &p->segs[p->nseg - 1];
+    struct motion_arc *a = &p->arcs[sg->arc];
+    a->abc_cubic = 1;
+    for (int k = 0; k < 3; k++) {
+        a->abc_m0[k] = b->rate0[k] * sg->len;
+        a->abc_m1[k] = b->rate1[k] * sg->len;
+    }
+}
+
 /* Builds the segment list from the program (geometry only; speeds come later). */
-int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err,
-                      size_t errlen)
+int motion_path_build(struct motion *m, const struct canon_prog *prog,
+                      const struct motion_blend_abc *abc, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
     double at[KINS_POSE_DIM];
@@ -283,7 +334,11 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err
         int rc = 0;
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
-        case CANON_ARC: rc = add_arc(p, c, at, err, errlen); break;
+        case CANON_ARC:
+            rc = add_arc(p, c, at, err, errlen);
+            if (rc == 0 && abc && abc[i].blend)
+                blend_abc(p, &abc[i]);
+            break;
         case CANON_DWELL: rc = c->value > 0 ? add_stop(p, c, at, SEG_DWELL, c->value) : 0; break;
         case CANON_PAUSE:
             if (c->ivalue == 0 || m->cfg.optional_stop)

@@ -19,6 +19,9 @@ struct motion_arc {
     double r0_mm, dr_mm;     /* start radius and its change to the end radius, mm */
     double h0_mm, dh_mm;     /* height along n at the start and its change, mm */
     double sweep_rad;        /* signed angle turned (> 0: counter-clockwise about n) */
+    int abc_cubic;           /* 1 (G64 blend arcs): A B C follow the cubic with end slopes
+                              * abc_m0, abc_m1 instead of going linearly with u */
+    double abc_m0[3], abc_m1[3]; /* d(A B C)/du at u = 0 and u = 1, deg */
 };
 
 /* One planned segment: a move, a dwell or a pause. The path parameter s runs over [0, len]
@@ -124,8 +127,13 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
 /* d pose / ds at s (mm or deg per unit of s). */
 void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg, double s,
                         double dp[KINS_POSE_DIM]);
-int motion_path_build(struct motion *m, const struct canon_prog *prog, char *err,
-                      size_t errlen);
+/* abc: NULL, or one entry per command of prog marking G64 blend arcs (motion_blend.h). */
+struct motion_blend_abc;
+int motion_path_build(struct motion *m, const struct canon_prog *prog,
+                      const struct motion_blend_abc *abc, char *err, size_t errlen);
+/* Largest |d2(A B C)/ds2| at s, deg/mm^2 (0 but on blend arcs). */
+double motion_seg_abc_curvature(const struct motion_plan *p, const struct motion_seg *sg,
+                                double s);
 void motion_plan_free(struct motion_plan *p);
 
 /* Planning (motion_plan.c). */

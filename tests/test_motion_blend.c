@@ -188,7 +188,7 @@ START_TEST(test_arc_geometry)
         struct motion_config cfg;
         motion_config_default(&cfg);
         size_t nb = 0;
-        ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+        ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
         ck_assert_int_eq(nb, 1);
         ck_assert_int_eq((int)out.count, 4);      /* path mode, line, arc, line */
         const struct canon_cmd *l1 = &out.cmds[1], *a = &out.cmds[2], *l2 = &out.cmds[3];
@@ -270,7 +270,7 @@ START_TEST(test_short_segments)
     struct motion_config cfg;
     motion_config_default(&cfg);
     size_t nb = 0;
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 7);
     double at[6];
     memcpy(at, out.start, sizeof at);
@@ -309,9 +309,11 @@ START_TEST(test_short_segments)
 }
 END_TEST
 
-/* A B C change on both lines: along the arc they go linearly with the arc angle from the
- * first line's pose at its trim point to the second's, so orientation is continuous and
- * each sample on the arc carries the interpolated A B C. */
+/* A B C change on both lines: along the arc they follow the cubic (in the arc's angle) from
+ * the first line's pose at its trim point to the second's whose rates at both ends are the
+ * lines' rates, so orientation and its rate per mm of path are continuous: every sample on
+ * the arc carries the cubic's A B C, and the rate measured between samples never steps by
+ * more than a quarter of the step a corner without the cubic would make. */
 START_TEST(test_orientation)
 {
     static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {10, 0, 0, 10, -4, 2},
@@ -321,16 +323,25 @@ START_TEST(test_orientation)
     struct motion_config cfg;
     motion_config_default(&cfg);
     size_t nb = 0;
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    struct motion_blend_abc *abc;
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, &abc), MOTION_OK);
     ck_assert_int_eq(nb, 1);
-    double T1[6], T2[6], C[3], r;
+    ck_assert(abc[2].blend && !abc[1].blend && !abc[3].blend);
+    double T1[6], T2[6], C[3], r, g1[3], g2[3], step = 0;
     memcpy(T1, out.cmds[1].end, sizeof T1);
     memcpy(T2, out.cmds[2].end, sizeof T2);
     memcpy(C, out.cmds[2].arc.center, sizeof C);
     r = dist3(T1, C);
-    double t = 10 - T1[0];                       /* trim length along the first line */
+    double t = 10 - T1[0], L = r * M_PI / 2;   /* trim length; arc length */
     ck_assert_double_eq_tol(T1[3], 10 * (1 - t / 10), 1e-9);   /* first line's pose there */
     ck_assert_double_eq_tol(T2[4], -4 + 20 * t / 10, 1e-9);    /* second line's */
+    for (int i = 0; i < 3; i++) {
+        g1[i] = pts[1][3 + i] / 10, g2[i] = (pts[2][3 + i] - pts[1][3 + i]) / 10;
+        ck_assert_double_eq_tol(abc[2].rate0[i], g1[i], 1e-12);
+        ck_assert_double_eq_tol(abc[2].rate1[i], g2[i], 1e-12);
+        step = fmax(step, fabs(g2[i] - g1[i]));
+    }
+    free(abc);
     canon_prog_free(&out);
 
     struct tm_machine mc;
@@ -340,22 +351,35 @@ START_TEST(test_orientation)
     run_log(mc.m, DT, &rl);
     ck_assert_int_eq(rl.state, MOTION_DONE);
     int on_arc = 0;
-    double jump = 0;
-    for (size_t k = 0; k < rl.n; k++) {
-        const double *q = rl.pose[k];
-        if (k > 0)
-            for (int i = 3; i < 6; i++)
-                jump = fmax(jump, fabs(q[i] - rl.pose[k - 1][i]));
+    double jump = 0, prate[3] = {0, 0, 0}, rstep = 0;
+    for (size_t k = 1; k < rl.n; k++) {
+        const double *q = rl.pose[k], *q0 = rl.pose[k - 1];
+        double ds = dist3(q, q0);
+        for (int i = 3; i < 6; i++)
+            jump = fmax(jump, fabs(q[i] - q0[i]));
+        if (ds > 1e-4) {                     /* rate per mm between samples */
+            for (int i = 0; i < 3; i++) {
+                double rate = (q[3 + i] - q0[3 + i]) / ds;
+                if (k > 1)
+                    rstep = fmax(rstep, fabs(rate - prate[i]));
+                prate[i] = rate;
+            }
+        }
         if (q[0] <= T1[0] + 1e-12 || q[1] <= 1e-12 || q[1] >= T2[1] - 1e-12)
             continue;                            /* on a line */
         double a0 = atan2(T1[1] - C[1], T1[0] - C[0]), a = atan2(q[1] - C[1], q[0] - C[0]);
-        double u = (a - a0) / (M_PI / 2);
+        double u = (a - a0) / (M_PI / 2), u2 = u * u, u3 = u2 * u;
         ck_assert_double_eq_tol(hypot(q[0] - C[0], q[1] - C[1]), r, 1e-9);
-        for (int i = 3; i < 6; i++)
-            ck_assert_double_eq_tol(q[i], T1[i] + u * (T2[i] - T1[i]), 1e-6);
+        for (int i = 0; i < 3; i++) {
+            double want = (2 * u3 - 3 * u2 + 1) * T1[3 + i] + (u3 - 2 * u2 + u) * g1[i] * L +
+                          (3 * u2 - 2 * u3) * T2[3 + i] + (u3 - u2) * g2[i] * L;
+            ck_assert_double_eq_tol(q[3 + i], want, 1e-6);
+        }
         on_arc++;
     }
     ck_assert_int_gt(on_arc, 3);
+    ck_assert_msg(rstep < 0.25 * step, "A B C rate stepped by %.4f deg/mm (corner: %.4f)",
+                  rstep, step);
     /* no step in A B C: within one period at the angular speed limit (90 deg/s) */
     ck_assert_msg(jump <= 90 * DT * (1 + 1e-6), "A B C stepped by %.6f deg", jump);
     free(rl.pose);
@@ -374,17 +398,17 @@ START_TEST(test_no_blend)
     struct canon_prog p, out;
     size_t nb = 9;
     polyline_prog(&p, pts, 3, 610, 0, 600);
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 0);
     ck_assert_int_eq((int)out.count, 0);
     canon_prog_free(&p);
     polyline_prog(&p, pts, 3, 640, 0, 600);     /* G64 without P: BLEND_TOLERANCE */
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 1);
     ck_assert_double_eq_tol(dist3(out.cmds[1].end, pts[1]) * (sqrt(2) - 1), 0.01, 1e-9);
     canon_prog_free(&out);
     cfg.blend_tol_mm = 0;
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 0);
     canon_prog_free(&p);
     cfg.blend_tol_mm = 0.01;
@@ -396,7 +420,7 @@ START_TEST(test_no_blend)
     tm_add(&p, CANON_FEED, 4, pts[0], 600, 0);
     tm_add(&p, CANON_PAUSE, 5, NULL, 0, 0);
     tm_add(&p, CANON_FEED, 6, pts[1], 600, 0);
-    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 0);
     canon_prog_free(&p);
 }
@@ -488,7 +512,7 @@ START_TEST(test_hexapod_zigzag)
     struct canon_prog p, out;
     polyline_prog(&p, ZIG, 6, 640, TOL, 30000);
     size_t nb;
-    ck_assert_int_eq(motion_blend_program(&mc.mc, &p, &out, &nb), MOTION_OK);
+    ck_assert_int_eq(motion_blend_program(&mc.mc, &p, &out, &nb, NULL), MOTION_OK);
     ck_assert_int_eq(nb, 4);
     load_start(mc.m, &p);
     struct motion_out a, b;
