@@ -105,7 +105,7 @@ static int blend_figures(void)
         zz[i][0] = -50 + 10 * i, zz[i][1] = i % 2 ? 20 : -20, zz[i][2] = 640 + (i % 2) * 5;
         zz[i][3] = i % 2 ? 4 : -4, zz[i][4] = i % 2 ? -3 : 3;
     }
-    static const char *names[3] = {"square wave, 20 x 10 mm steps", "72-gon, radius 40 mm",
+    static const char *names[3] = {"square wave, 5 x 20 mm steps", "72-gon, radius 40 mm",
                                    "five-axis zigzag, A B C reversing"};
     const double (*paths[3])[6] = {sq, pg, zz};
     const int counts[3] = {21, 73, 11};

@@ -142,8 +142,9 @@ static void line_pose(const double *from, const struct canon_cmd *c, double len_
 }
 
 /* The plane-0 arc of the blend at the end of command i, into line j. The arc belongs to the
- * move it enters (line, feed); A B C go linearly with the angle between the two trim points.
- * t1 is where line i now ends (the arc's start). */
+ * move it enters (line, feed); it goes from the pose at line i's trim point to the pose at
+ * line j's (A B C between them along the cubic of motion_blend_abc). t1 is where line i now
+ * ends (the arc's start). */
 static void blend_arc(const struct canon_prog *in, const struct blend_rec *rec, size_t i,
                       const double t1[6], struct canon_cmd *a)
 {

@@ -14,12 +14,12 @@
  * P: the path stays within P of the programmed end point). Each line gives up at most half
  * of its length to a blend, so a short line makes a smaller blend (closer than P).
  *
- *            corner
- *      ───────●  ─┐            turning angle theta between the directions d1, d2;
- *        T1 ╲ |   |  P         radius r, trim t = r tan(theta/2) along each line,
- *            ╲|  ─┘            corner to arc midpoint: r / cos(theta/2) - r = P
- *             │╲ T2
- *             │
+ *    first line  T1   corner      turning angle theta between the directions d1, d2;
+ *    ────────────●‥‥‥‥‥‥●          radius r, trim t = r tan(theta/2) along each line,
+ *                  ╲    ‥          corner to arc midpoint: r / cos(theta/2) - r = P
+ *                    ╲  ‥
+ *                      ╲●  T2
+ *                       │ second line
  */
 
 /* One corner's blend. */

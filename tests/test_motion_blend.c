@@ -426,6 +426,35 @@ START_TEST(test_no_blend)
 }
 END_TEST
 
+/* G93: the trimmed lines and the arc keep the speed of the moves they come from (10 mm in
+ * 0.01 min: 16.67 mm/s), measured on the run. */
+START_TEST(test_inverse_time)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {10, 0, 0, 0, 0, 0}, {10, 10, 0, 0, 0, 0}};
+    struct canon_prog p;
+    polyline_prog(&p, pts, 3, 640, 1.0, 0);
+    p.cmds[1].inverse_time_min = p.cmds[2].inverse_time_min = 0.01;
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    load_start(mc.m, &p);
+    struct run_log rl;
+    run_log(mc.m, DT, &rl);
+    ck_assert_int_eq(rl.state, MOTION_DONE);
+    double vmax = 0, vcorner = HUGE_VAL;
+    for (size_t k = 1; k < rl.n; k++) {
+        double v = dist3(rl.pose[k], rl.pose[k - 1]) / DT;
+        vmax = fmax(vmax, v);
+        if (dist3(rl.pose[k], pts[1]) < 2.5)    /* on the arc (r 2.41 mm) or next to it */
+            vcorner = fmin(vcorner, v);
+    }
+    ck_assert_double_eq_tol(vmax, 10 / 0.6, 1e-6);
+    ck_assert_msg(vcorner > 10 / 0.6 * (1 - 1e-4), "corner at %.4f mm/s", vcorner);
+    free(rl.pose);
+    tm_close(&mc);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* Distance from q to the blended path (lines and plane-0 arcs of prog). */
 static double dist_blended(const double *q, const struct canon_prog *p)
 {
@@ -554,6 +583,7 @@ static Suite *blend_suite(void)
     tcase_add_test(tc, test_short_segments);
     tcase_add_test(tc, test_orientation);
     tcase_add_test(tc, test_no_blend);
+    tcase_add_test(tc, test_inverse_time);
     tcase_add_test(tc, test_hexapod_zigzag);
     suite_add_tcase(s, tc);
     return s;
