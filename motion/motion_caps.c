@@ -8,7 +8,6 @@
 #define FD_H 0.05              /* finite-difference step along the path, mm (deg) */
 #define LEG_ACC_SPLIT 0.5      /* share of a leg's acceleration for the path acceleration term */
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
-#define KIN_TOL_SHARE 0.9      /* the d^2 estimate is first order: keep 10 % in hand */
 
 /* Samples segment sg at s; returns the inverse kinematics status at s itself. */
 static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
@@ -24,8 +23,10 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     int st = kins_inverse(m->kins, o->pose, o->L);
     kins_inverse(m->kins, pm, Lm);     /* legs are written even when out of range */
     kins_inverse(m->kins, pp, Lp);
-    for (int i = 0; i < KINS_POSE_DIM; i++)
+    for (int i = 0; i < KINS_POSE_DIM; i++) {
         o->dp[i] = (pp[i] - pm[i]) / (2 * h);
+        o->d2p[i] = (pp[i] - 2 * o->pose[i] + pm[i]) / (h * h);
+    }
     for (int i = 0; i < m->nj; i++) {
         o->dL[i] = (Lp[i] - Lm[i]) / (2 * h);
         o->d2L[i] = (Lp[i] - 2 * o->L[i] + Lm[i]) / (h * h);
@@ -90,6 +91,44 @@ static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S
     return 0;
 }
 
+/* q = J^-1 d2L at a sample: the pose's second derivative along the path as the legs see
+ * it (the path's own, d2p, plus the kinematics' bending). -1 when J is singular. */
+static int pose_curvature(struct motion *m, const struct motion_sample *S, double q[6])
+{
+    if (jacobian_inverse_near(m, S) < 0)
+        return -1;
+    for (int i = 0; i < 6; i++) {
+        q[i] = 0;
+        for (int j = 0; j < 6; j++)
+            q[i] += m->jc_Jinv[i][j] * S->d2L[j];
+    }
+    return 0;
+}
+
+/* The parts of a pose deviation q across the path (the part along it is only a timing
+ * shift): the X Y Z distance into *perp_mm, the largest A B C one into *ang_deg. */
+static void across_path(const struct motion_seg *sg, const struct motion_sample *S,
+                        const double q[6], double *perp_mm, double *ang_deg)
+{
+    double shift = 0, w2 = 0, perp2 = 0, ang = 0;   /* shift: along-path part, s units */
+    int base = sg->rotary ? 3 : 0;
+    for (int i = base; i < base + 3; i++)
+        w2 += S->dp[i] * S->dp[i], shift += q[i] * S->dp[i];
+    shift = w2 > 0 ? shift / w2 : 0;
+    for (int i = 0; i < 3; i++)
+        perp2 += (q[i] - shift * S->dp[i]) * (q[i] - shift * S->dp[i]);
+    for (int i = 3; i < 6; i++)
+        ang = fmax(ang, fabs(q[i] - shift * S->dp[i]));
+    *perp_mm = sqrt(perp2);
+    *ang_deg = ang;
+}
+
+/* The set-point period: drives move their legs linearly over it. */
+static double setpoint_period(const struct motion_config *c)
+{
+    return c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+}
+
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
  * linearly between set points T apart, so over a chord of path length d the legs sit off the
  * leg-space curve by d2L d^2 / 8 at mid-chord; through the inverse Jacobian that is a pose
@@ -102,34 +141,48 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0 || m->nj != 6)
         return HUGE_VAL;
-    double q[6];
-    if (jacobian_inverse_near(m, S) < 0)
+    double q[6], perp, ang, dmax = HUGE_VAL;
+    if (pose_curvature(m, S, q) < 0)
         return -1;
-    for (int i = 0; i < 6; i++) {
-        q[i] = 0;
-        for (int j = 0; j < 6; j++)
-            q[i] += m->jc_Jinv[i][j] * S->d2L[j];
-    }
-    double shift, w2 = 0;      /* shift: the along-path part of q, in s units */
-    int base = sg->rotary ? 3 : 0;
-    for (int i = base; i < base + 3; i++)
-        w2 += S->dp[i] * S->dp[i];
-    shift = 0;
-    for (int i = base; i < base + 3; i++)
-        shift += q[i] * S->dp[i];
-    shift = w2 > 0 ? shift / w2 : 0;
-    double perp2 = 0, ang = 0;
-    for (int i = 0; i < 3; i++)
-        perp2 += (q[i] - shift * S->dp[i]) * (q[i] - shift * S->dp[i]);
-    for (int i = 3; i < 6; i++)
-        ang = fmax(ang, fabs(q[i] - shift * S->dp[i]));
-    double dmax = HUGE_VAL;
-    if (perp2 > 1e-30)
-        dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / sqrt(perp2));
+    across_path(sg, S, q, &perp, &ang);
+    if (perp > 1e-15)
+        dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
         dmax = fmin(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
-    double T = c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
-    return dmax / T;
+    return dmax / setpoint_period(c);
+}
+
+/* See motion_priv.h. A set-point chord of length d that touches an arc spans a C1 path whose
+ * curvature is at most k: it cuts the path by at most the sagitta of a circle of radius 1/k,
+ * k d^2 / 8 · f with f = 2 / (1 + sqrt(1 - (k d / 2)^2)) (f -> 1 for short chords). The legs
+ * add their own deviation |q_kin| d^2 / 8, q_kin = q - d2p being the kinematics' part of the
+ * pose curvature (0 on a linear machine). The two add and share KIN_TOL_SHARE of the
+ * tolerance in proportion to their curvatures:
+ *     (k f + |q_kin,perp|) d^2 / 8 <= KIN_TOL_SHARE tol,
+ * and the same for A B C with the arc's A B C curvature kabc (blend arcs) and tol_deg. */
+double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
+                        const struct motion_sample *S, double k_mm, double kabc)
+{
+    const struct motion_config *c = &m->cfg;
+    if (c->kin_tol_mm <= 0)
+        return HUGE_VAL;
+    double qk[6] = {0}, perp = 0, ang = 0, tol = KIN_TOL_SHARE * c->kin_tol_mm;
+    if (m->nj == 6) {
+        if (pose_curvature(m, S, qk) < 0)
+            return -1;
+        for (int i = 0; i < 6; i++)
+            qk[i] -= S->d2p[i];
+        across_path(sg, S, qk, &perp, &ang);
+    }
+    double d = HUGE_VAL;
+    if (k_mm + perp > 1e-15) {
+        double d0 = sqrt(8 * tol / (k_mm + perp)), x = fmin(1.0, k_mm * d0 / 2);
+        double f = 2 / (1 + sqrt(1 - x * x));
+        d = sqrt(8 * tol / (k_mm * f + perp));
+    }
+    if (c->kin_tol_deg > 0 && kabc + ang > 1e-30)
+        d = fmin(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
+    return d / setpoint_period(c);
 }
 
 /* Reports a leg out of range at a sample, naming file, line, leg, amount and pose. */

@@ -361,6 +361,10 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         if (c->type == CANON_PROGRAM_END)
             break;
     }
+    if (motion_chord_zones(m) < 0) {   /* knots where a chord's reach of an arc ends */
+        snprintf(err, errlen, "out of memory planning the program");
+        return MOTION_ERR_NOMEM;
+    }
     double dist = 0;
     for (size_t i = 0; i < p->nseg; i++) {
         p->segs[i].dist0_mm = dist;

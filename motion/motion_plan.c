@@ -23,23 +23,57 @@
  * The result is trapezoidal (triangular on short moves), slowed wherever a cap says so.
  */
 
+/* The largest distance between neighbouring knots of sg (evenly spaced but where a chord's
+ * reach of an arc ends, motion_chord.c). */
+static double knot_spacing(const struct motion_plan *p, const struct motion_seg *sg)
+{
+    double h = 0;
+    for (size_t k = sg->k0; k + 1 < sg->k0 + sg->nk; k++)
+        h = fmax(h, p->ks[k + 1] - p->ks[k]);
+    return h;
+}
+
+/* The chord cap of knot k at s of sg when a set-point chord touching an arc can reach it
+ * (motion_chord.c), else HUGE_VAL; -1 when the pose is singular. */
+static double chord_cap(struct motion *m, const struct motion_seg *sg, double s,
+                        const struct motion_sample *S)
+{
+    double eps = 1e-9 * (1 + sg->len), k = 0, kabc = 0;
+    for (int e = 0; e < 2; e++) {
+        double from_end = e ? sg->len - s : s;
+        if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps)
+            k = fmax(k, sg->chord_k[e]), kabc = fmax(kabc, sg->chord_kabc[e]);
+    }
+    return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc) : HUGE_VAL;
+}
+
 /* Caps of the knots of one segment: hard caps into kt, caps into kv, acceleration into iacc
- * (per knot here, per interval after passes()); each knot's leg gains |dL/ds| into gain.
- * first/last receive the samples at the segment's ends (for the joints between segments). */
+ * (per knot here, per interval after passes()), chord caps near arcs into zcap; each knot's
+ * leg gains |dL/ds| into gain. first/last receive the samples at the segment's ends (for the
+ * joints between segments). */
 static int segment_caps(struct motion *m, const struct motion_seg *sg, double *gain,
-                        struct motion_sample *first, struct motion_sample *last, char *err,
-                        size_t errlen)
+                        double *zcap, struct motion_sample *first, struct motion_sample *last,
+                        char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
-    double hs = sg->len / (double)(sg->nk - 1);
+    double hs = knot_spacing(p, sg);
     for (size_t i = 0; i < sg->nk; i++) {
         size_t k = sg->k0 + i;
         double hard = 0, cap = 0, acc = HUGE_VAL;
+        zcap[k] = HUGE_VAL;
         if (sg->kind <= SEG_ARC) {
             struct motion_sample S;
             int st = motion_knot_caps(m, sg, p->ks[k], hs, &S, &hard, &cap, &acc, err, errlen);
             if (st)
                 return st;
+            zcap[k] = chord_cap(m, sg, p->ks[k], &S);
+            if (zcap[k] < 0) {
+                snprintf(err, errlen, "%s:%d: the move passes through a singular pose of the "
+                         "machine", sg->file ? sg->file : "program", sg->line);
+                return MOTION_ERR_KINS;
+            }
+            if (zcap[k] < cap)
+                p->info.limited_by_kin_tol++;
             for (int l = 0; l < m->nj; l++)
                 gain[k * (size_t)m->nj + l] = fabs(S.dL[l]);
             if (i == 0)
@@ -54,15 +88,33 @@ static int segment_caps(struct motion *m, const struct motion_seg *sg, double *g
     return MOTION_OK;
 }
 
+/* The chord caps of sg's knots (zcap) on its knots and on the intervals between two capped
+ * knots. They come after a knot took its neighbours' caps: an interval from the last capped
+ * knot out of the reach is not capped, so the speed may rise from there on. */
+static void apply_chord_caps(struct motion_plan *p, const struct motion_seg *sg,
+                             const double *zcap)
+{
+    size_t lk = sg->k0 + sg->nk - 1;
+    for (size_t k = sg->k0; k <= lk; k++) {
+        p->kv[k] = fmin(p->kv[k], zcap[k]);
+        p->kt[k] = fmin(p->kt[k], zcap[k]);
+        if (k < lk && zcap[k] < HUGE_VAL && zcap[k + 1] < HUGE_VAL) {
+            double z = fmin(zcap[k], zcap[k + 1]);
+            p->ivp[k] = fmin(p->ivp[k], z);
+            p->irho[k] = fmin(p->irho[k], z);
+        }
+    }
+}
+
 /* Caps at every knot (see segment_caps); interval caps into ivp and irho (hard); a knot's
  * speed suits both neighbouring intervals; joints between segments get their speed. */
-static int all_caps(struct motion *m, double *gain, char *err, size_t errlen)
+static int all_caps(struct motion *m, double *gain, double *zcap, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
     struct motion_sample prev_end, first, last;
     for (size_t j = 0; j < p->nseg; j++) {
         struct motion_seg *sg = &p->segs[j];
-        int st = segment_caps(m, sg, gain, &first, &last, err, errlen);
+        int st = segment_caps(m, sg, gain, zcap, &first, &last, err, errlen);
         if (st)
             return st;
         size_t lk = sg->k0 + sg->nk - 1;
@@ -78,6 +130,7 @@ static int all_caps(struct motion *m, double *gain, char *err, size_t errlen)
                 c = fmin(c, p->ivp[k]), h = fmin(h, p->irho[k]);
             p->kv[k] = c, p->kt[k] = h;
         }
+        apply_chord_caps(p, sg, zcap);
         double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, &prev_end, &first) : 0;
         size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
         p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
@@ -205,11 +258,14 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen)
         return MOTION_OK;
     }
     double *gain = malloc(p->nknot * (size_t)m->nj * sizeof *gain);
-    if (!gain) {
+    double *zcap = malloc(p->nknot * sizeof *zcap);
+    if (!gain || !zcap) {
+        free(gain);
+        free(zcap);
         snprintf(err, errlen, "out of memory planning the program");
         return MOTION_ERR_NOMEM;
     }
-    int st = all_caps(m, gain, err, errlen);
+    int st = all_caps(m, gain, zcap, err, errlen);
     if (!st) {
         passes(m);
         leg_rate_report(m, gain);
@@ -218,5 +274,6 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen)
         p->info.segments = p->nseg;
     }
     free(gain);
+    free(zcap);
     return st;
 }

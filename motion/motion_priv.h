@@ -41,6 +41,10 @@ struct motion_seg {
     size_t k0;               /* first knot */
     size_t nk;               /* knots (>= 2) */
     int arc;                 /* index into arcs for SEG_ARC, else -1 */
+    /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
+     * the path lie within reach of a chord touching an arc whose path curvature is at most
+     * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
+    double chord_mm[2], chord_k[2], chord_kabc[2];
 };
 
 /* The planned program: segments and the velocity profile at knots along them. Interval i
@@ -139,13 +143,17 @@ void motion_plan_free(struct motion_plan *p);
 /* Planning (motion_plan.c). */
 int motion_plan_profile(struct motion *m, char *err, size_t errlen);
 
+/* Share of KINEMATIC_TOLERANCE the first-order (d^2) estimates of a chord's deviation may
+ * use: 10 % is kept in hand for the terms they leave out. */
+#define KIN_TOL_SHARE 0.9
+
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */
 #define JUMP_SHARE 0.5
 
 /* One path sample through the kinematics: pose, its s-derivative, legs and their
  * first and second s-derivatives. */
 struct motion_sample {
-    double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM];
+    double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
     double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
 };
 
@@ -155,6 +163,20 @@ struct motion_sample {
 int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
                      struct motion_sample *S, double *hard, double *cap, double *acc,
                      char *err, size_t errlen);
+/* The speed cap of a knot within reach of a set-point chord touching an arc of path
+ * curvature k_mm (1/mm) and A B C curvature kabc (deg/mm^2): the chord's cut of the path
+ * plus the legs' own deviation stay within KIN_TOL_SHARE of the tolerances. HUGE_VAL when
+ * the bound is off; -1 when the pose is singular. */
+double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
+                        const struct motion_sample *S, double k_mm, double kabc);
+
+/* Chords near arcs (motion_chord.c). Marks the path within reach of a set-point chord that
+ * touches an arc (chord_mm, chord_k, chord_kabc of every segment) and puts a knot where
+ * that reach ends on a segment, so the cap holds exactly there; -1 when out of memory. */
+int motion_chord_zones(struct motion *m);
+/* Path curvature bound of an arc segment, 1/mm, and its largest A B C curvature into kabc. */
+double motion_arc_curvature(const struct motion_plan *p, const struct motion_seg *sg,
+                            double *kabc);
 /* Speed allowed through the joint between segments a and b (0: stop there); A and B are
  * the samples at the end of a and the start of b. */
 double motion_junction_speed(struct motion *m, const struct motion_seg *a,
