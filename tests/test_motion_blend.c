@@ -455,84 +455,12 @@ START_TEST(test_inverse_time)
 }
 END_TEST
 
-/* Distance from q to the blended path (lines and plane-0 arcs of prog). */
-static double dist_blended(const double *q, const struct canon_prog *p)
-{
-    double at[6], best = HUGE_VAL;
-    memcpy(at, p->start, sizeof at);
-    for (size_t i = 0; i < p->count; i++) {
-        const struct canon_cmd *c = &p->cmds[i];
-        if (c->type == CANON_FEED) {
-            best = fmin(best, dist_seg(q, at, c->end));
-        } else if (c->type == CANON_ARC) {
-            const double *n = c->arc.normal, *o = c->arc.center;
-            double v[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
-            double h = v[0] * n[0] + v[1] * n[1] + v[2] * n[2], w[3], e1[3], e2[3];
-            double r = dist3(at, o), sw = 0;
-            for (int k = 0; k < 3; k++)
-                w[k] = v[k] - h * n[k], e1[k] = (at[k] - o[k]) / r;
-            e2[0] = n[1] * e1[2] - n[2] * e1[1], e2[1] = n[2] * e1[0] - n[0] * e1[2];
-            e2[2] = n[0] * e1[1] - n[1] * e1[0];
-            double ang = atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
-                               w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
-            double ee[3] = {c->end[0] - o[0], c->end[1] - o[1], c->end[2] - o[2]};
-            sw = atan2(ee[0] * e2[0] + ee[1] * e2[1] + ee[2] * e2[2],
-                       ee[0] * e1[0] + ee[1] * e1[1] + ee[2] * e1[2]);
-            double rho = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-            if (ang >= 0 && ang <= sw)
-                best = fmin(best, hypot(h, rho - r));
-            best = fmin(best, fmin(dist3(q, at), dist3(q, c->end)));
-        }
-        if (c->type == CANON_FEED || c->type == CANON_ARC)
-            memcpy(at, c->end, sizeof at);
-    }
-    return best;
-}
-
-/* What chord_deviation measured. */
-struct chord_dev { double path_mm, prog_mm, time_s; size_t blends; };
-
-/* Runs p on the fast hexapod (2000 mm/s^2) with set points every T_s and KINEMATIC_TOLERANCE
- * tol_mm: legs interpolated linearly between successive set points at 9 inner points, the
- * tool point through the forward kinematics, its largest distance from the path the planner
- * follows (the blended lines and arcs, or p when nothing is blended) and from the
- * programmed lines of p. */
+/* Measures p's chords on the fast hexapod with set points every T_s (tm_chord_deviation);
+ * fails the test when the run or a forward solve fails. */
 static void chord_deviation(const struct canon_prog *p, double T_s, double tol_mm,
-                            struct chord_dev *d)
+                            struct tm_chord *d)
 {
-    struct tm_machine mc;
-    ck_assert_int_eq(tm_open(&mc, tm_fast_hexapod_cfg(T_s, tol_mm), &kins_hexapod_ops), 0);
-    struct canon_prog out;
-    memset(d, 0, sizeof *d);
-    ck_assert_int_eq(motion_blend_program(&mc.mc, p, &out, &d->blends, NULL), MOTION_OK);
-    load_start(mc.m, p);
-    struct motion_out a, b;
-    motion_step(mc.m, T_s, &a);
-    while (a.state != MOTION_DONE) {
-        motion_step(mc.m, T_s, &b);
-        double guess[6];
-        memcpy(guess, a.pose, sizeof guess);
-        for (int j = 1; j < 10; j++) {
-            double L[KINS_MAX_JOINTS], P[6], prog = HUGE_VAL, at[6];
-            for (int i = 0; i < 6; i++)
-                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
-            memcpy(P, guess, sizeof P);
-            ck_assert_int_eq(kins_forward(mc.kins, L, P, NULL), KINS_OK);
-            memcpy(guess, P, sizeof guess);
-            d->path_mm = fmax(d->path_mm, dist_blended(P, d->blends ? &out : p));
-            memcpy(at, p->start, sizeof at);
-            for (size_t i = 0; i < p->count; i++)
-                if (p->cmds[i].type == CANON_FEED) {
-                    prog = fmin(prog, dist_seg(P, at, p->cmds[i].end));
-                    memcpy(at, p->cmds[i].end, sizeof at);
-                }
-            d->prog_mm = fmax(d->prog_mm, prog);
-        }
-        a = b;
-    }
-    d->time_s = a.time_elapsed_s;
-    canon_prog_free(&out);
-    tm_close(&mc);
+    ck_assert_msg(tm_chord_deviation(p, T_s, tol_mm, d) == 0, "chord measurement failed");
 }
 
 /* A five-axis zigzag on the TMU hexapod under G64 P0.05 */
@@ -584,7 +512,7 @@ START_TEST(test_hexapod_zigzag)
 
     struct canon_prog p;
     polyline_prog(&p, ZIG, 6, 640, TOL, 30000);
-    struct chord_dev d;
+    struct tm_chord d;
     chord_deviation(&p, DT, 0.001, &d);
     ck_assert_int_eq(d.blends, 4);
     ck_assert_msg(d.path_mm <= 0.001, "off the blended path by %.6f mm", d.path_mm);
@@ -606,11 +534,15 @@ START_TEST(test_setpoint_chords)
     for (int k = 0; k < 3; k++) {
         struct canon_prog p;
         polyline_prog(&p, ZIG, 6, 640, TOL, 30000);
-        struct chord_dev d;
+        struct tm_chord d, d61;
         chord_deviation(&p, periods_s[k], 0.001, &d);
         ck_assert_int_eq(d.blends, 4);
+        canon_prog_free(&p);
+        polyline_prog(&p, ZIG, 6, 610, 0, 30000);
+        chord_deviation(&p, periods_s[k], 0.001, &d61);
         printf("hexapod zigzag G64 P0.05 at 500 mm/s, %.0f Hz set points: %.6f mm off the blended "
-               "path, %.3f s\n", 1 / periods_s[k], d.path_mm, d.time_s);
+               "path, %.3f s; G61 %.6f mm, %.3f s\n", 1 / periods_s[k], d.path_mm, d.time_s,
+               d61.path_mm, d61.time_s);
         ck_assert_msg(d.path_mm <= 0.001, "%.0f Hz: off the blended path by %.6f mm",
                       1 / periods_s[k], d.path_mm);
         ck_assert_msg(d.prog_mm <= TOL + 0.001, "off the zigzag by %.6f mm", d.prog_mm);
@@ -641,7 +573,7 @@ START_TEST(test_arc_chords)
     tm_add(&p, CANON_FEED, 10, A, 30000, 0);
     tm_arc(&p, 11, B, C, n, 1, 30000);
     tm_add(&p, CANON_FEED, 12, E, 30000, 0);
-    struct chord_dev d;
+    struct tm_chord d;
     chord_deviation(&p, 0.01, 0.001, &d);
     printf("tilted 0.3 mm arc between tangent lines at 500 mm/s, 100 Hz set points: %.6f mm off "
            "the path, %.3f s\n", d.path_mm, d.time_s);

@@ -10,6 +10,7 @@
 #include "interp/canon.h"
 #include "kins/kins.h"
 #include "motion/motion.h"
+#include "motion/motion_blend.h"
 #include "tests/test_kins_util.h"
 
 /* A machine: configuration table, kinematics and motion. */
@@ -230,6 +231,109 @@ static inline struct tk_cfg *tm_fast_hexapod_cfg(double period_s, double tol_mm)
         tk_set(c, sec, "MAX_ACCELERATION", "20000");
     }
     return c;
+}
+
+/* Distance from p to the segment a-b (X Y Z). */
+static inline double tm_dist_seg(const double *p, const double *a, const double *b)
+{
+    double d[3], w[3], dd = 0, u = 0, e2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], w[i] = p[i] - a[i], dd += d[i] * d[i], u += w[i] * d[i];
+    u = dd > 0 ? fmin(1, fmax(0, u / dd)) : 0;
+    for (int i = 0; i < 3; i++)
+        e2 += (w[i] - u * d[i]) * (w[i] - u * d[i]);
+    return sqrt(e2);
+}
+
+/* Distance from q (X Y Z) to an arc of prog from `at` (any normal, sweep under a half turn
+ * counter-clockwise about the normal, as the blend arcs and the tests' arcs are). */
+static inline double tm_dist_arc(const double *q, const double *at, const struct canon_cmd *c)
+{
+    const double *n = c->arc.normal, *o = c->arc.center;
+    double v[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]}, w[3], e1[3], e2[3], r = 0;
+    double h = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+    for (int k = 0; k < 3; k++)
+        r += (at[k] - o[k]) * (at[k] - o[k]);
+    r = sqrt(r);
+    for (int k = 0; k < 3; k++)
+        w[k] = v[k] - h * n[k], e1[k] = (at[k] - o[k]) / r;
+    e2[0] = n[1] * e1[2] - n[2] * e1[1], e2[1] = n[2] * e1[0] - n[0] * e1[2];
+    e2[2] = n[0] * e1[1] - n[1] * e1[0];
+    double ang = atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
+                       w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+    double ee[3] = {c->end[0] - o[0], c->end[1] - o[1], c->end[2] - o[2]};
+    double sw = atan2(ee[0] * e2[0] + ee[1] * e2[1] + ee[2] * e2[2],
+                      ee[0] * e1[0] + ee[1] * e1[1] + ee[2] * e1[2]);
+    double best = fmin(tm_dist_seg(q, at, at), tm_dist_seg(q, c->end, c->end));
+    if (ang >= 0 && ang <= sw)
+        best = fmin(best, hypot(h, sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) - r));
+    return best;
+}
+
+/* Distance from q (X Y Z) to the path of prog: its lines and arcs. */
+static inline double tm_dist_path(const double *q, const struct canon_prog *p)
+{
+    double at[6], best = HUGE_VAL;
+    memcpy(at, p->start, sizeof at);
+    for (size_t i = 0; i < p->count; i++) {
+        const struct canon_cmd *c = &p->cmds[i];
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE)
+            best = fmin(best, tm_dist_seg(q, at, c->end));
+        else if (c->type == CANON_ARC)
+            best = fmin(best, tm_dist_arc(q, at, c));
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE || c->type == CANON_ARC)
+            memcpy(at, c->end, sizeof at);
+    }
+    return best;
+}
+
+/* What tm_chord_deviation measured: largest distance from the path followed (the blended
+ * program, or p when nothing is blended) and from p's own lines, the run time, the blends. */
+struct tm_chord { double path_mm, prog_mm, time_s; size_t blends; };
+
+/* Runs p on the fast hexapod (2000 mm/s^2, tm_fast_hexapod_cfg) with set points every T_s
+ * and KINEMATIC_TOLERANCE tol_mm: legs interpolated linearly between successive set points
+ * at 9 inner points, the tool point through the forward kinematics, its distances. 0 or -1. */
+static inline int tm_chord_deviation(const struct canon_prog *p, double T_s, double tol_mm,
+                                     struct tm_chord *d)
+{
+    struct tm_machine mc;
+    struct tk_cfg *c = tm_fast_hexapod_cfg(T_s, tol_mm);
+    memset(d, 0, sizeof *d);
+    if (!c || tm_open(&mc, c, &kins_hexapod_ops))
+        return -1;
+    struct canon_prog out, lines;
+    char err[512];
+    int st = motion_blend_program(&mc.mc, p, &out, &d->blends, NULL) ||
+             motion_load(mc.m, p, err, sizeof err) || motion_start(mc.m);
+    canon_prog_init(&lines);
+    memcpy(lines.start, p->start, sizeof lines.start);
+    for (size_t i = 0; i < p->count && !st; i++)
+        if (p->cmds[i].type == CANON_FEED)
+            st = canon_prog_sink(&lines, &p->cmds[i]);
+    struct motion_out a, b;
+    motion_step(mc.m, T_s, &a);
+    for (int n = 0; !st && a.state != MOTION_DONE && n < 10000000; n++) {
+        motion_step(mc.m, T_s, &b);
+        double guess[6];
+        memcpy(guess, a.pose, sizeof guess);
+        for (int j = 1; j < 10 && !st; j++) {
+            double L[KINS_MAX_JOINTS], P[6];
+            for (int i = 0; i < 6; i++)
+                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+            memcpy(P, guess, sizeof P);
+            st = kins_forward(mc.kins, L, P, NULL) != KINS_OK;
+            memcpy(guess, P, sizeof guess);
+            d->path_mm = fmax(d->path_mm, tm_dist_path(P, d->blends ? &out : p));
+            d->prog_mm = fmax(d->prog_mm, tm_dist_path(P, &lines));
+        }
+        a = b;
+    }
+    d->time_s = a.time_elapsed_s;
+    canon_prog_free(&lines);
+    canon_prog_free(&out);
+    tm_close(&mc);
+    return st || a.state != MOTION_DONE ? -1 : 0;
 }
 
 #endif
