@@ -118,6 +118,8 @@ struct motion_plan_info {
     int limited_by_legs;     /* samples where leg limits lowered the speed below the feed */
     int limited_by_kin_tol;  /* samples where the kinematic-error bound lowered it */
     size_t blends;           /* G64 P corners rounded by a tangent arc (motion_blend.h) */
+    size_t stops_held;       /* stops where the path changes direction, held for one set-point
+                              * period so that a set point lands on them (docs/motion.md) */
 };
 int motion_plan_info(const struct motion *m, struct motion_plan_info *out);
 

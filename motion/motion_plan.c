@@ -181,6 +181,58 @@ static void speed_passes(struct motion_plan *p)
     }
 }
 
+/* Whether drives with this set-point period need direction-changing stops held: a stop that
+ * falls between two set points lets the drive's chord across it cut the corner by up to
+ * a T^2 / 8 (a: the path acceleration into and out of the stop). Held unless that fits, for
+ * both position and orientation, in the tenth of the tolerances the bound keeps in hand. */
+static int stops_need_rest(const struct motion_config *c)
+{
+    double T = c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+    if (c->kin_tol_mm <= 0)
+        return 0;                      /* the kinematic-error bound is off */
+    return c->max_lin_acc_mm_s2 * T * T / 8 > (1 - KIN_TOL_SHARE) * c->kin_tol_mm ||
+           (c->kin_tol_deg > 0 &&
+            c->max_ang_acc_deg_s2 * T * T / 8 > (1 - KIN_TOL_SHARE) * c->kin_tol_deg);
+}
+
+/* Unit direction of the pose's motion (mm and deg together) at s of a move. */
+static void pose_direction(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                           double u[KINS_POSE_DIM])
+{
+    double n = 0;
+    motion_seg_tangent(p, sg, s, u);
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        n += u[i] * u[i];
+    n = sqrt(n);
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        u[i] = n > 0 ? u[i] / n : 0;
+}
+
+/* Rest to add where move j stops (s): one set-point period less the dwells already there,
+ * when the next move leaves in another direction, so that the drive has a set point on the
+ * corner whatever its phase; 0 before a pause (the machine waits there), at the program's
+ * end and where the path goes on straight. */
+static double stop_rest_s(const struct motion *m, size_t j)
+{
+    const struct motion_plan *p = &m->plan;
+    const struct motion_config *c = &m->cfg;
+    double T = c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+    double rested = 0, u0[KINS_POSE_DIM], u1[KINS_POSE_DIM], du = 0;
+    size_t k = j + 1;
+    for (; k < p->nseg && p->segs[k].kind > SEG_ARC; k++) {
+        if (p->segs[k].kind == SEG_PAUSE)
+            return 0;
+        rested += p->segs[k].dwell_s;
+    }
+    if (k >= p->nseg || rested >= T || !stops_need_rest(c))
+        return 0;
+    pose_direction(p, &p->segs[j], p->segs[j].len, u0);
+    pose_direction(p, &p->segs[k], 0, u1);
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        du = fmax(du, fabs(u1[i] - u0[i]));
+    return du > 1e-9 ? T - rested : 0;
+}
+
 /* Per interval: cruise speed, duration, override ceiling; then knot times and ceilings. */
 static void passes(struct motion *m)
 {
@@ -208,6 +260,9 @@ static void passes(struct motion *m)
             p->ivp[i] = v0;
             if (sg->kind == SEG_DWELL && i == sg->k0)
                 dt = sg->dwell_s;
+            else if (sg->kind <= SEG_ARC && v0 == 0 && i + 1 == sg->k0 + sg->nk)
+                dt = stop_rest_s(m, j);  /* a stop between moves: held (rest_interval) */
+            p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
         }
         p->irho[i] = fmax(rho, 1.0);
         t += dt;

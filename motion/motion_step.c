@@ -104,6 +104,16 @@ static void follow_knots(struct motion *m)
     }
 }
 
+/* Whether interval ci of segment sg is a rest: a dwell, or the hold of a stop where the path
+ * changes direction (motion_plan.c). A rest lasts its time whatever the override: the hold
+ * must cover one whole set-point period. */
+static int resting(const struct motion_plan *p, size_t ci, const struct motion_seg *sg)
+{
+    if (sg->kind == SEG_DWELL)
+        return ci == sg->k0;
+    return ci + 1 == sg->k0 + sg->nk && p->kt[ci + 1] > p->kt[ci];
+}
+
 /* Advances the plan clock by one period. */
 static void advance(struct motion *m, double dt)
 {
@@ -111,9 +121,9 @@ static void advance(struct motion *m, double dt)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap;
     m->elapsed_s += dt;
-    if (sg->kind == SEG_DWELL && m->ci == sg->k0) {
+    if (resting(p, m->ci, sg)) {
         if (m->state == MOTION_RUNNING)
-            m->tau_s += dt;             /* a dwell lasts its time whatever the override */
+            m->tau_s += dt;             /* a rest lasts its time whatever the override */
         else
             m->rate = 0;
     } else {

@@ -523,15 +523,18 @@ START_TEST(test_hexapod_zigzag)
 }
 END_TEST
 
-/* Set points at 100 Hz, 500 Hz (the CAN drives) and 1 kHz with 2000 mm/s^2: a set-point chord
- * that starts on a blend arc (0.03 mm radius here) and ends on the line accelerating away
- * from it must not cut the arc by more than KINEMATIC_TOLERANCE: the arcs and the line ends
- * within one chord of them are capped by the arc's curvature (without that cap the chord
- * left the blended path by 0.0011 mm at 100 Hz). */
+/* Set points at 100 Hz, 250 Hz (the Modbus drives), 500 Hz (the CAN drives) and 1 kHz with
+ * 2000 mm/s^2: a set-point chord that starts on a blend arc (0.03 mm radius here) and ends on
+ * the line accelerating away from it must not cut the arc by more than KINEMATIC_TOLERANCE:
+ * the arcs and the line ends within one chord of them are capped by the arc's curvature
+ * (without that cap the chord left the blended path by 0.0011 mm at 100 Hz). In G61 every
+ * corner is held for one set-point period, so a set point lands on it and no chord cuts it
+ * (without the hold: 0.004046 mm at 100 Hz); the planned time counts the holds and the run
+ * takes it. */
 START_TEST(test_setpoint_chords)
 {
-    static const double periods_s[3] = {0.01, 0.002, 0.001};
-    for (int k = 0; k < 3; k++) {
+    static const double periods_s[4] = {0.01, 0.004, 0.002, 0.001};
+    for (int k = 0; k < 4; k++) {
         struct canon_prog p;
         polyline_prog(&p, ZIG, 6, 640, TOL, 30000);
         struct tm_chord d, d61;
@@ -541,13 +544,47 @@ START_TEST(test_setpoint_chords)
         polyline_prog(&p, ZIG, 6, 610, 0, 30000);
         chord_deviation(&p, periods_s[k], 0.001, &d61);
         printf("hexapod zigzag G64 P0.05 at 500 mm/s, %.0f Hz set points: %.6f mm off the blended "
-               "path, %.3f s; G61 %.6f mm, %.3f s\n", 1 / periods_s[k], d.path_mm, d.time_s,
-               d61.path_mm, d61.time_s);
+               "path, %.3f s; G61 %.6f mm, %.3f s (%zu corners held)\n", 1 / periods_s[k],
+               d.path_mm, d.time_s, d61.path_mm, d61.time_s, d61.stops_held);
         ck_assert_msg(d.path_mm <= 0.001, "%.0f Hz: off the blended path by %.6f mm",
                       1 / periods_s[k], d.path_mm);
         ck_assert_msg(d.prog_mm <= TOL + 0.001, "off the zigzag by %.6f mm", d.prog_mm);
+        ck_assert_msg(d61.path_mm <= 0.001, "%.0f Hz: G61 off the zigzag by %.6f mm",
+                      1 / periods_s[k], d61.path_mm);
+        ck_assert_int_eq(d61.stops_held, 4);
+        ck_assert_msg(fabs(d61.time_s - d61.plan_s) <= periods_s[k] + 1e-9,
+                      "G61 ran %.4f s, planned %.4f s", d61.time_s, d61.plan_s);
         canon_prog_free(&p);
     }
+}
+END_TEST
+
+/* The hold does not depend on the drive's phase: with a 1 ms servo period and drives taking a
+ * set point every 10 ms, 4 ms or 2 ms, whichever servo period the drive samples first, the
+ * G61 zigzag stays within KINEMATIC_TOLERANCE (without the hold, at 100 Hz: 0.003579 to
+ * 0.008009 mm depending on the phase; at 250 Hz up to 0.001250 mm). */
+START_TEST(test_stop_phases)
+{
+    static const double periods_s[3] = {0.01, 0.004, 0.002};
+    struct canon_prog p;
+    polyline_prog(&p, ZIG, 6, 610, 0, 30000);
+    for (int k = 0; k < 3; k++) {
+        int every = (int)lround(periods_s[k] / DT);
+        double worst = 0;
+        for (int phase = 0; phase < every; phase++) {
+            struct tm_chord d;
+            ck_assert_msg(tm_chord_deviation_at(&p, periods_s[k], DT, phase, 0.001, &d) == 0,
+                          "chord measurement failed");
+            ck_assert_msg(d.path_mm <= 0.001, "%.0f Hz set points, phase %d ms: %.6f mm off",
+                          1 / periods_s[k], phase, d.path_mm);
+            ck_assert_msg(fabs(d.time_s - d.plan_s) <= DT + 1e-9, "ran %.4f s, planned %.4f s",
+                          d.time_s, d.plan_s);
+            worst = fmax(worst, d.path_mm);
+        }
+        printf("G61 zigzag, %.0f Hz set points on a 1 kHz servo, every phase: at most %.6f mm "
+               "off\n", 1 / periods_s[k], worst);
+    }
+    canon_prog_free(&p);
 }
 END_TEST
 
@@ -595,6 +632,7 @@ static Suite *blend_suite(void)
     tcase_add_test(tc, test_inverse_time);
     tcase_add_test(tc, test_hexapod_zigzag);
     tcase_add_test(tc, test_setpoint_chords);
+    tcase_add_test(tc, test_stop_phases);
     tcase_add_test(tc, test_arc_chords);
     suite_add_tcase(s, tc);
     return s;

@@ -288,45 +288,78 @@ static inline double tm_dist_path(const double *q, const struct canon_prog *p)
 }
 
 /* What tm_chord_deviation measured: largest distance from the path followed (the blended
- * program, or p when nothing is blended) and from p's own lines, the run time, the blends. */
-struct tm_chord { double path_mm, prog_mm, time_s; size_t blends; };
+ * program, or p when nothing is blended) and from p's own lines, the run time, the planned
+ * time, the blends and the stops held for a set point (motion_plan_info). */
+struct tm_chord {
+    double path_mm, prog_mm, time_s, plan_s;
+    size_t blends, stops_held;
+};
 
-/* Runs p on the fast hexapod (2000 mm/s^2, tm_fast_hexapod_cfg) with set points every T_s
- * and KINEMATIC_TOLERANCE tol_mm: legs interpolated linearly between successive set points
- * at 9 inner points, the tool point through the forward kinematics, its distances. 0 or -1. */
-static inline int tm_chord_deviation(const struct canon_prog *p, double T_s, double tol_mm,
-                                     struct tm_chord *d)
+/* Largest distance from the path (p, or the blended program when blended) and from lines of
+ * the poses through the forward kinematics of legs interpolated at 9 inner points between
+ * the set points La and Lb (guess: the pose at La); -1 when a forward solve fails. */
+static inline int tm_chord_check(struct kins *k, const double *La, const double *Lb,
+                                 const double *guess0, const struct canon_prog *path,
+                                 const struct canon_prog *lines, struct tm_chord *d)
+{
+    double guess[6];
+    memcpy(guess, guess0, sizeof guess);
+    for (int j = 1; j < 10; j++) {
+        double L[KINS_MAX_JOINTS], P[6];
+        for (int i = 0; i < 6; i++)
+            L[i] = La[i] + (Lb[i] - La[i]) * j / 10.0;
+        memcpy(P, guess, sizeof P);
+        if (kins_forward(k, L, P, NULL) != KINS_OK)
+            return -1;
+        memcpy(guess, P, sizeof guess);
+        d->path_mm = fmax(d->path_mm, tm_dist_path(P, path));
+        d->prog_mm = fmax(d->prog_mm, tm_dist_path(P, lines));
+    }
+    return 0;
+}
+
+/* Runs p on the fast hexapod (2000 mm/s^2, tm_fast_hexapod_cfg) with KINEMATIC_TOLERANCE
+ * tol_mm, a servo period servo_s and drives taking a set point every T_s ([TRAJ]
+ * SETPOINT_PERIOD), at the servo outputs phase, phase + T_s / servo_s, ... (the drive's phase
+ * against the program's start): legs interpolated linearly between successive set points at
+ * 9 inner points, the tool point through the forward kinematics, its distances. 0 or -1. */
+static inline int tm_chord_deviation_at(const struct canon_prog *p, double T_s, double servo_s,
+                                        int phase, double tol_mm, struct tm_chord *d)
 {
     struct tm_machine mc;
-    struct tk_cfg *c = tm_fast_hexapod_cfg(T_s, tol_mm);
+    struct tk_cfg *c = tm_fast_hexapod_cfg(servo_s, tol_mm);
     memset(d, 0, sizeof *d);
-    if (!c || tm_open(&mc, c, &kins_hexapod_ops))
+    if (!c)
+        return -1;
+    tk_setf(c, "TRAJ", "SETPOINT_PERIOD", T_s * 1e9);
+    if (tm_open(&mc, c, &kins_hexapod_ops))
         return -1;
     struct canon_prog out, lines;
+    struct motion_plan_info info;
     char err[512];
+    int every = (int)lround(T_s / servo_s);
     int st = motion_blend_program(&mc.mc, p, &out, &d->blends, NULL) ||
              motion_load(mc.m, p, err, sizeof err) || motion_start(mc.m);
+    motion_plan_info(mc.m, &info);
+    d->plan_s = info.time_s;
+    d->stops_held = info.stops_held;
     canon_prog_init(&lines);
     memcpy(lines.start, p->start, sizeof lines.start);
     for (size_t i = 0; i < p->count && !st; i++)
         if (p->cmds[i].type == CANON_FEED)
             st = canon_prog_sink(&lines, &p->cmds[i]);
     struct motion_out a, b;
-    motion_step(mc.m, T_s, &a);
+    motion_step(mc.m, servo_s, &a);    /* the first set point: output phase */
+    for (int n = 0; n < phase; n++)
+        motion_step(mc.m, servo_s, &a);
     for (int n = 0; !st && a.state != MOTION_DONE && n < 10000000; n++) {
-        motion_step(mc.m, T_s, &b);
-        double guess[6];
-        memcpy(guess, a.pose, sizeof guess);
-        for (int j = 1; j < 10 && !st; j++) {
-            double L[KINS_MAX_JOINTS], P[6];
-            for (int i = 0; i < 6; i++)
-                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
-            memcpy(P, guess, sizeof P);
-            st = kins_forward(mc.kins, L, P, NULL) != KINS_OK;
-            memcpy(guess, P, sizeof guess);
-            d->path_mm = fmax(d->path_mm, tm_dist_path(P, d->blends ? &out : p));
-            d->prog_mm = fmax(d->prog_mm, tm_dist_path(P, &lines));
+        for (int k = 0; k < every; k++) {
+            motion_step(mc.m, servo_s, &b);
+            if (b.state == MOTION_DONE)
+                break;
         }
+        st = tm_chord_check(mc.kins, a.joint_pos, b.joint_pos, a.pose,
+                            d->blends ? &out : p, &lines, d);
         a = b;
     }
     d->time_s = a.time_elapsed_s;
@@ -334,6 +367,13 @@ static inline int tm_chord_deviation(const struct canon_prog *p, double T_s, dou
     canon_prog_free(&out);
     tm_close(&mc);
     return st || a.state != MOTION_DONE ? -1 : 0;
+}
+
+/* tm_chord_deviation_at with the servo period equal to the set-point period T_s. */
+static inline int tm_chord_deviation(const struct canon_prog *p, double T_s, double tol_mm,
+                                     struct tm_chord *d)
+{
+    return tm_chord_deviation_at(p, T_s, T_s, 0, tol_mm, d);
 }
 
 #endif
