@@ -261,7 +261,7 @@ static void passes(struct motion *m)
             if (sg->kind == SEG_DWELL && i == sg->k0)
                 dt = sg->dwell_s;
             else if (sg->kind <= SEG_ARC && v0 == 0 && i + 1 == sg->k0 + sg->nk)
-                dt = stop_rest_s(m, j);  /* a stop between moves: held (rest_interval) */
+                dt = stop_rest_s(m, j);  /* a stop between moves: held (motion_step.c) */
             p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
         }
         p->irho[i] = fmax(rho, 1.0);
