@@ -42,12 +42,26 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
     return st;
 }
 
+/* Leg rates (mm/s) = J · pose velocity of legs already evaluated at the pose. */
+static void hexapod_rates_of(const struct hexapod_rot *o, const struct hexapod_legs *lg,
+                             const double pose_vel[KINS_POSE_DIM], double *rates)
+{
+    double row[KINS_POSE_DIM];
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        hexapod_jac_row(o, lg, i, HEXAPOD_RAD_PER_DEG, row);
+        double r = 0.0;
+        for (int j = 0; j < KINS_POSE_DIM; j++)
+            r += row[j] * pose_vel[j];
+        rates[i] = r;
+    }
+}
+
 /* Leg rates (mm/s) = J · pose velocity, the angle rates turned into an angular velocity. */
 static int hexapod_leg_rates(struct kins *k, const double pose[KINS_POSE_DIM],
                              const double pose_vel[KINS_POSE_DIM], double *rates)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3], row[KINS_POSE_DIM];
+    double t[3];
     struct hexapod_rot o;
     struct hexapod_legs lg;
     if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
@@ -56,13 +70,34 @@ static int hexapod_leg_rates(struct kins *k, const double pose[KINS_POSE_DIM],
         if (!isfinite(pose_vel[j]))
             return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
+    hexapod_rates_of(&o, &lg, pose_vel, rates);
+    return KINS_OK;
+}
+
+/* Inverse and leg rates from one evaluation of the legs (the servo thread's every period). */
+static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM],
+                                 const double pose_vel[KINS_POSE_DIM], double *joints,
+                                 double *rates)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    int st = KINS_OK;
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        hexapod_jac_row(&o, &lg, i, HEXAPOD_RAD_PER_DEG, row);
-        double r = 0.0;
-        for (int j = 0; j < KINS_POSE_DIM; j++)
-            r += row[j] * pose_vel[j];
-        rates[i] = r;
+        joints[i] = lg.len_mm[i];
+        if (lg.len_mm[i] < k->joint_min[i] || lg.len_mm[i] > k->joint_max[i])
+            st = KINS_ERR_UNREACHABLE;
     }
+    if (st != KINS_OK)
+        return st;
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        if (!isfinite(pose_vel[j]))
+            return KINS_ERR_ARG;
+    hexapod_rates_of(&o, &lg, pose_vel, rates);
     return KINS_OK;
 }
 
@@ -180,4 +215,5 @@ const struct kins_ops kins_hexapod_ops = {
     .leg_rates = hexapod_leg_rates,
     .check = hexapod_check,
     .tool_point = hexapod_tool_point,
+    .inverse_rates = hexapod_inverse_rates,
 };

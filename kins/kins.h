@@ -75,6 +75,11 @@ struct kins_ops {
      * frame, mm; either output may be NULL. NULL when the model has no tool (trivial). */
     int (*tool_point)(struct kins *k, const double pose[KINS_POSE_DIM], double tip_base_mm[3],
                       double tip_platform_mm[3]);
+    /* Optional: inverse and leg rates from one evaluation of the pose (the servo thread
+     * needs both every period). Statuses as inverse; rates are written only on KINS_OK.
+     * NULL: kins_inverse_rates() calls inverse, then leg_rates. */
+    int (*inverse_rates)(struct kins *k, const double pose[KINS_POSE_DIM],
+                         const double pose_vel[KINS_POSE_DIM], double *joints, double *rates);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -120,6 +125,16 @@ static inline int kins_leg_rates(struct kins *k, const double *pose, const doubl
 { return k->ops->leg_rates(k, pose, vel, rates); }
 static inline int kins_check_pose(struct kins *k, const double *pose, struct kins_check *out)
 { return k->ops->check(k, pose, out); }
+/* Leg lengths and leg rates of a pose and its velocity, in one evaluation where the model
+ * offers it. */
+static inline int kins_inverse_rates(struct kins *k, const double *pose, const double *vel,
+                                     double *joints, double *rates)
+{
+    if (k->ops->inverse_rates)
+        return k->ops->inverse_rates(k, pose, vel, joints, rates);
+    int st = k->ops->inverse(k, pose, joints);
+    return st == KINS_OK ? k->ops->leg_rates(k, pose, vel, rates) : st;
+}
 static inline int kins_tool_point(struct kins *k, const double *pose, double *tip_base_mm,
                                   double *tip_platform_mm)
 { return k->ops->tool_point ? k->ops->tool_point(k, pose, tip_base_mm, tip_platform_mm)

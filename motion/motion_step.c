@@ -169,10 +169,12 @@ static int evaluate(struct motion *m)
     m->line = sg->line;
     m->file = sg->file;
     m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
-    int st = kins_inverse(m->kins, m->pose, m->joint_cmd);
-    if (st == KINS_OK && v != 0)
-        st = kins_leg_rates(m->kins, m->pose, m->pose_vel, m->joint_vel);
-    else
+    if (v == 0) {
+        memset(m->joint_vel, 0, sizeof m->joint_vel);
+        return kins_inverse(m->kins, m->pose, m->joint_cmd);
+    }
+    int st = kins_inverse_rates(m->kins, m->pose, m->pose_vel, m->joint_cmd, m->joint_vel);
+    if (st != KINS_OK)
         memset(m->joint_vel, 0, sizeof m->joint_vel);
     return st;
 }

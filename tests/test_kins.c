@@ -149,6 +149,34 @@ START_TEST(test_leg_rates)
 }
 END_TEST
 
+/* The servo thread's combined call gives exactly what inverse and leg rates give apart (the
+ * hexapod evaluates the pose once; the trivial model's fallback runs in the motion tests);
+ * out of range it reports unreachable with the lengths written, like inverse. */
+START_TEST(test_inverse_rates)
+{
+    struct kins *k = make_tmu();
+    ck_assert_ptr_nonnull(k->ops->inverse_rates);
+    uint64_t rng = 4242;
+    for (int n = 0; n < 500; n++) {
+        double pose[6], vel[6], L[6], R[6], L2[6], R2[6];
+        tk_rand_pose(&rng, pose);
+        for (int j = 0; j < 6; j++)
+            vel[j] = tk_rand(&rng, -1, 1) * (j < 3 ? 50.0 : 5.0);
+        ck_assert_int_eq(kins_inverse_rates(k, pose, vel, L, R), KINS_OK);
+        ck_assert_int_eq(kins_inverse(k, pose, L2), KINS_OK);
+        ck_assert_int_eq(kins_leg_rates(k, pose, vel, R2), KINS_OK);
+        for (int i = 0; i < 6; i++) {
+            ck_assert_double_eq(L[i], L2[i]);
+            ck_assert_double_eq(R[i], R2[i]);
+        }
+    }
+    double far[6] = { 0, 0, 2000, 0, 0, 0 }, vel[6] = { 1, 0, 0, 0, 0, 0 }, L[6], R[6];
+    ck_assert_int_eq(kins_inverse_rates(k, far, vel, L, R), KINS_ERR_UNREACHABLE);
+    ck_assert(L[0] > k->joint_max[0]);
+    kins_free(k);
+}
+END_TEST
+
 /* All platform joints in one point: rotations move no leg, the Jacobian has rank 3. */
 START_TEST(test_singular_geometry)
 {
@@ -442,6 +470,7 @@ static Suite *kins_suite(void)
     tcase_add_test(tc, test_home_by_hand);
     tcase_add_test(tc, test_round_trip);
     tcase_add_test(tc, test_leg_rates);
+    tcase_add_test(tc, test_inverse_rates);
     tcase_add_test(tc, test_singular_geometry);
     tcase_add_test(tc, test_singular_pose);
     tcase_add_test(tc, test_failures);
