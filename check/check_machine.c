@@ -1,11 +1,11 @@
 /* check_machine.c: the machine of an INI file (kinematics, motion, interpreter settings) without HAL threads. */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "check/check_priv.h"
+#include "common/errbuf.h"
 #include "common/inifile.h"
 #include "hal/hal.h"
 #include "interp/interp.h"
@@ -28,21 +28,6 @@ const char *check_strerror(int status)
     return status_text[status];
 }
 
-/* Formats into err and returns status (one-line error paths). */
-static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-/* Formats into err and returns status (one-line error paths). */
-static int fail(char *err, size_t errlen, int status, const char *fmt, ...)
-{
-    if (err && errlen) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
-
 /* The kins_config lookup over the INI held by the HAL runtime (only its reader is used). */
 static const char *ini_get(void *ctx, const char *section, const char *key)
 {
@@ -55,11 +40,11 @@ static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, 
     const char *v = hal_ini_get(mc->hal, "KINS", "TOOL_AXIS");
     double a[3] = { 0, 0, -1 };
     if (v && sscanf(v, " %lf%*[ ,]%lf%*[ ,]%lf", &a[0], &a[1], &a[2]) != 3)
-        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS = %s: expected three "
+        return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS = %s: expected three "
                     "numbers x y z", ini, v);
     double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     if (!(n > 0))
-        return fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS has no direction", ini);
+        return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS has no direction", ini);
     for (int i = 0; i < 3; i++)
         mc->tool_axis[i] = a[i] / n;
     return CHECK_OK;
@@ -75,16 +60,16 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
     int st = interp_settings_read(&mc->interp, ini_get, mc->hal, hal_ini_dir(mc->hal), msg,
                                   sizeof msg);
     if (st != INTERP_OK)
-        return fail(err, errlen, CHECK_ERR_CONFIG, "%s",
+        return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s",
                     inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
     struct interp *probe = interp_create();
     if (!probe)
-        return fail(err, errlen, CHECK_ERR_NOMEM, "out of memory");
+        return errbuf_set(err, errlen, CHECK_ERR_NOMEM, "out of memory");
     st = interp_settings_apply(probe, &mc->interp, mc->tt, INTERP_SETUP_PARAMS_READ_ONLY, msg,
                                sizeof msg);
     interp_destroy(probe);
     if (st != INTERP_OK)
-        return fail(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
+        return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
@@ -93,7 +78,7 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
                 HAL_ERR_SYNTAX ||
             hal_ini_double(mc->hal, sec, "STEPGEN_MAXACCEL", 0, &mc->drive_acc[i]) ==
                 HAL_ERR_SYNTAX)
-            return fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+            return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
     }
     return CHECK_OK;
 }
@@ -105,40 +90,40 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
     struct check_machine *mc = calloc(1, sizeof *mc);
     int st = CHECK_ERR_NOMEM;
     if (!mc || !(mc->hal = hal_create()) || !(mc->tt = malloc(sizeof *mc->tt))) {
-        fail(err, errlen, st, "out of memory");
+        errbuf_set(err, errlen, st, "out of memory");
         goto fail;
     }
     tooltable_init(mc->tt);
     snprintf(mc->ini, sizeof mc->ini, "%s", ini);
     if (hal_load_ini(mc->hal, ini) != HAL_OK) {
-        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+        st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
         goto fail;
     }
     struct kins_config kc = { ini_get, mc->hal };
     const char *name = hal_ini_get(mc->hal, "KINS", "KINEMATICS");
     char msg[768];
     if (!name) {
-        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] KINEMATICS is missing: which "
+        st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] KINEMATICS is missing: which "
                   "kinematics does the machine have?", ini);
         goto fail;
     }
     char where[1024];   /* "[SECTION] KEY: ..." messages get the key's INI line */
     if (kins_load(name, &kc, &mc->kins, msg, sizeof msg) != KINS_OK) {
-        st = fail(err, errlen, CHECK_ERR_KINS, "%s",
+        st = errbuf_set(err, errlen, CHECK_ERR_KINS, "%s",
                   inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
         goto fail;
     }
     motion_config_default(&mc->mcfg);
     if (motion_config_read(&mc->mcfg, &kc, mc->kins->njoints, msg, sizeof msg) != MOTION_OK ||
         motion_create(&mc->mcfg, mc->kins, &mc->motion, msg, sizeof msg) != MOTION_OK) {
-        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s",
+        st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s",
                   inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
         goto fail;
     }
     mc->cond_limit = 100;
     if (hal_ini_double(mc->hal, "KINS", "SINGULAR_CONDITION", 100, &mc->cond_limit) ==
         HAL_ERR_SYNTAX) {
-        st = fail(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
+        st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
         goto fail;
     }
     if ((st = read_interp_settings(mc, ini, err, errlen)) ||

@@ -1,26 +1,12 @@
 /* interp_setup.c: reads [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE and applies them. */
 #include "interp/interp_setup.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "common/errbuf.h"
 #include "interp/interp.h"
 #include "interp/tooltable.h"
-
-/* Formats err (when given) and returns status: every error path is one line. */
-static int setup_fail(char *err, size_t errlen, int status, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static int setup_fail(char *err, size_t errlen, int status, const char *fmt, ...)
-{
-    if (err && errlen) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 /* A path from [section]key made relative to the INI's folder unless absolute; "" when the
  * key is absent or empty. */
@@ -33,7 +19,7 @@ static int setup_path(const char *section, const char *key, const char *value, c
     int n = value[0] == '/' || !dir || !dir[0] ? snprintf(out, len, "%s", value)
                                                : snprintf(out, len, "%s/%s", dir, value);
     if (n < 0 || (size_t)n >= len)
-        return setup_fail(err, errlen, INTERP_ERR_CONFIG, "[%s] %s = %s: the path is longer "
+        return errbuf_set(err, errlen, INTERP_ERR_CONFIG, "[%s] %s = %s: the path is longer "
                           "than %zu characters", section, key, value, len - 1);
     return INTERP_OK;
 }
@@ -46,7 +32,7 @@ int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, voi
     s->feed_factor = 1.0;
     const char *units = get(ctx, "RS274NGC", "FEED_UNITS");
     if (units && units[0] && interp_feed_units_parse(units, &s->feed_factor) != 0)
-        return setup_fail(err, errlen, INTERP_ERR_CONFIG, "[RS274NGC] FEED_UNITS = %s: use "
+        return errbuf_set(err, errlen, INTERP_ERR_CONFIG, "[RS274NGC] FEED_UNITS = %s: use "
                           "mm/min or m/min", units);
     const char *table_section = "RS274NGC";
     const char *table = get(ctx, "RS274NGC", "TOOL_TABLE");
@@ -70,7 +56,7 @@ int interp_settings_apply(struct interp *in, const struct interp_settings *s,
     if (tt && s->tool_table[0]) {
         char msg[600];
         if (tooltable_load(tt, s->tool_table, msg, sizeof msg) != TOOLTABLE_OK)
-            return setup_fail(err, errlen, INTERP_ERR_TOOL, "%s", msg);
+            return errbuf_set(err, errlen, INTERP_ERR_TOOL, "%s", msg);
         interp_set_tooltable(in, tt);
     }
     if (s->param_file[0]) {
@@ -79,7 +65,7 @@ int interp_settings_apply(struct interp *in, const struct interp_settings *s,
                      : interp_set_param_file(in, s->param_file);
         if (st != INTERP_OK) {
             char msg[600];
-            return setup_fail(err, errlen, st, "%s",
+            return errbuf_set(err, errlen, st, "%s",
                               interp_error_format(interp_last_error(in), msg, sizeof msg));
         }
     }

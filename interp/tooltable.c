@@ -1,14 +1,14 @@
 /* tooltable.c: LinuxCNC-format tool table: parse, look up, wear, G10 L1 (file I/O: tooltable_file.c). */
 #include "interp/tooltable.h"
-#include "interp/tooltable_int.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "common/errbuf.h"
 
 static const char *const tooltable_msgs[TOOLTABLE_STATUS_COUNT] = {
     [TOOLTABLE_OK] = "ok",
@@ -26,18 +26,6 @@ const char *tooltable_strerror(int status)
     if (status < 0 || status >= TOOLTABLE_STATUS_COUNT)
         return "unknown tool table status";
     return tooltable_msgs[status];
-}
-
-/* Formats an error message into err (when the caller gave one) and returns status. */
-int tooltable_fail(char *err, size_t errlen, int status, const char *fmt, ...)
-{
-    if (err && errlen) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return status;
 }
 
 /* An empty table. */
@@ -223,41 +211,41 @@ static int tooltable_parse_line(const char *s, struct tooltable_line *l, int *is
         }
         char letter = (char)toupper((unsigned char)*s);
         if (!isalpha((unsigned char)*s) || !strchr("TPXYZABCUVWDIJQ", letter))
-            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                                   "%s:%d: unknown field '%c' (a tool table knows T P X Y Z A "
                                   "B C U V W D I J Q)", name, l->lineno, *s);
         s++;
         double v;
         if (tooltable_number(&s, letter == 'T' || letter == 'P' || letter == 'Q', &v))
-            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                                   "%s:%d: field %c needs a %snumber", name, l->lineno,
                                   letter, strchr("TPQ", letter) ? "whole " : "");
         if (*s && !strchr(" \t\r\n;", *s))
-            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                                   "%s:%d: field %c is followed by '%c' (put a space between "
                                   "fields)", name, l->lineno, letter, *s);
         if (tooltable_store(&l->e, &seen, letter, v))
-            return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                                   "%s:%d: field %c appears twice", name, l->lineno, letter);
     }
     if (!seen)
         return TOOLTABLE_OK;
     if (!(seen & 1u))
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                               "%s:%d: the line has no tool number (T)", name, l->lineno);
     if (l->e.tool <= 0 || l->e.tool == TOOLTABLE_WEAR_BASE)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                               "%s:%d: tool number T%d is not allowed (use 1..%d, or %d+n for "
                               "the wear of tool n)", name, l->lineno, l->e.tool,
                               TOOLTABLE_WEAR_BASE - 1, TOOLTABLE_WEAR_BASE);
     if (!(seen & 2u))
         l->e.pocket = l->e.tool;
     if (l->e.tool > TOOLTABLE_WEAR_BASE && (seen & ~(1u | 2u | (1u << 11))))
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_SYNTAX,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
                               "%s:%d: wear entry T%d may only carry P and D (diameter wear)",
                               name, l->lineno, l->e.tool);
     if (l->e.tool < TOOLTABLE_WEAR_BASE && l->e.diameter_mm < 0.0)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_VALUE,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_VALUE,
                               "%s:%d: tool T%d has a negative diameter D%g", name,
                               l->lineno, l->e.tool, l->e.diameter_mm);
     *is_tool = 1;
@@ -278,11 +266,11 @@ static int tooltable_apply_wear(struct tooltable *t, const struct tooltable_wear
     int tool = l->tool;
     int i = tooltable_index(t, tool);
     if (i < 0)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_NO_TOOL,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_NO_TOOL,
                               "%s:%d: wear entry T%d is for tool T%d, which is not in the "
                               "table", name, l->lineno, tool + TOOLTABLE_WEAR_BASE, tool);
     if (wear_line[i])
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_DUPLICATE,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_DUPLICATE,
                               "%s:%d: a second wear entry for tool T%d (the first is on line "
                               "%d)", name, l->lineno, tool, wear_line[i]);
     t->tools[i].wear_mm = l->wear_mm;
@@ -296,11 +284,11 @@ static int tooltable_add_line(struct tooltable *t, const struct tooltable_line *
 {
     int i = tooltable_index(t, l->e.tool);
     if (i >= 0)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_DUPLICATE,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_DUPLICATE,
                               "%s:%d: tool T%d appears twice (first on line %d)", name,
                               l->lineno, l->e.tool, line_of[i]);
     if (t->count >= TOOLTABLE_MAX)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_FULL,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_FULL,
                               "%s:%d: more than %d tools", name, l->lineno, TOOLTABLE_MAX);
     line_of[t->count] = l->lineno;
     t->tools[t->count++] = l->e;
@@ -324,7 +312,7 @@ int tooltable_parse(struct tooltable *t, const char *text, const char *name, cha
         rc = tooltable_parse_line(s, &l, &is_tool, name, err, errlen);
         if (rc == TOOLTABLE_OK && is_tool && l.e.tool > TOOLTABLE_WEAR_BASE) {
             if (nwear >= TOOLTABLE_MAX)
-                rc = tooltable_fail(err, errlen, TOOLTABLE_ERR_FULL,
+                rc = errbuf_set(err, errlen, TOOLTABLE_ERR_FULL,
                                     "%s:%d: more than %d wear entries", name, l.lineno,
                                     TOOLTABLE_MAX);
             else

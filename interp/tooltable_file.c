@@ -7,8 +7,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/errbuf.h"
 #include "interp/tooltable.h"
-#include "interp/tooltable_int.h"
 
 #define TOOLTABLE_MAX_FILE_BYTES (4L << 20) /* a table file larger than 4 MiB is refused */
 
@@ -23,18 +23,18 @@ static char *tooltable_slurp(const char *path, char *err, size_t errlen, int *rc
     long n;
     *rc = TOOLTABLE_ERR_IO;
     if (!f) {
-        tooltable_fail(err, errlen, *rc, "%s: cannot open the tool table: %s", path,
+        errbuf_set(err, errlen, *rc, "%s: cannot open the tool table: %s", path,
                        strerror(errno));
         return NULL;
     }
     if (fseek(f, 0, SEEK_END) || (n = ftell(f)) < 0 || n > TOOLTABLE_MAX_FILE_BYTES ||
         fseek(f, 0, SEEK_SET)) {
-        tooltable_fail(err, errlen, *rc, "%s: cannot read the tool table (too large?)", path);
+        errbuf_set(err, errlen, *rc, "%s: cannot read the tool table (too large?)", path);
         goto out;
     }
     buf = malloc((size_t)n + 1);
     if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        tooltable_fail(err, errlen, *rc, "%s: cannot read the tool table", path);
+        errbuf_set(err, errlen, *rc, "%s: cannot read the tool table", path);
         free(buf);
         buf = NULL;
         goto out;
@@ -128,10 +128,10 @@ int tooltable_save(const struct tooltable *t, const char *path, char *err, size_
 {
     char tmp[1100];
     if (tooltable_temp_name(path, tmp, sizeof tmp))
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO, "%s: path too long", path);
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_IO, "%s: path too long", path);
     int fd = mkstemp(tmp);
     if (fd < 0)
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_IO,
                               "%s: cannot create a temporary file next to it: %s", path,
                               strerror(errno));
     (void)fchmod(fd, 0644);
@@ -139,7 +139,7 @@ int tooltable_save(const struct tooltable *t, const char *path, char *err, size_
     if (!f) {
         close(fd);
         unlink(tmp);
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO, "%s: %s", tmp, strerror(errno));
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
     int bad = 0;
     for (int i = 0; i < t->count && !bad; i++)
@@ -149,7 +149,7 @@ int tooltable_save(const struct tooltable *t, const char *path, char *err, size_
     if (bad || rename(tmp, path) != 0) {
         int e = errno;
         unlink(tmp);
-        return tooltable_fail(err, errlen, TOOLTABLE_ERR_IO,
+        return errbuf_set(err, errlen, TOOLTABLE_ERR_IO,
                               "%s: cannot write the tool table: %s", path, strerror(e));
     }
     tooltable_sync_dir(path);

@@ -1,11 +1,11 @@
 /* runner.c: sets a machine up from its INI and HAL files, and interprets and plans a program. */
 #include "task/runner_priv.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/errbuf.h"
 #include "common/inifile.h"
 #include "interp/interp.h"
 #include "interp/interp_setup.h"
@@ -34,18 +34,6 @@ const char *runner_strerror(int status)
     return runner_msgs[status];
 }
 
-/* Formats err (when given) and returns status: every error path is one line. */
-int runner_fail(char *err, size_t errlen, int status, const char *fmt, ...)
-{
-    if (err && errlen) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
-
 /* A path from the INI, made relative to the INI's folder unless absolute. */
 static void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len)
 {
@@ -63,9 +51,9 @@ static int runner_read_timing(struct runner *r, const struct runner_opts *opts, 
     long sim = 0, period = 1000000;
     if (hal_ini_int(r->hal, "EMCMOT", "SIM_CLOCK", 0, &sim) == HAL_ERR_SYNTAX ||
         hal_ini_int(r->hal, "EMCMOT", "SERVO_PERIOD", 1000000, &period) == HAL_ERR_SYNTAX)
-        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
+        return errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
     if (period <= 0)
-        return runner_fail(err, errlen, RUNNER_ERR_CONFIG,
+        return errbuf_set(err, errlen, RUNNER_ERR_CONFIG,
                            "%s: [EMCMOT] SERVO_PERIOD must be a positive number of ns",
                            opts->ini_path);
     r->period_ns = period;
@@ -82,7 +70,7 @@ static int runner_task_pins(struct runner *r, char *err, size_t errlen)
     if (hal_pin_bit_newf(h, HAL_OUT, &r->user_enable_out, "task.user-enable-out") ||
         hal_pin_bit_newf(h, HAL_OUT, &r->user_request_enable, "task.user-request-enable") ||
         hal_pin_bit_newf(h, HAL_IN, &r->emc_enable_in, "task.emc-enable-in"))
-        return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(h));
+        return errbuf_set(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(h));
     return RUNNER_OK;
 }
 
@@ -92,7 +80,7 @@ static int runner_load_halfiles(struct runner *r, const char *ini_path, char *er
                                 size_t errlen)
 {
     if (!hal_ini_get_n(r->hal, "HAL", "HALFILE", 0))
-        return runner_fail(err, errlen, RUNNER_ERR_CONFIG,
+        return errbuf_set(err, errlen, RUNNER_ERR_CONFIG,
                            "%s: no [HAL] HALFILE: the machine has no HAL wiring", ini_path);
     static const char *const sections[] = { "HAL", "TASK" };
     for (int sec = 0; sec < 2; sec++) {
@@ -101,7 +89,7 @@ static int runner_load_halfiles(struct runner *r, const char *ini_path, char *er
             char path[1024];
             runner_ini_path(r, name, path, sizeof path);
             if (hal_source(r->hal, path) != HAL_OK)
-                return runner_fail(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(r->hal));
+                return errbuf_set(err, errlen, RUNNER_ERR_HAL, "%s", hal_last_error(r->hal));
         }
     }
     return RUNNER_OK;
@@ -113,7 +101,7 @@ static int runner_bind(struct runner *r, const char *ini_path, char *err, size_t
     r->kins = hal_get_object(r->hal, "kins");
     r->motion = motion_hal_get(r->hal);
     if (!r->kins || !r->motion)
-        return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s: the HAL files load no %s "
+        return errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s: the HAL files load no %s "
                            "(they need `loadrt [KINS]KINEMATICS` and `loadrt motion`)",
                            ini_path, r->kins ? "motion" : "kinematics");
     r->njoints = r->kins->njoints;
@@ -123,11 +111,11 @@ static int runner_bind(struct runner *r, const char *ini_path, char *err, size_t
         snprintf(name, sizeof name, "motion.joint-pos-cmd-%d", i);
         r->cmd_pin[i] = hal_data_ptr(r->hal, name, &t);
         if (!r->cmd_pin[i] || t != HAL_FLOAT)
-            return runner_fail(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
+            return errbuf_set(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
         snprintf(name, sizeof name, "motion.joint-pos-fb-%d", i);
         r->fb_pin[i] = hal_data_ptr(r->hal, name, &t);
         if (!r->fb_pin[i] || t != HAL_FLOAT)
-            return runner_fail(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
+            return errbuf_set(err, errlen, RUNNER_ERR_HAL, "no float pin %s", name);
     }
     const char *open = hal_ini_get(r->hal, "DISPLAY", "OPEN_FILE");
     if (open && open[0])
@@ -143,11 +131,11 @@ int runner_create(const struct runner_opts *opts, struct runner **out, char *err
     struct runner *r = calloc(1, sizeof *r);
     if (!r || !(r->hal = hal_create())) {
         free(r);
-        return runner_fail(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
+        return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
     int st;
     if (hal_load_ini(r->hal, opts->ini_path) != HAL_OK) {
-        st = runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
+        st = errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
         goto fail;
     }
     if ((st = runner_read_timing(r, opts, err, errlen)) ||
@@ -202,7 +190,7 @@ static int runner_setup_interp(struct runner *r, struct interp *in, struct toolt
     if (st == INTERP_OK)
         return RUNNER_OK;
     char where[1536];
-    return runner_fail(err, errlen, RUNNER_ERR_CONFIG, "%s", st == INTERP_ERR_CONFIG
+    return errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", st == INTERP_ERR_CONFIG
                        ? inifile_locate_msg(hal_ini_file(r->hal), msg, where, sizeof where)
                        : msg);
 }
@@ -216,7 +204,7 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     struct tooltable *tt = malloc(sizeof *tt);
     int st = RUNNER_ERR_NOMEM;
     if (!in || !tt) {
-        runner_fail(err, errlen, st, "out of memory");
+        errbuf_set(err, errlen, st, "out of memory");
         goto out;
     }
     tooltable_init(tt);
@@ -228,7 +216,7 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
         goto out;
     if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {
         char msg[600];
-        st = runner_fail(err, errlen, RUNNER_ERR_PROGRAM, "%s",
+        st = errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s",
                          interp_error_format(interp_last_error(in), msg, sizeof msg));
         goto out;
     }
@@ -244,7 +232,7 @@ out:
 int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen)
 {
     if (runner_moving(r))
-        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
     struct canon_prog prog;
     canon_prog_init(&prog);
     r->loaded = false;
@@ -252,9 +240,9 @@ int runner_load_program(struct runner *r, const char *path, char *err, size_t er
     if (st == RUNNER_OK) {
         char msg[512];
         if (motion_hal_load(r->hal, &prog, msg, sizeof msg) != MOTION_OK)
-            st = runner_fail(err, errlen, RUNNER_ERR_PLAN, "%s", msg);
+            st = errbuf_set(err, errlen, RUNNER_ERR_PLAN, "%s", msg);
         else if (motion_plan_info(r->motion, &r->plan) != MOTION_OK)
-            st = runner_fail(err, errlen, RUNNER_ERR_PLAN, "%s", motion_hal_fault(r->hal));
+            st = errbuf_set(err, errlen, RUNNER_ERR_PLAN, "%s", motion_hal_fault(r->hal));
     }
     canon_prog_free(&prog);
     r->loaded = st == RUNNER_OK;

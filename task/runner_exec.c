@@ -1,11 +1,12 @@
 /* runner_exec.c: runs a planned program: start, the per-period monitor, stop, summary. */
-#include "hal/components/lcm_status.h"
 #include "task/runner_priv.h"
 
 #include <math.h>
 #include <string.h>
 #include <time.h>
 
+#include "common/errbuf.h"
+#include "hal/components/lcm_status.h"
 #include "motion/motion_hal.h"
 
 /* Slice of machine time between checks of the stop flag and progress calls. */
@@ -80,7 +81,7 @@ int runner_monitor_install(struct runner *r, char *err, size_t errlen)
     snprintf(r->thread, sizeof r->thread, "servo-thread");
     if (hal_export_functf(r->hal, runner_monitor, r, "runner.monitor") != HAL_OK ||
         hal_addf(r->hal, "runner.monitor", r->thread, 0) != HAL_OK)
-        return runner_fail(err, errlen, RUNNER_ERR_HAL, "the run monitor cannot join the "
+        return errbuf_set(err, errlen, RUNNER_ERR_HAL, "the run monitor cannot join the "
                            "servo thread: %s", hal_last_error(r->hal));
     return RUNNER_OK;
 }
@@ -109,9 +110,9 @@ static void runner_reset_summary(struct runner *r)
 int runner_start(struct runner *r, char *err, size_t errlen)
 {
     if (!r->loaded)
-        return runner_fail(err, errlen, RUNNER_ERR_STATE, "no program is loaded");
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "no program is loaded");
     if (runner_moving(r))
-        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
     runner_reset_summary(r);
     r->aborting = false;
     /* Machine on: out of e-stop (reset pulse to the latch), then enabled. */
@@ -119,12 +120,12 @@ int runner_start(struct runner *r, char *err, size_t errlen)
     if (!*r->emc_enable_in)
         *r->user_request_enable = true;
     if (motion_hal_start(r->hal) != MOTION_OK)
-        return runner_fail(err, errlen, RUNNER_ERR_STATE, "%s", motion_hal_fault(r->hal));
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "%s", motion_hal_fault(r->hal));
     atomic_store(&r->mon_state, (int)MOTION_RUNNING);
     r->started = true;
     if (!hal_running(r->hal) && hal_start(r->hal) != HAL_OK) {
         r->started = false;
-        return runner_fail(err, errlen, RUNNER_ERR_RT, "%s", hal_last_error(r->hal));
+        return errbuf_set(err, errlen, RUNNER_ERR_RT, "%s", hal_last_error(r->hal));
     }
     lcm_status_post_event(r->hal, LCM_SEV_INFO, RUNNER_EVENT_STARTED, "task", 0,
                           "program started: %.3f s and %.3f mm planned", r->plan.time_s,
@@ -224,12 +225,12 @@ static int runner_outcome(struct runner *r, char *err, size_t errlen)
     enum motion_state s = (enum motion_state)atomic_load(&r->mon_state);
     double t_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
     if (s == MOTION_FAULT && r->first_fault[0])
-        return runner_fail(err, errlen, RUNNER_ERR_FAULT, "%s (cause: %s)",
+        return errbuf_set(err, errlen, RUNNER_ERR_FAULT, "%s (cause: %s)",
                            motion_hal_fault(r->hal), r->first_fault);
     if (s == MOTION_FAULT)
-        return runner_fail(err, errlen, RUNNER_ERR_FAULT, "%s", motion_hal_fault(r->hal));
+        return errbuf_set(err, errlen, RUNNER_ERR_FAULT, "%s", motion_hal_fault(r->hal));
     if (r->aborting)
-        return runner_fail(err, errlen, RUNNER_ERR_ABORTED, "stopped by the operator at line "
+        return errbuf_set(err, errlen, RUNNER_ERR_ABORTED, "stopped by the operator at line "
                            "%d after %.3f s: the machine came to rest on the path",
                            atomic_load(&r->mon_line), t_s);
     return RUNNER_OK;
@@ -246,7 +247,7 @@ static int runner_check_started(struct runner *r, char *err, size_t errlen)
         atomic_load(&r->mon_periods) < RUNNER_START_PERIODS ||
         (enum motion_state)atomic_load(&r->mon_state) != MOTION_IDLE)
         return RUNNER_OK;
-    return runner_fail(err, errlen, RUNNER_ERR_STATE, "the machine did not come out of "
+    return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine did not come out of "
                        "e-stop: motion.enable stayed false (task.emc-enable-in %s); the HAL "
                        "files must wire task.user-enable-out and task.user-request-enable "
                        "into the e-stop chain ([TASK] HALFILE)",
@@ -258,7 +259,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
                void *ctx, char *err, size_t errlen)
 {
     if (!r->started)
-        return runner_fail(err, errlen, RUNNER_ERR_STATE, "the program is not started");
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the program is not started");
     double slice_s = r->sim_clock ? RUNNER_SLICE_PERIODS * (double)r->period_ns * 1e-9
                                   : RUNNER_RT_SLICE_S;
     /* A program that overruns its plan by this much is stuck: stop rather than hang. */
@@ -269,7 +270,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
         if (stop && *stop && !r->aborting)
             runner_abort(r);
         if ((st = runner_advance(r, slice_s)) != RUNNER_OK) {
-            runner_fail(err, errlen, st, "%s", hal_last_error(r->hal));
+            errbuf_set(err, errlen, st, "%s", hal_last_error(r->hal));
             break;
         }
         runner_drain_messages(r);
@@ -279,7 +280,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
         if ((st = runner_check_started(r, err, errlen)) != RUNNER_OK)
             break;
         if (p.elapsed_s > limit_s) {
-            st = runner_fail(err, errlen, RUNNER_ERR_TIMEOUT, "the machine was still moving "
+            st = errbuf_set(err, errlen, RUNNER_ERR_TIMEOUT, "the machine was still moving "
                              "after %.1f s, twice the planned %.1f s", p.elapsed_s,
                              r->plan.time_s);
             break;

@@ -63,8 +63,5 @@ int runner_monitor_install(struct runner *r, char *err, size_t errlen);
 /* Whether the motion core is under way (running, pausing, paused, stopping). */
 bool runner_moving(const struct runner *r);
 
-/* printf into err (when given) and return status. */
-int runner_fail(char *err, size_t errlen, int status, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
 
 #endif
