@@ -23,6 +23,20 @@ static int hexapod_pose_frame(const double pose[KINS_POSE_DIM], double t_mm[3],
     return KINS_OK;
 }
 
+/* Copies evaluated leg lengths out; KINS_ERR_UNREACHABLE when any is outside its limits
+ * (all are written, so callers can say by how much). */
+static int hexapod_lengths_of(const struct kins *k, const struct hexapod_legs *lg,
+                              double *joints)
+{
+    int st = KINS_OK;
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        joints[i] = lg->len_mm[i];
+        if (lg->len_mm[i] < k->joint_min[i] || lg->len_mm[i] > k->joint_max[i])
+            st = KINS_ERR_UNREACHABLE;
+    }
+    return st;
+}
+
 /* Inverse kinematics: leg i length = |t + R·p_i - b_i|. */
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
 {
@@ -33,13 +47,7 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
     if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
-    int st = KINS_OK;
-    for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        joints[i] = lg.len_mm[i];
-        if (lg.len_mm[i] < k->joint_min[i] || lg.len_mm[i] > k->joint_max[i])
-            st = KINS_ERR_UNREACHABLE;
-    }
-    return st;
+    return hexapod_lengths_of(k, &lg, joints);
 }
 
 /* Leg rates (mm/s) = J · pose velocity of legs already evaluated at the pose. */
@@ -86,12 +94,7 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
     if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
-    int st = KINS_OK;
-    for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        joints[i] = lg.len_mm[i];
-        if (lg.len_mm[i] < k->joint_min[i] || lg.len_mm[i] > k->joint_max[i])
-            st = KINS_ERR_UNREACHABLE;
-    }
+    int st = hexapod_lengths_of(k, &lg, joints);
     if (st != KINS_OK)
         return st;
     for (int j = 0; j < KINS_POSE_DIM; j++)
