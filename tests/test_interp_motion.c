@@ -10,26 +10,10 @@
 
 #define TOL 1e-9
 
-/* Runs a program that must succeed. */
-static void ok(const char *text, struct canon_prog *p)
-{
-    struct interp_error e;
-    int rc = run_text(text, p, &e);
-    ck_assert_msg(rc == INTERP_OK, "failed: %s:%d:%d: %s", e.file, e.line, e.column, e.message);
-}
-
-static int status_of(const char *text)
-{
-    struct canon_prog p;
-    int rc = run_text(text, &p, NULL);
-    canon_prog_free(&p);
-    return rc;
-}
-
 START_TEST(straight_moves_and_feed)
 {
     struct canon_prog p;
-    ok("G0 X1 Y2 Z3 A4 B5 C6\nG1 X-1 F250\nG91 G1 Y1 C-6\nM2\n", &p);
+    interp_ok("G0 X1 Y2 Z3 A4 B5 C6\nG1 X-1 F250\nG91 G1 Y1 C-6\nM2\n", &p);
     ck_assert_pose(nth(&p, CANON_TRAVERSE, 0)->end, 1, 2, 3, 4, 5, 6, TOL);
     const struct canon_cmd *f = nth(&p, CANON_FEED, 0);
     ck_assert_pose(f->end, -1, 2, 3, 4, 5, 6, TOL);
@@ -38,14 +22,14 @@ START_TEST(straight_moves_and_feed)
     ck_assert_pose(nth(&p, CANON_FEED, 1)->end, -1, 3, 3, 4, 5, 0, TOL);
     ck_assert_int_eq(nth(&p, CANON_PROGRAM_END, 0)->ivalue, 2);
     canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G1 X1\nM2\n"), INTERP_ERR_WORD); /* no feed */
+    ck_assert_int_eq(interp_status_of("G1 X1\nM2\n"), INTERP_ERR_WORD); /* no feed */
 }
 END_TEST
 
 START_TEST(units_and_feed_factor)
 {
     struct canon_prog p;
-    ok("G20 G1 X1 Y-0.5 A10 F10\nG21 G1 X1\nM2\n", &p);
+    interp_ok("G20 G1 X1 Y-0.5 A10 F10\nG21 G1 X1\nM2\n", &p);
     ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 25.4, -12.7, 0, 10, 0, 0, TOL);
     ck_assert_double_eq_tol(nth(&p, CANON_FEED, 0)->feed_mm_min, 254.0, TOL);
     ck_assert_pose(nth(&p, CANON_FEED, 1)->end, 1, -12.7, 0, 10, 0, 0, TOL);
@@ -61,19 +45,19 @@ START_TEST(units_and_feed_factor)
     canon_prog_free(&p);
     interp_destroy(in);
     /* G93: every feed move carries its own time */
-    ok("G93 G1 X10 F2\nG1 X20 F4\nM2\n", &p);
+    interp_ok("G93 G1 X10 F2\nG1 X20 F4\nM2\n", &p);
     ck_assert_double_eq(nth(&p, CANON_FEED, 0)->inverse_time_min, 0.5);
     ck_assert_double_eq(nth(&p, CANON_FEED, 1)->inverse_time_min, 0.25);
     ck_assert_double_eq(nth(&p, CANON_FEED_MODE, 0)->value, 1);
     canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G93 G1 X10 F2\nG1 X20\nM2\n"), INTERP_ERR_WORD);
+    ck_assert_int_eq(interp_status_of("G93 G1 X10 F2\nG1 X20\nM2\n"), INTERP_ERR_WORD);
 }
 END_TEST
 
 START_TEST(arc_centre_form_planes)
 {
     struct canon_prog p;
-    ok("G1 X10 F100\nG2 X20 Y10 I10 J0\nG3 X20 Y10 I-5 J0 Z-2\n"
+    interp_ok("G1 X10 F100\nG2 X20 Y10 I10 J0\nG3 X20 Y10 I-5 J0 Z-2\n"
        "G18 G2 X30 Z-2 I5 K0\nG19 G3 Y20 Z-2 J5 K0\nM2\n", &p);
     const struct canon_cmd *a = nth(&p, CANON_ARC, 0);
     ck_assert_pose(a->end, 20, 10, 0, 0, 0, 0, TOL);
@@ -103,7 +87,7 @@ START_TEST(arc_radius_form_and_turns)
 {
     struct canon_prog p;
     /* from (0,0) to (10,0), R5: the centre is the midpoint; R-8 vs R8 choose opposite sides */
-    ok("G1 X0 Y0 F100\nG2 X10 Y0 R5\nG2 X0 Y0 R8\nG2 X10 Y0 R-8\nG3 I-5 P3 Z-3\nM2\n", &p);
+    interp_ok("G1 X0 Y0 F100\nG2 X10 Y0 R5\nG2 X0 Y0 R8\nG2 X10 Y0 R-8\nG3 I-5 P3 Z-3\nM2\n", &p);
     ck_assert_double_eq_tol(nth(&p, CANON_ARC, 0)->arc.center[0], 5, TOL);
     ck_assert_double_eq_tol(nth(&p, CANON_ARC, 0)->arc.center[1], 0, 1e-6);
     double yc_short = nth(&p, CANON_ARC, 1)->arc.center[1];
@@ -117,9 +101,9 @@ START_TEST(arc_radius_form_and_turns)
     ck_assert_int_eq(h->arc.rotation, 3);
     ck_assert_double_eq(h->end[2], -3);
     canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G1 F1\nG2 X20 R5\nM2\n"), INTERP_ERR_ARC);  /* too small */
-    ck_assert_int_eq(status_of("G1 F1\nG2 X0 Y0 R5\nM2\n"), INTERP_ERR_ARC); /* full circle */
-    ck_assert_int_eq(status_of("G1 F1\nG2 X10 I5 P0\nM2\n"), INTERP_ERR_WORD);
+    ck_assert_int_eq(interp_status_of("G1 F1\nG2 X20 R5\nM2\n"), INTERP_ERR_ARC);  /* too small */
+    ck_assert_int_eq(interp_status_of("G1 F1\nG2 X0 Y0 R5\nM2\n"), INTERP_ERR_ARC); /* full circle */
+    ck_assert_int_eq(interp_status_of("G1 F1\nG2 X10 I5 P0\nM2\n"), INTERP_ERR_WORD);
 }
 END_TEST
 
@@ -127,21 +111,21 @@ END_TEST
  * absolute one; more is an error. Each case was checked against rs274 -g. */
 START_TEST(arc_radius_mismatch)
 {
-    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.01 J0\nM2\n"), INTERP_OK);   /* 0.02 */
-    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-5.02 J0\nM2\n"), INTERP_ERR_ARC); /* 0.04 */
+    ck_assert_int_eq(interp_status_of("G1 X10 F1\nG2 X0 I-5.01 J0\nM2\n"), INTERP_OK);   /* 0.02 */
+    ck_assert_int_eq(interp_status_of("G1 X10 F1\nG2 X0 I-5.02 J0\nM2\n"), INTERP_ERR_ARC); /* 0.04 */
     /* large radius: under 0.1 %, so only the 100 x 0.0283 = 2.83 mm bound applies */
-    ck_assert_int_eq(status_of("G1 X20000 F1\nG2 X0 I-10001.01 J0\nM2\n"), INTERP_OK);
-    ck_assert_int_eq(status_of("G1 X20000 F1\nG2 X0 I-10001.5 J0\nM2\n"), INTERP_ERR_ARC);
-    ck_assert_int_eq(status_of("G20 G1 X1 F1\nG2 X0 I-0.5011 J0\nM2\n"), INTERP_OK);
-    ck_assert_int_eq(status_of("G20 G1 X1 F1\nG2 X0 I-0.502 J0\nM2\n"), INTERP_ERR_ARC);
-    ck_assert_int_eq(status_of("G1 X10 F1\nG2 X0 I-10 J0\nM2\n"), INTERP_ERR_ARC); /* r2 = 0 */
+    ck_assert_int_eq(interp_status_of("G1 X20000 F1\nG2 X0 I-10001.01 J0\nM2\n"), INTERP_OK);
+    ck_assert_int_eq(interp_status_of("G1 X20000 F1\nG2 X0 I-10001.5 J0\nM2\n"), INTERP_ERR_ARC);
+    ck_assert_int_eq(interp_status_of("G20 G1 X1 F1\nG2 X0 I-0.5011 J0\nM2\n"), INTERP_OK);
+    ck_assert_int_eq(interp_status_of("G20 G1 X1 F1\nG2 X0 I-0.502 J0\nM2\n"), INTERP_ERR_ARC);
+    ck_assert_int_eq(interp_status_of("G1 X10 F1\nG2 X0 I-10 J0\nM2\n"), INTERP_ERR_ARC); /* r2 = 0 */
 }
 END_TEST
 
 START_TEST(offsets_work_and_g92)
 {
     struct canon_prog p;
-    ok("G10 L2 P1 X100 Y50\nG10 L2 P6 Z-20 B3\nG0 X1 Y1\nG59 G0 Z1 B1\n"
+    interp_ok("G10 L2 P1 X100 Y50\nG10 L2 P6 Z-20 B3\nG0 X1 Y1\nG59 G0 Z1 B1\n"
        "G54 G92 X0 Y0\nG0 X1 Y1\nG92.2\nG0 X1 Y1\nG92.3\nG0 X2\nG92.1\nG0 X2\n"
        "G53 G0 X0\nM2\n", &p);
     ck_assert_pose(nth(&p, CANON_TRAVERSE, 0)->end, 101, 51, 0, 0, 0, 0, TOL);
@@ -155,15 +139,15 @@ START_TEST(offsets_work_and_g92)
     const struct canon_cmd *o = nth(&p, CANON_OFFSETS, 0);
     ck_assert_double_eq(o->offset[0], 100);
     canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G91 G53 G0 X1\nM2\n"), INTERP_ERR_MODAL);
-    ck_assert_int_eq(status_of("G53 G2 X1 I1\nM2\n"), INTERP_ERR_MODAL);
+    ck_assert_int_eq(interp_status_of("G91 G53 G0 X1\nM2\n"), INTERP_ERR_MODAL);
+    ck_assert_int_eq(interp_status_of("G53 G2 X1 I1\nM2\n"), INTERP_ERR_MODAL);
 }
 END_TEST
 
 START_TEST(offsets_g10_l20_and_homes)
 {
     struct canon_prog p;
-    ok("G0 X10 Y20 Z30\nG10 L20 P1 X0 Y0\nG0 X1 Y1\nG28.1\nG0 X50 Y50 Z50\nG28 Z40\n"
+    interp_ok("G0 X10 Y20 Z30\nG10 L20 P1 X0 Y0\nG0 X1 Y1\nG28.1\nG0 X50 Y50 Z50\nG28 Z40\n"
        "G28\nG30.1\nG0 X0\nG30\nM2\n", &p);
     ck_assert_pose(nth(&p, CANON_TRAVERSE, 1)->end, 11, 21, 30, 0, 0, 0, TOL);
     /* G28 Z40: through program Z40, then only Z to the stored home (machine 30) */
@@ -198,7 +182,7 @@ START_TEST(tool_length)
     ck_assert_double_eq(tooltable_find(tt, 5)->diameter_mm, 6);
     ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 0)->end[2], 7);
     canon_prog_free(&p);
-    ck_assert_int_eq(status_of("G10 L1 P5 R3\nM2\n"), INTERP_ERR_TOOL); /* no table */
+    ck_assert_int_eq(interp_status_of("G10 L1 P5 R3\nM2\n"), INTERP_ERR_TOOL); /* no table */
     ck_assert_int_eq(run_on(in, "G43 H4\nM2\n", &p), INTERP_ERR_TOOL);
     canon_prog_free(&p);
     ck_assert_int_eq(run_on(in, "T9 M6\nM2\n", &p), INTERP_ERR_TOOL);
@@ -211,7 +195,7 @@ END_TEST
 START_TEST(machine_words)
 {
     struct canon_prog p;
-    ok("S1200 M3\nM4\nM5\nM7\nM8\nM9\nG4 P1.5\nM1\nM0\nG64 P0.05\nG61\nM30\n", &p);
+    interp_ok("S1200 M3\nM4\nM5\nM7\nM8\nM9\nG4 P1.5\nM1\nM0\nG64 P0.05\nG61\nM30\n", &p);
     ck_assert_double_eq(nth(&p, CANON_SPINDLE_SPEED, 0)->value, 1200);
     ck_assert_double_eq(nth(&p, CANON_SPINDLE_ON, 0)->value, 1);
     ck_assert_double_eq(nth(&p, CANON_SPINDLE_ON, 1)->value, -1);

@@ -8,14 +8,6 @@
 
 #define TOL 1e-9
 
-/* Runs a program that must succeed. */
-static void ok(const char *text, struct canon_prog *p)
-{
-    struct interp_error e;
-    int rc = run_text(text, p, &e);
-    ck_assert_msg(rc == INTERP_OK, "failed: %s:%d:%d: %s", e.file, e.line, e.column, e.message);
-}
-
 /* Runs a program on in that must succeed, and frees its commands. */
 static void ok_on(struct interp *in, const char *text)
 {
@@ -40,18 +32,18 @@ static struct interp_error fail_of(const char *text)
 START_TEST(set_and_use)
 {
     struct canon_prog p;
-    ok("#<Safe Z>=10\n#<_G>=[2*3]\nG0 Z#<safez> X[#<_g> + #<SAFE z>]\nM2\n", &p);
+    interp_ok("#<Safe Z>=10\n#<_G>=[2*3]\nG0 Z#<safez> X[#<_g> + #<SAFE z>]\nM2\n", &p);
     ck_assert_pose(nth(&p, CANON_TRAVERSE, 0)->end, 16, 0, 10, 0, 0, 0, TOL);
     canon_prog_free(&p);
     /* settings land after the line; a new name reads 0 until then, as in LinuxCNC */
-    ok("#<a>=1\n#<a>=2 G0 X#<a>\nG0 Y#<a>\n#<b>=3 G0 Z[#<b>+1]\nG0 A#<b>\nM2\n", &p);
+    interp_ok("#<a>=1\n#<a>=2 G0 X#<a>\nG0 Y#<a>\n#<b>=3 G0 Z[#<b>+1]\nG0 A#<b>\nM2\n", &p);
     ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 0)->end[0], 1, TOL);
     ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 1)->end[1], 2, TOL);
     ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 2)->end[2], 1, TOL);
     ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 3)->end[3], 3, TOL);
     canon_prog_free(&p);
     /* ##<p> reads the numbered parameter whose number #<p> holds */
-    ok("#2=7 #<p>=2\nG0 X##<p>\nM2\n", &p);
+    interp_ok("#2=7 #<p>=2\nG0 X##<p>\nM2\n", &p);
     ck_assert_double_eq_tol(nth(&p, CANON_TRAVERSE, 0)->end[0], 7, TOL);
     canon_prog_free(&p);
 }

@@ -60,6 +60,23 @@ static inline const struct canon_cmd *last_move(const struct canon_prog *p)
     return &none;
 }
 
+/* Runs a program that must succeed; the failure message is the interpreter's error. */
+static inline void interp_ok(const char *text, struct canon_prog *p)
+{
+    struct interp_error e;
+    int rc = run_text(text, p, &e);
+    ck_assert_msg(rc == INTERP_OK, "failed: %s:%d:%d: %s", e.file, e.line, e.column, e.message);
+}
+
+/* The status a program ends with (its commands are freed). */
+static inline int interp_status_of(const char *text)
+{
+    struct canon_prog p;
+    int rc = run_text(text, &p, NULL);
+    canon_prog_free(&p);
+    return rc;
+}
+
 #define ck_assert_pose(pose, x, y, z, a, b, c, tol) do {                              \
         const double *p_ = (pose);                                                    \
         const double e_[6] = {x, y, z, a, b, c};                                      \
