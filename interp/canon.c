@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "interp/tooltable.h"
+
 static const char *const canon_names[CANON_TYPE_COUNT] = {
     [CANON_TRAVERSE] = "TRAVERSE",       [CANON_FEED] = "FEED",
     [CANON_ARC] = "ARC",                 [CANON_DWELL] = "DWELL",
@@ -13,6 +15,7 @@ static const char *const canon_names[CANON_TYPE_COUNT] = {
     [CANON_TOOL_CHANGE] = "TOOL_CHANGE", [CANON_COOLANT] = "COOLANT",
     [CANON_COMMENT] = "COMMENT",         [CANON_PAUSE] = "PAUSE",
     [CANON_PROGRAM_END] = "PROGRAM_END", [CANON_OFFSETS] = "OFFSETS",
+    [CANON_SETTING] = "SETTING",
 };
 
 const char *canon_type_name(enum canon_type t)
@@ -25,11 +28,37 @@ void canon_prog_init(struct canon_prog *p)
     memset(p, 0, sizeof *p);
 }
 
+/* A copy of a SETTING payload in one allocation (freed with free()), or NULL. */
+static struct canon_setting *canon_setting_dup(const struct canon_setting *s)
+{
+    size_t tool = s->tool ? sizeof *s->tool : 0;
+    size_t params = s->nparams * sizeof *s->params;
+    struct canon_setting *d = malloc(sizeof *d + tool + params);
+    if (!d)
+        return NULL;
+    unsigned char *after = (unsigned char *)(d + 1);
+    d->tool = NULL;
+    d->nparams = s->nparams;
+    d->params = NULL;
+    if (tool) {
+        memcpy(after, s->tool, tool);
+        d->tool = (const struct tool_entry *)after;
+    }
+    if (params) {
+        memcpy(after + tool, s->params, params);
+        d->params = (const struct canon_param *)(after + tool);
+    }
+    return d;
+}
+
 void canon_prog_free(struct canon_prog *p)
 {
-    for (size_t i = 0; i < p->count; i++)
+    for (size_t i = 0; i < p->count; i++) {
         if (p->cmds[i].type == CANON_COMMENT)
             free((char *)p->cmds[i].text);
+        if (p->cmds[i].type == CANON_SETTING)
+            free((struct canon_setting *)p->cmds[i].setting);
+    }
     free(p->cmds);
     canon_prog_init(p);
 }
@@ -53,6 +82,12 @@ int canon_prog_sink(void *ctx, const struct canon_cmd *cmd)
             return -1;
     } else {
         c->text = NULL;
+    }
+    c->setting = NULL;
+    if (cmd->type == CANON_SETTING && cmd->setting) {
+        c->setting = canon_setting_dup(cmd->setting);
+        if (!c->setting)
+            return -1;
     }
     p->count++;
     return 0;

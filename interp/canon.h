@@ -29,6 +29,11 @@ enum canon_type {
     CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */
     CANON_PROGRAM_END,     /* M2 / M30 (ivalue 2 or 30) */
     CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]) */
+    CANON_SETTING,         /* a setting the machine keeps (setting): a tool-table entry (G10
+                            * L1) and/or persistent parameters #5161..#5390 (G10 L2/L20,
+                            * G28.1/G30.1, G92, G54..G59.3, #n=) changed by this line. It
+                            * takes effect, and is saved, when execution reaches it: motion
+                            * passes it in order as a point of zero length */
     CANON_TYPE_COUNT
 };
 
@@ -45,6 +50,21 @@ struct canon_arc {
     int plane;             /* 17, 18, 19, or 0 */
 };
 
+/* One persistent parameter as a line left it. */
+struct canon_param {
+    int number;            /* 5161..5390 */
+    double value;          /* mm and deg for lengths and angles, as in the parameter file */
+};
+
+struct tool_entry;
+
+/* The payload of CANON_SETTING: what the machine saves when it executes the line. */
+struct canon_setting {
+    const struct tool_entry *tool; /* the tool's whole entry after G10 L1, or NULL */
+    size_t nparams;                /* persistent parameters the line changed */
+    const struct canon_param *params;
+};
+
 struct canon_cmd {
     enum canon_type type;
     int line;              /* source line number (1-based) in `file` */
@@ -58,6 +78,7 @@ struct canon_cmd {
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */
+    const struct canon_setting *setting; /* SETTING only (owned by the interpreter) */
     int has_n;             /* the source block had an N word (for printers) */
     int n_number;          /* its value */
 };
@@ -76,8 +97,9 @@ struct canon_prog {
 };
 void canon_prog_init(struct canon_prog *p);
 void canon_prog_free(struct canon_prog *p);
-/* A canon_sink_fn that appends to a struct canon_prog (ctx); it copies COMMENT text, so the
- * program owns everything it holds. Returns -1 on allocation failure. */
+/* A canon_sink_fn that appends to a struct canon_prog (ctx); it copies COMMENT text and
+ * SETTING payloads, so the program owns everything it holds. Returns -1 on allocation
+ * failure. */
 int canon_prog_sink(void *ctx, const struct canon_cmd *cmd);
 const char *canon_type_name(enum canon_type t);
 

@@ -299,6 +299,7 @@ static int exec_stop(struct interp *in)
     CHP(emit_simple(in, CANON_COOLANT, 0, 9));
     in->flood = in->mist = 0;
     in->ended = 1;
+    CHP(interp_emit_param_changes(in)); /* the program end is the last thing motion passes */
     return emit_simple(in, CANON_PROGRAM_END, 0, m);
 }
 
@@ -352,5 +353,10 @@ int interp_execute(struct interp *in)
         CHP(exec_comp5(in, g0));
     else
         CHP(exec_motion(in));
-    return exec_stop(in);
+    CHP(exec_stop(in));
+    /* Only these blocks can change a persistent parameter: #n=, G10/G28.1/G30.1/G92.x
+     * (group 0), G54..G59.3 (group 12), M2/M30 (back to G54, reported above). */
+    if (!in->ended && (b->nassign || g0 >= 0 || b->g[12] >= 0))
+        CHP(interp_emit_param_changes(in));
+    return 0;
 }

@@ -197,6 +197,7 @@ static int percent_line(struct interp *in, int first)
 {
     if (first) {
         in->pct_open = 1;
+        in->pct_line = in->line;
         return 0;
     }
     if (!in->pct_open)
@@ -229,14 +230,15 @@ static int run_lines(struct interp *in, const char *text, size_t len)
             first = 0;
         p = nl ? nl + 1 : end;
     }
-    if (!in->ended && !in->pct_open)
+    /* A program opened by % and not closed is a truncated file, as rs274 says ("File ended
+     * with no percent sign"): refused, so that no motion starts on it. */
+    if (!in->ended && in->pct_open)
+        return interp_fail(in, INTERP_ERR_SYNTAX, 0, "the program opened with '%%' on line %d "
+                           "ends without its closing '%%' line (a truncated file?)",
+                           in->pct_line);
+    if (!in->ended)
         return interp_fail(in, INTERP_ERR_SYNTAX, 0, "the program ends without M2, M30 or a "
                            "closing %% line");
-    if (!in->ended) { /* opened with % and never closed: LinuxCNC accepts it */
-        int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
-        if (rc)
-            return interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_strerror(rc));
-    }
     return 0;
 }
 
@@ -252,9 +254,8 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     in->sink_ctx = ctx;
     comp5_init(&in->comp);
     interp_named_clear_locals(in); /* #<name> belongs to one program, #<_name> stays */
-    int rc = run_lines(in, text, len);
-    int save = interp_params_save(in);
-    return rc ? rc : save;
+    interp_settings_begin(in);     /* settings are reported, never saved, from here */
+    return run_lines(in, text, len);
 }
 
 /* Reads the whole file into memory, then runs it as text. */

@@ -47,12 +47,13 @@ void interp_destroy(struct interp *in);
 
 /* Configuration (before a run). The initial pose is in machine coordinates (mm, deg). */
 void interp_set_start(struct interp *in, const double pose[6]);
-/* Parameter file (LinuxCNC's format, "number value" per line). Loads it now if it exists;
- * the persistent parameters (5161..5390) are written back, atomically, when a run ends.
- * NULL: no file. Returns INTERP_OK or an error (details in interp_last_error). */
+/* Parameter file (LinuxCNC's format, "number value" per line). Loads it now if it exists and
+ * remembers it as the file interp_setting_apply() saves the persistent parameters
+ * (5161..5390) to. Interpreting a program never writes it. NULL: no file. Returns INTERP_OK
+ * or an error (details in interp_last_error). */
 int interp_set_param_file(struct interp *in, const char *path);
-/* Loads a parameter file as interp_set_param_file() does but never writes it back, so that
- * an offline check leaves the machine's offsets as they are. */
+/* Loads a parameter file as interp_set_param_file() does but remembers no file to save to,
+ * so that even interp_setting_apply() leaves the machine's offsets as they are. */
 int interp_load_param_file(struct interp *in, const char *path);
 /* Tool table for T/M6, G43 H and the D word of G141/G142; not owned. NULL: no table. */
 void interp_set_tooltable(struct interp *in, struct tooltable *tt);
@@ -63,6 +64,23 @@ void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit);
 void interp_set_block_delete(struct interp *in, int on);
 /* Parses an [RS274NGC] FEED_UNITS value ("mm/min" or "m/min"); -1 if unknown, else 0. */
 int interp_feed_units_parse(const char *name, double *factor);
+
+/*
+ * Settings that G-code writes (G10 L1 tool entries; G10 L2/L20, G28.1/G30.1, G92, G54..G59.3
+ * and #n= on the persistent parameters 5161..5390) change the interpreter's state at once, so
+ * later lines see them, but no file is written while interpreting: each line that changes
+ * them sends a CANON_SETTING command, and whoever executes the program hands it to
+ * interp_setting_apply() of an interpreter set up with the machine's files when execution
+ * reaches it (the runner does; `hexcnc interp` and `hexcnc check` never do).
+ */
+/* Applies setting s to in's parameters and tool table and saves the parameter file and/or
+ * the tool table (when in has them). INTERP_OK, or a status with err naming the file. */
+int interp_setting_apply(struct interp *in, const struct canon_setting *s, char *err,
+                         size_t errlen);
+/* Whether the files interp_setting_apply(in, s) would write can be written, without writing
+ * anything: INTERP_OK, or INTERP_ERR_IO with err naming the file and the reason. */
+int interp_setting_check(const struct interp *in, const struct canon_setting *s, char *err,
+                         size_t errlen);
 
 /* Runs a whole program, sending canonical commands to sink. The state (modes, position,
  * offsets, parameters) persists from run to run on one interpreter. Returns INTERP_OK or

@@ -76,6 +76,7 @@ struct interp {
     int line;                    /* 1-based */
     int depth;                   /* nesting of [ ] and # while reading a value */
     int pct_open;                /* the program began with a % line */
+    int pct_line;                /* the line of that opening % */
     int ended;                   /* M2/M30 or closing % seen */
     canon_sink_fn sink;
     void *sink_ctx;
@@ -84,6 +85,8 @@ struct interp {
     /* numbered parameters, mm and deg for lengths and angles */
     double params[INTERP_NPARAMS];
     struct named_table named;    /* #<name> (local to a program) and #<_name> (global) */
+    /* #5161..#5390 as last reported in a CANON_SETTING (settings.c) */
+    double persist_prev[PARAM_PERSIST_HI - PARAM_PERSIST_LO + 1];
 
     /* modal state */
     double pos[6];               /* current machine pose, mm/deg */
@@ -152,8 +155,14 @@ int interp_check_block(struct interp *in);
 /* params.c */
 int interp_params_load(struct interp *in, const char *path);
 int interp_params_save(struct interp *in);
+int interp_param_persistent(int n);     /* 1 if #n is written to the parameter file */
 void interp_select_coord(struct interp *in, int system);
 int interp_emit_offsets(struct interp *in);
+
+/* settings.c: settings the machine keeps go out as CANON_SETTING commands; no file I/O. */
+void interp_settings_begin(struct interp *in);
+int interp_emit_param_changes(struct interp *in);
+int interp_emit_tool_setting(struct interp *in, int tool);
 
 /* exec.c: runs the block in in->blk in LinuxCNC's order of execution. */
 int interp_execute(struct interp *in);

@@ -25,7 +25,8 @@ static int any_axis(const struct interp *in)
     return 0;
 }
 
-/* G10 L1 P R Z: a tool's radius and length into the tool table, then the table's file. */
+/* G10 L1 P R Z: a tool's radius and length into the tool table in memory; the entry goes out
+ * as a CANON_SETTING, saved to the table's file when the machine executes the line. */
 static int g10_l1(struct interp *in, int p)
 {
     if (!in->tt)
@@ -35,13 +36,7 @@ static int g10_l1(struct interp *in, int p)
                               interp_len_mm(in, V('z')));
     if (rc)
         return interp_fail(in, INTERP_ERR_TOOL, W('p'), "G10 L1 P%d: %s", p, tooltable_strerror(rc));
-    if (in->tt->path[0]) {
-        char err[256];
-        rc = tooltable_save(in->tt, in->tt->path, err, sizeof err);
-        if (rc)
-            return interp_fail(in, INTERP_ERR_IO, 0, "%s", err);
-    }
-    return 0;
+    return interp_emit_tool_setting(in, p >= TOOLTABLE_WEAR_BASE ? p - TOOLTABLE_WEAR_BASE : p);
 }
 
 /* G10 L2 / L20 P: a work offset set directly, or so that the current point reads as given. */

@@ -62,6 +62,12 @@ static int persistent(int n)
     return n >= 5221 && (n - 5221) % 20 < 9;
 }
 
+/* Whether parameter n is one the parameter file keeps (for settings.c). */
+int interp_param_persistent(int n)
+{
+    return persistent(n);
+}
+
 /* Writes the persistent parameters to a temporary file, syncs it and renames it over the
  * parameter file, so a crash leaves either the old file or the new one, never half. */
 int interp_params_save(struct interp *in)

@@ -80,6 +80,7 @@ static void rewind_plan(struct motion *m)
     m->ci = 0;
     m->cs = 0;
     m->paused_at_seg = 0;
+    m->marks_done = 0;
     m->path_vel = 0;
     memset(m->pose_vel, 0, sizeof m->pose_vel);
     memset(m->joint_vel, 0, sizeof m->joint_vel);

@@ -141,6 +141,9 @@ struct motion_out {
     double distance_done_mm;           /* XYZ path length covered, mm */
     double distance_total_mm;          /* XYZ path length of the program, mm */
     double feed_override;              /* override in effect now (ramps to the requested) */
+    size_t settings_done;              /* CANON_SETTING commands of the program the machine has
+                                        * passed since motion_start, in program order: the
+                                        * path reached their place (never decreases) */
 };
 
 /* Advances the clock by period_s and fills out. In FAULT, IDLE, PAUSED and DONE the pose

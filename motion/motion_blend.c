@@ -73,7 +73,8 @@ double motion_blend_tolerance(const struct motion_config *c, const struct canon_
 static int transparent(enum canon_type t)
 {
     return t == CANON_FEED_RATE || t == CANON_FEED_MODE || t == CANON_PATH_MODE ||
-           t == CANON_COMMENT || t == CANON_OFFSETS || t == CANON_SPINDLE_SPEED;
+           t == CANON_COMMENT || t == CANON_OFFSETS || t == CANON_SPINDLE_SPEED ||
+           t == CANON_SETTING;
 }
 
 /* Start poses, straight-feed lengths and directions, and the tolerance at every command. */

@@ -278,6 +278,21 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     return 0;
 }
 
+/* A setting point (CANON_SETTING): no segment, only its place between segments, so that
+ * the machine passes it without slowing down and reports it passed (motion_out). */
+static int add_mark(struct motion_plan *p)
+{
+    if (p->nmarks == p->capmarks) {
+        size_t cap = p->capmarks ? 2 * p->capmarks : 16;
+        size_t *n = realloc(p->marks, cap * sizeof *n);
+        if (!n)
+            return -1;
+        p->marks = n, p->capmarks = cap;
+    }
+    p->marks[p->nmarks++] = p->nseg;
+    return 0;
+}
+
 /* A dwell or a pause: two knots at one point, speed 0. */
 static int add_stop(struct motion_plan *p, const struct canon_cmd *c, const double *at,
                     enum motion_seg_kind kind, double dwell_s)
@@ -340,6 +355,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
                 blend_abc(p, &abc[i]);
             break;
         case CANON_DWELL: rc = c->value > 0 ? add_stop(p, c, at, SEG_DWELL, c->value) : 0; break;
+        case CANON_SETTING: rc = add_mark(p); break;
         case CANON_PAUSE:
             if (c->ivalue == 0 || m->cfg.optional_stop)
                 rc = add_stop(p, c, at, SEG_PAUSE, 0);
@@ -389,5 +405,6 @@ void motion_plan_free(struct motion_plan *p)
     for (size_t i = 0; i < p->nfiles; i++)
         free(p->files[i]);
     free(p->files);
+    free(p->marks);
     memset(p, 0, sizeof *p);
 }

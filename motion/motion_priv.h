@@ -64,6 +64,9 @@ struct motion_plan {
     double *ivp;             /* interval: cruise speed (accelerate, cruise, decelerate) */
     double *irho;             /* interval: override ceiling from speed and acceleration caps */
     size_t nknot, capknot;
+    size_t *marks;           /* CANON_SETTING points in program order: the segment each lies
+                              * before (nseg: after the last); passed, not planned */
+    size_t nmarks, capmarks;
     char **files;            /* interned file names */
     size_t nfiles;
     double total_time_s;
@@ -95,6 +98,7 @@ struct motion {
     size_t ci;               /* current interval */
     size_t cs;               /* segment holding knot ci */
     size_t paused_at_seg;    /* pause segment already honoured (+1), 0 = none */
+    size_t marks_done;       /* setting points passed since motion_start (never goes back) */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];
     double pose_vel[KINS_POSE_DIM];

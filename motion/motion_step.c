@@ -179,6 +179,16 @@ static int evaluate(struct motion *m)
     return st;
 }
 
+/* Counts the setting points the path has reached: those before the segment being followed,
+ * and every one once the program is done. */
+static void pass_marks(struct motion *m)
+{
+    const struct motion_plan *p = &m->plan;
+    size_t reached = m->state == MOTION_DONE ? p->nseg : m->cs;
+    while (m->marks_done < p->nmarks && p->marks[m->marks_done] <= reached)
+        m->marks_done++;
+}
+
 /* One servo period (see motion.h). */
 int motion_step(struct motion *m, double period_s, struct motion_out *out)
 {
@@ -191,6 +201,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         m->elapsed_s += period_s;
     if (moving && m->loaded && m->plan.nseg) {
         advance(m, period_s);
+        pass_marks(m);
         int st = evaluate(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
@@ -200,6 +211,8 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
             m->fault_status = ret = MOTION_ERR_KINS;
         }
     } else {
+        if (m->loaded && m->state == MOTION_DONE)
+            pass_marks(m);     /* a program without moves is done at once */
         m->path_vel = 0;
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         memset(m->joint_vel, 0, sizeof m->joint_vel);
@@ -220,5 +233,6 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->distance_done_mm = m->dist_mm;
     out->distance_total_mm = m->plan.total_len_mm;
     out->feed_override = m->rate;
+    out->settings_done = m->marks_done;
     return ret;
 }

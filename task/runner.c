@@ -158,6 +158,7 @@ void runner_destroy(struct runner *r)
         return;
     hal_destroy(r->hal);  /* stops the threads first */
     interp_destroy(r->interp);
+    runner_settings_free(r);
     free(r);
 }
 
@@ -181,8 +182,8 @@ static const char *runner_ini_get(void *ctx, const char *section, const char *ke
 
 /* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE (interp_setup: the same code
  * hexcnc check and hexcnc interp use); a bad value is pointed at its INI line. */
-static int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt,
-                               char *err, size_t errlen)
+int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt, char *err,
+                        size_t errlen)
 {
     char msg[1024];
     int st = interp_setup(in, tt, runner_ini_get, r->hal, hal_ini_dir(r->hal), 0, msg,
@@ -237,6 +238,8 @@ int runner_load_program(struct runner *r, const char *path, char *err, size_t er
     canon_prog_init(&prog);
     r->loaded = false;
     int st = runner_interpret(r, path, &prog, err, errlen);
+    if (st == RUNNER_OK)
+        st = runner_settings_load(r, &prog, err, errlen);
     if (st == RUNNER_OK) {
         char msg[512];
         if (motion_hal_load(r->hal, &prog, msg, sizeof msg) != MOTION_OK)

@@ -69,6 +69,7 @@ static void runner_monitor(void *arg, long period_ns)
     atomic_store_explicit(&r->mon_distance_mm, r->last.distance_done_mm, memory_order_relaxed);
     atomic_store_explicit(&r->mon_file, r->last.file, memory_order_relaxed);
     atomic_store_explicit(&r->mon_line, r->last.line, memory_order_relaxed);
+    atomic_store_explicit(&r->mon_settings, r->last.settings_done, memory_order_release);
     atomic_store_explicit(&r->mon_state, (int)state, memory_order_relaxed);
     atomic_store_explicit(&r->mon_periods,
                           atomic_load_explicit(&r->mon_periods, memory_order_relaxed) + 1,
@@ -115,6 +116,9 @@ int runner_start(struct runner *r, char *err, size_t errlen)
         return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
     runner_reset_summary(r);
     r->aborting = false;
+    r->settings_applied = 0;
+    r->save_err[0] = '\0';
+    atomic_store(&r->mon_settings, 0);
     /* Machine on: out of e-stop (reset pulse to the latch), then enabled. */
     *r->user_enable_out = true;
     if (!*r->emc_enable_in)
@@ -133,15 +137,21 @@ int runner_start(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
-/* Simulated clock: runs the threads for dt_s; real time: sleeps dt_s. */
+/* Simulated clock: runs the threads for dt_s; real time: sleeps dt_s. Then saves the
+ * settings of the lines the machine has passed meanwhile. */
 int runner_advance(struct runner *r, double dt_s)
 {
-    if (r->sim_clock)
-        return hal_sim_advance(r->hal, (long)llround(dt_s * 1e9)) == HAL_OK ? RUNNER_OK
-                                                                           : RUNNER_ERR_RT;
-    struct timespec ts = { (time_t)dt_s, (long)((dt_s - floor(dt_s)) * 1e9) };
-    nanosleep(&ts, NULL);
-    return RUNNER_OK;
+    int st = RUNNER_OK;
+    if (r->sim_clock) {
+        if (hal_sim_advance(r->hal, (long)llround(dt_s * 1e9)) != HAL_OK)
+            st = RUNNER_ERR_RT;
+    } else {
+        struct timespec ts = { (time_t)dt_s, (long)((dt_s - floor(dt_s)) * 1e9) };
+        nanosleep(&ts, NULL);
+    }
+    if (r->started)
+        runner_settings_apply(r);
+    return st;
 }
 
 /* Ctrl-C's path: motion decelerates along the path, then drops the program. */
@@ -224,6 +234,8 @@ static int runner_outcome(struct runner *r, char *err, size_t errlen)
 {
     enum motion_state s = (enum motion_state)atomic_load(&r->mon_state);
     double t_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
+    if (r->save_err[0])
+        return errbuf_set(err, errlen, RUNNER_ERR_FAULT, "%s", r->save_err);
     if (s == MOTION_FAULT && r->first_fault[0])
         return errbuf_set(err, errlen, RUNNER_ERR_FAULT, "%s (cause: %s)",
                            motion_hal_fault(r->hal), r->first_fault);
@@ -288,6 +300,7 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
     }
     if (!r->sim_clock)
         hal_stop(r->hal);
+    runner_settings_apply(r);  /* those passed in the last slice */
     runner_drain_messages(r);
     if (st == RUNNER_OK)
         st = runner_outcome(r, err, errlen);

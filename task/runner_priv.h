@@ -29,6 +29,14 @@ struct runner {
                                          * file names the plan's moves point at, so it lives
                                          * until the next program or runner_destroy */
 
+    /* Settings the program writes (runner_settings.c), saved as execution reaches them. */
+    struct canon_prog settings;         /* the program's CANON_SETTING commands, in order */
+    struct interp *store;               /* applies and saves them: set up with the machine's
+                                         * parameter file and tool table (NULL: none) */
+    struct tooltable *store_tt;         /* its tool table */
+    size_t settings_applied;            /* settings saved so far in this run */
+    char save_err[800];                 /* why a save failed ("" when none has) */
+
     /* The task's own pins, as LinuxCNC's iocontrol: the HAL files wire them to the e-stop
      * chain. user-enable-out is the operator's "machine on"; user-request-enable pulses for
      * one period to reset the latch; emc-enable-in reports the chain. */
@@ -51,6 +59,7 @@ struct runner {
     _Atomic long mon_periods;                /* periods run since start */
     _Atomic double mon_distance_mm;          /* path length covered after the last period */
     const char *_Atomic mon_file;            /* program file of the line being executed */
+    _Atomic size_t mon_settings;             /* settings motion has passed (motion_out) */
     struct motion_out last;                  /* motion's output after the last period */
 
     runner_observer_fn observer;             /* called every period (may be NULL) */
@@ -62,6 +71,17 @@ int runner_monitor_install(struct runner *r, char *err, size_t errlen);
 
 /* Whether the motion core is under way (running, pausing, paused, stopping). */
 bool runner_moving(const struct runner *r);
+
+/* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE to an interpreter (runner.c). */
+struct tooltable;
+int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt, char *err,
+                        size_t errlen);
+
+/* runner_settings.c: the program's settings, checked at load, saved as they execute. */
+int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *err,
+                         size_t errlen);
+void runner_settings_apply(struct runner *r);
+void runner_settings_free(struct runner *r);
 
 
 #endif
