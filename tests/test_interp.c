@@ -156,19 +156,70 @@ START_TEST(params_read_after_line)
 }
 END_TEST
 
-/* G10 L2 and G92 values survive in the parameter file, written atomically. */
+/* The value parameter n has in a CANON_SETTING, or -999 when the setting leaves it alone. */
+static double setting_param(const struct canon_cmd *c, int n)
+{
+    for (size_t i = 0; i < c->setting->nparams; i++)
+        if (c->setting->params[i].number == n)
+            return c->setting->params[i].value;
+    return -999;
+}
+
+/* Each line that changes persistent parameters reports exactly its changes, at its place in
+ * the stream; lines that change none report nothing; later lines see the new values. */
+START_TEST(settings_in_stream)
+{
+    struct canon_prog p;
+    interp_ok("G10 L2 P2 X5 Y-6 A7\nG0 X1\nG92 Z3\nG55\nG0 X0 Y0\n#5221=4\nG1 X2 F100\nM2\n", &p);
+    ck_assert_int_eq(count_type(&p, CANON_SETTING), 5); /* G10, G92, G55, #5221, M2 (G54) */
+    const struct canon_cmd *c = nth(&p, CANON_SETTING, 0);
+    ck_assert_int_eq(c->line, 1);
+    ck_assert_int_eq((int)c->setting->nparams, 3);
+    ck_assert_double_eq(setting_param(c, 5241), 5);
+    ck_assert_double_eq(setting_param(c, 5242), -6);
+    ck_assert_double_eq(setting_param(c, 5244), 7);
+    ck_assert_ptr_null(c->setting->tool);
+    c = nth(&p, CANON_SETTING, 1);
+    ck_assert_int_eq(c->line, 3);
+    ck_assert_int_eq((int)c->setting->nparams, 2);
+    ck_assert_double_eq(setting_param(c, 5213), -3);
+    ck_assert_double_eq(setting_param(c, 5210), 1);
+    ck_assert_double_eq(setting_param(nth(&p, CANON_SETTING, 2), 5220), 2);
+    ck_assert_int_eq(nth(&p, CANON_SETTING, 3)->line, 6);
+    ck_assert_double_eq(setting_param(nth(&p, CANON_SETTING, 3), 5221), 4);
+    c = nth(&p, CANON_SETTING, 4);
+    ck_assert_int_eq(c->line, 8);
+    ck_assert_double_eq(setting_param(c, 5220), 1);
+    ck_assert_int_eq(p.cmds[p.count - 2].type, CANON_SETTING); /* before PROGRAM_END */
+    ck_assert_pose(nth(&p, CANON_TRAVERSE, 1)->end, 5, -6, 0, 0, 0, 0, 1e-12); /* G55 seen */
+    canon_prog_free(&p);
+    interp_ok("G0 X1\n#1=2\nG54\nG1 X2 F100\nM2\n", &p);  /* nothing persistent changes */
+    ck_assert_int_eq(count_type(&p, CANON_SETTING), 0);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* Interpreting writes no parameter file; applying the stream's settings (what the runner does
+ * as the machine executes them) writes it atomically, and it loads back. */
 START_TEST(params_file_persistence)
 {
-    char dir[] = "/tmp/hexcnc_interp_XXXXXX", path[128], tmp[140];
+    char dir[] = "/tmp/hexcnc_interp_XXXXXX", path[128], tmp[140], err[512];
     ck_assert_ptr_nonnull(mkdtemp(dir));
     snprintf(path, sizeof path, "%s/hexcnc.var", dir);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    struct interp *in = interp_create();
+    struct interp *in = interp_create(), *store = interp_create();
     ck_assert_int_eq(interp_set_param_file(in, path), 0); /* missing: starts from zero */
+    ck_assert_int_eq(interp_set_param_file(store, path), 0);
     struct canon_prog p;
     ck_assert_int_eq(run_on(in, "G10 L2 P2 X5 Y-6 A7\nG0 X1\nG92 Z3\nM2\n", &p), 0);
-    canon_prog_free(&p);
     interp_destroy(in);
+    ck_assert_int_eq(access(path, F_OK), -1);   /* the interpreter wrote nothing */
+    for (size_t i = 0; i < p.count; i++)
+        if (p.cmds[i].type == CANON_SETTING)
+            ck_assert_msg(interp_setting_apply(store, p.cmds[i].setting, err, sizeof err) == 0,
+                          "%s", err);
+    canon_prog_free(&p);
+    interp_destroy(store);
     ck_assert_int_ne(access(path, R_OK), -1);
     ck_assert_int_eq(access(tmp, F_OK), -1);
     FILE *f = fopen(path, "r");
@@ -188,6 +239,25 @@ START_TEST(params_file_persistence)
     interp_destroy(in);
     unlink(path);
     rmdir(dir);
+}
+END_TEST
+
+/* A setting whose file cannot be written is found before anything is saved. */
+START_TEST(settings_file_check)
+{
+    char err[512];
+    struct canon_param prm = { 5221, 1.0 };
+    struct canon_setting s = { .tool = NULL, .nparams = 1, .params = &prm };
+    struct interp *in = interp_create();
+    ck_assert_int_eq(interp_setting_check(in, &s, err, sizeof err), 0); /* no file: no save */
+    ck_assert_int_eq(interp_set_param_file(in, "/nonexistent-dir/hexcnc.var"), 0);
+    ck_assert_int_eq(interp_setting_check(in, &s, err, sizeof err), INTERP_ERR_IO);
+    ck_assert_msg(strstr(err, "/nonexistent-dir/hexcnc.var") != NULL, "%s", err);
+    ck_assert_int_ne(interp_setting_apply(in, &s, err, sizeof err), 0);
+    ck_assert_msg(strstr(err, "/nonexistent-dir/hexcnc.var") != NULL, "%s", err);
+    ck_assert_int_eq(interp_load_param_file(in, "/nonexistent-dir/hexcnc.var"), 0);
+    ck_assert_int_eq(interp_setting_check(in, &s, err, sizeof err), 0); /* read only */
+    interp_destroy(in);
 }
 END_TEST
 
@@ -305,6 +375,8 @@ static Suite *interp_suite(void)
     tcase_add_test(tc, expr_errors);
     tcase_add_test(tc, params_read_after_line);
     tcase_add_test(tc, params_file_persistence);
+    tcase_add_test(tc, settings_in_stream);
+    tcase_add_test(tc, settings_file_check);
     tcase_add_test(tc, params_file_errors);
     tcase_add_test(tc, modal_groups);
     tcase_add_test(tc, error_stops_output);

@@ -177,11 +177,22 @@ START_TEST(tool_length)
     ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 2)->end[2], 0);
     ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 3)->end[2], 13.5); /* G43 alone: tool 3 */
     canon_prog_free(&p);
-    /* G10 L1 writes the table: radius R (diameter 2R) and length Z */
-    ck_assert_int_eq(run_on(in, "G10 L1 P5 R3 Z7\nG43 H5\nG0 Z0\nG49\nM2\n", &p), 0);
+    /* G10 L1 writes the table in memory: radius R (diameter 2R) and length Z; the entry goes
+     * out as a CANON_SETTING at its line, for the machine to save when it gets there */
+    snprintf(tt->path, sizeof tt->path, "/nonexistent-dir/never-written.tbl");
+    ck_assert_int_eq(run_on(in, "G0 Z1\nG10 L1 P5 R3 Z7\nG43 H5\nG0 Z0\nG49\nM2\n", &p), 0);
     ck_assert_double_eq(tooltable_find(tt, 5)->diameter_mm, 6);
-    ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 0)->end[2], 7);
+    ck_assert_double_eq(nth(&p, CANON_TRAVERSE, 1)->end[2], 7);
+    ck_assert_int_eq(count_type(&p, CANON_SETTING), 1);
+    const struct canon_cmd *set = nth(&p, CANON_SETTING, 0);
+    ck_assert_int_eq(set->line, 2);
+    ck_assert(set > nth(&p, CANON_TRAVERSE, 0));  /* after line 1's move, */
+    ck_assert(set < nth(&p, CANON_OFFSETS, 0));   /* before line 3's G43 */
+    ck_assert_int_eq(set->setting->tool->tool, 5);
+    ck_assert_double_eq(set->setting->tool->diameter_mm, 6);
+    ck_assert_double_eq(set->setting->tool->z_offset_mm, 7);
     canon_prog_free(&p);
+    tt->path[0] = '\0';
     ck_assert_int_eq(interp_status_of("G10 L1 P5 R3\nM2\n"), INTERP_ERR_TOOL); /* no table */
     ck_assert_int_eq(run_on(in, "G43 H4\nM2\n", &p), INTERP_ERR_TOOL);
     canon_prog_free(&p);
