@@ -70,5 +70,38 @@ check "Ctrl-C exits 130" [ $rc -eq 130 ]
 check "Ctrl-C says it stopped" has "$tmp/err" "interrupted"
 check "Ctrl-C still prints the summary" has "$tmp/out" "machine time"
 
+# 8. Settings G-code writes (G10 L1 tool table, G10 L2 parameter file) are saved only when
+#    their line runs on the machine: interp and check leave both files byte for byte as they
+#    were, and so does a run refused before motion; a full run saves them.
+m="$tmp/settings"; mkdir -p "$m"
+sed "s|^HALFILE = |HALFILE = $root/configs/sim/|" "$ini" \
+    | sed "s|^TOOL_TABLE = .*|TOOL_TABLE = $m/tool.tbl\nPARAMETER_FILE = $m/hexcnc.var|" >"$m/m.ini"
+printf 'T1 P1 D10 ;ten\n' >"$m/tool.tbl"
+printf '5221\t0.000000\n' >"$m/hexcnc.var"
+printf 'G0 X0 Y0 Z645\nG10 L1 P1 R7\nG10 L2 P1 X0.5\nG1 X10 F2\nM2\n' >"$m/g10.ngc"
+sums() { cksum "$m/tool.tbl" "$m/hexcnc.var"; }
+sums >"$m/before"
+"$bin" interp -i "$m/m.ini" "$m/g10.ngc" >"$tmp/out" 2>"$tmp/err"
+check "interp of a G10 program exits 0" [ $? -eq 0 ]
+sums | cmp -s - "$m/before"; check "interp leaves tool table and parameter file as they were" [ $? -eq 0 ]
+"$bin" check "$m/m.ini" "$m/g10.ngc" >"$tmp/out" 2>"$tmp/err"
+check "check of a G10 program exits 0" [ $? -eq 0 ]
+sums | cmp -s - "$m/before"; check "check leaves tool table and parameter file as they were" [ $? -eq 0 ]
+printf 'G0 X0 Y0 Z645\nG10 L1 P1 R7\nG10 L2 P1 X0.5\nG1 X600 F2\nM2\n' >"$m/far.ngc"
+"$bin" run "$m/m.ini" "$m/far.ngc" >"$tmp/out" 2>"$tmp/err"
+check "refused G10 program exits 1" [ $? -eq 1 ]
+sums | cmp -s - "$m/before"; check "refused run leaves tool table and parameter file as they were" [ $? -eq 0 ]
+"$bin" run "$m/m.ini" "$m/g10.ngc" >"$tmp/out" 2>"$tmp/err"
+check "G10 program runs" [ $? -eq 0 ]
+check "the run saved G10 L1 (T1 D14)" has "$m/tool.tbl" "^T1 P1 D14 ;ten"
+check "the run saved G10 L2 (#5221 = 0.5)" has "$m/hexcnc.var" "^5221.0.500000"
+
+# 9. A %-framed program cut short (no closing %) is refused before motion, with file:line.
+printf '%%\nG0 X0 Y0 Z645\nG1 X15 F2\nG1 X1' >"$tmp/cut.ngc"
+"$bin" run "$ini" "$tmp/cut.ngc" >"$tmp/out" 2>"$tmp/err"
+check "truncated program exits 1" [ $? -eq 1 ]
+check "truncated program names file:line" has "$tmp/err" "cut.ngc:4: error: the program opened with '%' on line 1 ends without its closing '%'"
+check "truncated program: no motion" has "$tmp/err" "did not move"
+
 [ $fails -eq 0 ] || { echo "run_cli: $fails failed"; cat "$tmp/err"; exit 1; }
 echo "run_cli: all passed"
