@@ -20,8 +20,8 @@ struct interp_settings {
 
 /* Flags of interp_settings_apply() and interp_setup(). */
 enum interp_setup_flag {
-    /* Load the parameter file but never write it back: an offline check must not change
-     * the offsets the machine will cut with. */
+    /* Load the parameter file but remember no file to save to: even interp_setting_apply()
+     * then leaves the offsets the machine will cut with alone (interpreting never writes). */
     INTERP_SETUP_PARAMS_READ_ONLY = 1 << 0,
 };
 
@@ -33,7 +33,8 @@ int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, voi
 
 /* Applies them to in: the feed factor; the tool table loaded into tt and handed to in
  * (tt NULL: the table is the caller's business and TOOL_TABLE is not loaded); the parameter
- * file loaded (and, unless INTERP_SETUP_PARAMS_READ_ONLY, written back when a run ends).
+ * file loaded (and, unless INTERP_SETUP_PARAMS_READ_ONLY, remembered as the file that
+ * interp_setting_apply() saves to; interpreting itself never writes it).
  * Errors name the file and line (a missing tool table names its path). */
 int interp_settings_apply(struct interp *in, const struct interp_settings *s,
                           struct tooltable *tt, unsigned flags, char *err, size_t errlen);

@@ -162,6 +162,66 @@ START_TEST(test_program_pause)
 }
 END_TEST
 
+/* What the settings hook saw: settings_done when X first passed 10 and at each state. */
+struct settings_watch {
+    size_t max_before_10;     /* largest count while X < 10 - 1e-9 (still on line 1) */
+    size_t min_after_10;      /* smallest count once X > 10 + 1e-9 (on line 3) */
+    double min_vel_mid;       /* slowest path speed between X 9 and X 11 */
+};
+
+static int settings_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    (void)m, (void)step;
+    struct settings_watch *w = ctx;
+    if (o->pose[0] < 10 - 1e-9 && o->settings_done > w->max_before_10)
+        w->max_before_10 = o->settings_done;
+    if (o->pose[0] > 10 + 1e-9 && o->settings_done < w->min_after_10)
+        w->min_after_10 = o->settings_done;
+    if (o->pose[0] > 9 && o->pose[0] < 11)
+        w->min_vel_mid = fmin(w->min_vel_mid, o->path_vel);
+    return 0;
+}
+
+/* A setting (CANON_SETTING) is a point of zero length: counted as passed once the path is
+ * beyond it, never before; the machine does not stop there (G64: the blend goes on); the
+ * one before PROGRAM_END counts when the program is done. */
+START_TEST(test_settings_passed)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double a[6] = {10, 0, 0, 0, 0, 0}, b[6] = {20, 0, 0, 0, 0, 0};
+    struct canon_param prm = {5221, 1.5};
+    struct canon_setting set = {.tool = NULL, .nparams = 1, .params = &prm};
+    struct canon_cmd c = {.type = CANON_SETTING, .line = 2, .file = "test.ngc", .setting = &set};
+    tm_add(&p, CANON_PATH_MODE, 1, NULL, 0, 0.01);
+    p.cmds[0].ivalue = 640;
+    tm_add(&p, CANON_FEED, 1, a, 1200, 0);
+    ck_assert_int_eq(canon_prog_sink(&p, &c), 0);
+    tm_add(&p, CANON_FEED, 3, b, 1200, 0);
+    c.line = 4;
+    ck_assert_int_eq(canon_prog_sink(&p, &c), 0);
+    ck_assert_ptr_ne(p.cmds[4].setting, &set);             /* the program owns a copy */
+    ck_assert_double_eq(p.cmds[4].setting->params[0].value, 1.5);
+    tm_add(&p, CANON_PROGRAM_END, 5, NULL, 0, 0);
+    char err[256];
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
+    motion_start(mc.m);
+    struct settings_watch w = {.min_after_10 = 99, .min_vel_mid = 1e9};
+    struct tm_stats s;
+    tm_run(mc.m, DT, 100000, &s, settings_hook, &w);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_int_eq((int)w.max_before_10, 0);
+    ck_assert_int_eq((int)w.min_after_10, 1);
+    ck_assert_int_eq((int)s.last.settings_done, 2);
+    ck_assert_msg(w.min_vel_mid > 1200 / 60.0 * 0.5, "slowed to %g mm/s at the setting",
+                  w.min_vel_mid);                            /* straight on: no stop */
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* Feed override 0.5 from the start: the cruise takes twice as long. Override 2 on a feed of
  * half the machine's limit: twice as fast, the acceleration still within its limit; override
  * 2 on a feed near the limit: held at MAX_LINEAR_VELOCITY. */
@@ -330,6 +390,7 @@ static Suite *run_suite(void)
     tcase_add_test(tc, test_pause_resume);
     tcase_add_test(tc, test_abort);
     tcase_add_test(tc, test_program_pause);
+    tcase_add_test(tc, test_settings_passed);
     tcase_add_test(tc, test_feed_override);
     tcase_add_test(tc, test_feed_override_live);
     tcase_add_test(tc, test_estop);
