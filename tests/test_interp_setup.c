@@ -188,8 +188,10 @@ START_TEST(errors_name_the_key_or_the_file)
 }
 END_TEST
 
-/* Runs G10 L2 (a new G54 X) on a fresh interpreter set up with flags; returns the file. */
-static void run_g10(const char *dir, unsigned flags, char *after, size_t len)
+/* Runs G10 L2 (a new G54 X) on a fresh interpreter set up with flags: the file after the
+ * interpretation into mid, then after applying the program's settings (as the runner does
+ * when the machine executes them) into after. */
+static void run_g10(const char *dir, unsigned flags, char *mid, char *after, size_t len)
 {
     char err[512];
     struct fake_ini ini = { { { "RS274NGC", "PARAMETER_FILE", "p.var" } } };
@@ -198,22 +200,32 @@ static void run_g10(const char *dir, unsigned flags, char *after, size_t len)
     ck_assert_int_eq(interp_setup(in, NULL, fake_get, &ini, dir, flags, err, sizeof err),
                      INTERP_OK);
     const char prog[] = "G10 L2 P1 X7\nM2\n";
-    ck_assert_int_eq(interp_run_text(in, "g10.ngc", prog, strlen(prog), drop, NULL),
+    struct canon_prog p;
+    canon_prog_init(&p);
+    ck_assert_int_eq(interp_run_text(in, "g10.ngc", prog, strlen(prog), canon_prog_sink, &p),
                      INTERP_OK);
+    get_text(dir, "p.var", mid, len);
+    for (size_t i = 0; i < p.count; i++)
+        if (p.cmds[i].type == CANON_SETTING)
+            ck_assert_msg(interp_setting_apply(in, p.cmds[i].setting, err, sizeof err) ==
+                          INTERP_OK, "%s", err);
+    canon_prog_free(&p);
     interp_destroy(in);
     get_text(dir, "p.var", after, len);
 }
 
 START_TEST(read_only_never_writes_the_parameter_file)
 {
-    char dir[64], after[8192];
+    char dir[64], mid[8192], after[8192];
     make_dir(dir, sizeof dir);
     const char *before = "5221 40\n";
     put(dir, "p.var", before);
-    run_g10(dir, INTERP_SETUP_PARAMS_READ_ONLY, after, sizeof after);
+    run_g10(dir, INTERP_SETUP_PARAMS_READ_ONLY, mid, after, sizeof after);
+    ck_assert_str_eq(mid, before);
     ck_assert_str_eq(after, before);                      /* the check leaves it alone */
-    run_g10(dir, 0, after, sizeof after);
-    ck_assert_msg(strstr(after, "5221\t7.000000\n"), "%s", after);   /* the run saves it */
+    run_g10(dir, 0, mid, after, sizeof after);
+    ck_assert_str_eq(mid, before);                        /* interpreting writes nothing */
+    ck_assert_msg(strstr(after, "5221\t7.000000\n"), "%s", after);   /* executing saves it */
     remove_dir(dir);
 }
 END_TEST
