@@ -78,7 +78,8 @@ struct canon_cmd {
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */
-    const struct canon_setting *setting; /* SETTING only (owned by the interpreter) */
+    const struct canon_setting *setting; /* SETTING only: valid during the sink call (the
+                                          * interpreter's); canon_prog_sink keeps a copy */
     int has_n;             /* the source block had an N word (for printers) */
     int n_number;          /* its value */
 };
