@@ -95,7 +95,7 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
     }
     tooltable_init(mc->tt);
     snprintf(mc->ini, sizeof mc->ini, "%s", ini);
-    if (hal_load_ini(mc->hal, ini) != HAL_OK) {
+    if (hal_load_machine_ini(mc->hal, ini) != HAL_OK) {
         st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
         goto fail;
     }

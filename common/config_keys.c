@@ -120,7 +120,7 @@ const struct config_key config_keys[] = {
     /* [EMCMOT] */
     { "EMCMOT", "SERVO_PERIOD", INT, "ns", "1000..1e9", 0, 0, "1000000", "servo thread "
       "period" },
-    { "EMCMOT", "SIM_CLOCK", BOOL, "", "", 0, 0, "0", "`hexcnc run` runs on the simulated "
+    { "EMCMOT", "SIM_CLOCK", INT, "", "0..1", 0, 0, "0", "`hexcnc run` runs on the simulated "
       "clock (1) or paces the servo thread on the wall clock (0)" },
     { "EMCMOT", "EMCMOT", STR, "", "", 0, IGN, "", "LinuxCNC's motion module" },
     { "EMCMOT", "COMM_TIMEOUT", NUM, "s", "", 0, IGN, "", "LinuxCNC's" },

@@ -1,8 +1,9 @@
-/* hal_ini.c: the runtime's INI file (common/inifile.c) and typed readers. */
-#include <errno.h>
+/* hal_ini.c: the runtime's INI file (common/inifile.c, checked by common/config.h) and typed
+ * readers (common/config_value.c's rules). */
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "hal/hal_priv.h"
 
 /* Frees the INI entries and paths. */
@@ -21,6 +22,19 @@ int hal_load_ini(struct hal *h, const char *path)
     int hst = st == INIFILE_ERR_NOMEM ? HAL_ERR_NOMEM
             : st == INIFILE_ERR_SYNTAX ? HAL_ERR_SYNTAX : HAL_ERR_IO;
     return hal_error(h, hst, "%s", err);
+}
+
+/* Reads the INI and checks it whole against the key table. */
+int hal_load_machine_ini(struct hal *h, const char *path)
+{
+    int st = hal_load_ini(h, path);
+    if (st != HAL_OK)
+        return st;
+    char err[sizeof h->err];
+    if (config_check(&h->ini, err, sizeof err) == CONFIG_OK)
+        return HAL_OK;
+    inifile_free(&h->ini);
+    return hal_error(h, HAL_ERR_SYNTAX, "%s", err);
 }
 
 /* The n-th occurrence of [section]key, or NULL. */
@@ -68,10 +82,8 @@ int hal_ini_double(struct hal *h, const char *section, const char *key, double d
     *out = def;
     if (!v)
         return HAL_ERR_NOT_FOUND;
-    char *end;
-    errno = 0;
-    double d = strtod(v, &end);
-    if (end == v || *end || errno == ERANGE)
+    double d;
+    if (config_parse_number(v, &d, NULL, 0) != 0)
         return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a number",
                          hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = d;
@@ -85,10 +97,8 @@ int hal_ini_int(struct hal *h, const char *section, const char *key, long def, l
     *out = def;
     if (!v)
         return HAL_ERR_NOT_FOUND;
-    char *end;
-    errno = 0;
-    long n = strtol(v, &end, 10);
-    if (end == v || *end || errno == ERANGE)
+    long n;
+    if (config_parse_integer(v, &n, NULL, 0) != 0)
         return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a whole number",
                          hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = n;

@@ -134,7 +134,7 @@ int runner_create(const struct runner_opts *opts, struct runner **out, char *err
         return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
     int st;
-    if (hal_load_ini(r->hal, opts->ini_path) != HAL_OK) {
+    if (hal_load_machine_ini(r->hal, opts->ini_path) != HAL_OK) {
         st = errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
         goto fail;
     }

@@ -303,7 +303,7 @@ START_TEST(test_plots_written)
 }
 END_TEST
 
-/* A bad kinematics value in the INI: the message names the file and the key's line. */
+/* A bad value in the INI: the check at load names the file and the key's line. */
 START_TEST(test_config_error_names_the_ini_line)
 {
     char path[] = "/tmp/hexcnc-check-ini-XXXXXX", err[1024], want[256];
@@ -313,11 +313,12 @@ START_TEST(test_config_error_names_the_ini_line)
     fprintf(f, "[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\nPLATFORM_RADIUS = 300\n"
                "BASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = 10\n");
     for (int i = 0; i < 6; i++)
-        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\n", i, i == 3 ? "abc" : "980");
+        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\nMAX_VELOCITY = 100\n"
+                   "MAX_ACCELERATION = 1000\nFERROR = 1\n", i, i == 3 ? "abc" : "980");
     fclose(f);
     struct check_machine *mc = NULL;
-    ck_assert_int_eq(check_machine_open(path, &mc, err, sizeof err), CHECK_ERR_KINS);
-    snprintf(want, sizeof want, "%s:18: [JOINT_3] MAX_LIMIT: 'abc' is not a number", path);
+    ck_assert_int_eq(check_machine_open(path, &mc, err, sizeof err), CHECK_ERR_CONFIG);
+    snprintf(want, sizeof want, "%s:27: [JOINT_3] MAX_LIMIT = abc: not a number (mm)", path);
     ck_assert_str_eq(err, want);
     ck_assert_ptr_null(mc);
     unlink(path);

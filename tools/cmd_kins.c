@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/inifile.h"
+#include "common/config.h"
 #include "kins/kins.h"
 #include "tools/cmd.h"
 
@@ -110,7 +110,7 @@ int cmd_kins(int argc, char **argv)
     }
     struct inifile ini = { 0 };
     char err[1024], msg[1536];
-    if (inifile_load(&ini, argv[1], err, sizeof err) != INIFILE_OK) {
+    if (config_load(&ini, argv[1], err, sizeof err) != CONFIG_OK) {
         fprintf(stderr, "hexcnc kins: %s\n", err);
         return 1;
     }
