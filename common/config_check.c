@@ -23,11 +23,13 @@ const char *config_strerror(int status)
     return config_msgs[status];
 }
 
-/* Does a concrete name (JOINT_3) match a table name (JOINT_#)? '#' takes one or more
- * digits. */
+/* Does a concrete name (JOINT_3) match a table name (JOINT_#)? '#' takes one to three
+ * digits, a final '*' any non-empty rest (LinuxCNC's AXIS_X). */
 static int config_name_match(const char *pattern, const char *name)
 {
     for (; *pattern; pattern++, name++) {
+        if (pattern[0] == '*' && !pattern[1])
+            return *name != '\0';
         if (*pattern == '#') {
             size_t n = strspn(name, "0123456789");
             if (n == 0 || n > 3)

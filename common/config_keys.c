@@ -4,7 +4,8 @@
  *
  * Columns: section, key, type, unit, range (numbers: "", "> A", ">= A", "A..B", "!= 0";
  * enums: the words "a|b"), count (NUMBERS), flags, default ("" = none), meaning.
- * '#' in a section or key name stands for an index: JOINT_# is JOINT_0, JOINT_1, ... */
+ * '#' in a section or key name stands for an index: JOINT_# is JOINT_0, JOINT_1, ...; a
+ * final '*' for any ending (AXIS_* is AXIS_X, AXIS_Y, ...). */
 #include "common/config.h"
 
 #define NUM CONFIG_NUMBER
@@ -40,7 +41,7 @@ const struct config_section config_sections[] = {
     /* Other programs' sections, accepted and ignored so a LinuxCNC INI can be used. */
     { "HALUI", CONFIG_FOREIGN, "LinuxCNC's halui" },
     { "FILTER", CONFIG_FOREIGN, "LinuxCNC's program filters" },
-    { "AXIS_#", CONFIG_FOREIGN, "LinuxCNC's per-axis limits (hexcnc limits legs, [JOINT_#], "
+    { "AXIS_*", CONFIG_FOREIGN, "LinuxCNC's per-axis limits (hexcnc limits legs, [JOINT_#], "
       "and the path, [TRAJ])" },
     { "SPINDLE_#", CONFIG_FOREIGN, "LinuxCNC's spindle settings" },
     { "PYTHON", CONFIG_FOREIGN, "LinuxCNC's Python plugins" },

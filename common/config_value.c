@@ -125,19 +125,20 @@ int config_in_range(double x, const char *range, char *why, size_t whylen)
         inside = x >= lo;
     else if (range[0] == '>' && sscanf(range + 1, "%lf", &lo) == 1)
         inside = x > lo;
-    else if (sscanf(range, "%lf..%lf", &lo, &hi) == 2)
+    else if (strstr(range, "..")) {   /* strtod stops at the second '.' of "0..59" */
+        lo = strtod(range, NULL);
+        hi = strtod(strstr(range, "..") + 2, NULL);
         inside = x >= lo && x <= hi;
+    }
     if (inside)
         return 0;
     if (why && whylen) {
-        if (strstr(range, ".."))
-            snprintf(why, whylen, "must be from %s to %s", range,
-                     strstr(range, "..") + 2);
+        const char *dots = strstr(range, "..");
+        if (dots)
+            snprintf(why, whylen, "must be from %.*s to %s", (int)(dots - range), range,
+                     dots + 2);
         else
             snprintf(why, whylen, "must be %s", range);
-        char *dots = strstr(why, "..");
-        if (dots)   /* "from 1..1000 to 1000" -> "from 1 to 1000" */
-            memmove(dots, strstr(dots, " to "), strlen(strstr(dots, " to ")) + 1);
     }
     return -1;
 }
