@@ -6,6 +6,7 @@
 
 #include "check/check_priv.h"
 #include "common/errbuf.h"
+#include "common/config.h"
 #include "common/inifile.h"
 #include "hal/hal.h"
 #include "interp/interp.h"
@@ -39,7 +40,7 @@ static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, 
 {
     const char *v = hal_ini_get(mc->hal, "KINS", "TOOL_AXIS");
     double a[3] = { 0, 0, -1 };
-    if (v && sscanf(v, " %lf%*[ ,]%lf%*[ ,]%lf", &a[0], &a[1], &a[2]) != 3)
+    if (v && config_parse_numbers(v, a, 3, NULL, 0) != 0)
         return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS = %s: expected three "
                     "numbers x y z", ini, v);
     double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
