@@ -203,14 +203,15 @@ int config_check_value(const struct config_key *k, const char *value, char *why,
     return -1;
 }
 
-/* Appends one "PATH:LINE: ..." line to err; keeps the first status. */
+/* One check's output: every problem a line of err, the first problem's status. */
 struct config_report {
-    const struct inifile *ini;
-    char *err;
-    size_t errlen, used;
-    int status;
+    const struct inifile *ini;   /* the file checked */
+    char *err;                   /* messages, one per line; may be NULL */
+    size_t errlen, used;         /* its size and the characters written */
+    int status;                  /* the first problem's status, CONFIG_OK when none */
 };
 
+/* Appends one "PATH:LINE: ..." line to err; keeps the first status. */
 static void config_report(struct config_report *r, int status, int line, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 static void config_report(struct config_report *r, int status, int line, const char *fmt, ...)

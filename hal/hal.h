@@ -65,6 +65,9 @@ int hal_load_ini(struct hal *h, const char *path);
 int hal_load_machine_ini(struct hal *h, const char *path);
 /* Value of the first KEY in SECTION, or NULL. */
 const char *hal_ini_get(const struct hal *h, const char *section, const char *key);
+/* hal_ini_get for callers that hold the runtime as a void *: the one lookup behind the get()
+ * of struct kins_config, interp_setup() and the Modbus configuration reader. */
+const char *hal_ini_lookup(void *h, const char *section, const char *key);
 /* Value of the n-th (0-based) occurrence of a repeated key (e.g. [HAL] HALFILE), or NULL. */
 const char *hal_ini_get_n(const struct hal *h, const char *section, const char *key, int n);
 /* Typed readers: HAL_OK, HAL_ERR_NOT_FOUND when absent (out = def), HAL_ERR_SYNTAX when

@@ -49,6 +49,12 @@ const char *hal_ini_get(const struct hal *h, const char *section, const char *ke
     return inifile_get(&h->ini, section, key);
 }
 
+/* hal_ini_get through a void * (kins_config, interp_setup, modbus_cfg). */
+const char *hal_ini_lookup(void *h, const char *section, const char *key)
+{
+    return hal_ini_get(h, section, key);
+}
+
 const char *hal_ini_path(const struct hal *h)
 {
     return inifile_path(&h->ini);

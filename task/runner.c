@@ -173,19 +173,13 @@ const char *runner_default_program(const struct runner *r)
     return r->default_program[0] ? r->default_program : NULL;
 }
 
-/* The INI lookup interp_setup reads through. */
-static const char *runner_ini_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 /* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE (interp_setup: the same code
  * hexcnc check and hexcnc interp use); a bad value is pointed at its INI line. */
 static int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt,
                                char *err, size_t errlen)
 {
     char msg[1024];
-    int st = interp_setup(in, tt, runner_ini_get, r->hal, hal_ini_dir(r->hal), 0, msg,
+    int st = interp_setup(in, tt, hal_ini_lookup, r->hal, hal_ini_dir(r->hal), 0, msg,
                           sizeof msg);
     if (st == INTERP_OK)
         return RUNNER_OK;
