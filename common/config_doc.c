@@ -2,6 +2,7 @@
  * (`hexcnc ini doc`, `make ini-doc`; tests/ini_doc_fresh.sh fails when it is out of date). */
 #include "common/config.h"
 
+#include <ctype.h>
 #include <string.h>
 
 static const char *const config_type_names[] = {
@@ -32,7 +33,8 @@ static void config_doc_section(FILE *out, const struct config_section *s)
                         "keys are theirs and ignored",
         [CONFIG_FOREIGN] = "ignored",
     };
-    fprintf(out, "\n## [%s]\n\n%s; %s.\n", s->name, s->doc, kinds[s->kind]);
+    fprintf(out, "\n## [%s]\n\n%c%s; %s.\n", s->name, toupper((unsigned char)s->doc[0]),
+            s->doc + 1, kinds[s->kind]);
     int any = 0;
     for (int i = 0; i < config_nkeys; i++) {
         const struct config_key *k = &config_keys[i];
