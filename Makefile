@@ -9,12 +9,13 @@
 #   make sanitize   the same tests built with ASan + UBSan (in build/san/)
 #   make bench      run the benchmarks
 #   make run        run the simulated TMU hexapod on the paper's programs
+#   make ini-doc    write docs/ini.md from the INI key table (common/config_keys.c)
 #   make install PREFIX=/usr/local
 
 PREFIX ?= /usr/local
 BUILD_MAKE = $(MAKE) --no-print-directory -f mk/build.mk
 
-.PHONY: all deps test sanitize bench run experiment install clean fuzz
+.PHONY: all deps test sanitize bench run experiment install clean fuzz ini-doc
 all: deps
 	@$(BUILD_MAKE) all
 deps:
@@ -31,6 +32,8 @@ experiment: deps
 	@$(BUILD_MAKE) experiment
 fuzz: deps
 	@$(BUILD_MAKE) fuzz
+ini-doc: deps
+	@$(BUILD_MAKE) ini-doc
 install: deps
 	@$(BUILD_MAKE) install PREFIX=$(PREFIX)
 clean:

@@ -9,7 +9,7 @@
 
 #define TARGET_S 3600.0      /* machining time the generated program aims at, s */
 #define SHORT_S 360.0        /* the exhaustive baseline runs on a tenth of that (it is slow) */
-#define FEED_MM_S 10.0       /* its feed: F0.6 (m/min, as the TMU INI reads F) = 10 mm/s */
+#define FEED_MM_S 10.0       /* its feed: F600 (mm/min, as the TMU INI reads F) = 10 mm/s */
 
 /* Wall and process CPU clocks, s (the machine is shared: CPU time is the fair figure). */
 static double clock_s(clockid_t id)
@@ -40,7 +40,7 @@ static char *generate(double target_s, size_t *len, int *moves)
     if (!t)
         return NULL;
     n += (size_t)snprintf(t + n, cap - n, "G21 G90 G64 P0.01\nG1 X0 Y0 Z645 A0 B0 C0 F%.3f\n",
-                          FEED_MM_S * 60 / 1000);
+                          FEED_MM_S * 60);
     for (*moves = 0; time_s < target_s; ++*moves) {
         double q[6];
         do {

@@ -257,7 +257,8 @@ int main(void)
 {
     static char ini[1024];
     const char *root = getenv("HEXCNC_ROOT");
-    snprintf(ini, sizeof ini, "%s/configs/sim/tmu-hexapod.ini", root ? root : ".");
+    /* the paper's machine for path 1: its programs' F2 is 2 m/min there */
+    snprintf(ini, sizeof ini, "%s/examples/paper/experiment/tmu-path1.ini", root ? root : ".");
     static double legs[4096][KINS_MAX_JOINTS];
     struct legs_log log = { legs, 0, 4096, 0 };
     double wall_s, cpu1_s, machine_s, wall2_s, cpu2_s, machine2_s;

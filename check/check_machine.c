@@ -6,6 +6,7 @@
 
 #include "check/check_priv.h"
 #include "common/errbuf.h"
+#include "common/config.h"
 #include "common/inifile.h"
 #include "hal/hal.h"
 #include "interp/interp.h"
@@ -28,18 +29,13 @@ const char *check_strerror(int status)
     return status_text[status];
 }
 
-/* The kins_config lookup over the INI held by the HAL runtime (only its reader is used). */
-static const char *ini_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
 
 /* [KINS] TOOL_AXIS as a unit vector (default 0 0 -1, as the kinematics reads it). */
 static int read_tool_axis(struct check_machine *mc, const char *ini, char *err, size_t errlen)
 {
     const char *v = hal_ini_get(mc->hal, "KINS", "TOOL_AXIS");
     double a[3] = { 0, 0, -1 };
-    if (v && sscanf(v, " %lf%*[ ,]%lf%*[ ,]%lf", &a[0], &a[1], &a[2]) != 3)
+    if (v && config_parse_numbers(v, a, 3, NULL, 0) != 0)
         return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s: [KINS] TOOL_AXIS = %s: expected three "
                     "numbers x y z", ini, v);
     double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
@@ -57,7 +53,7 @@ static int read_interp_settings(struct check_machine *mc, const char *ini, char 
                                 size_t errlen)
 {
     char msg[1024], where[1536];
-    int st = interp_settings_read(&mc->interp, ini_get, mc->hal, hal_ini_dir(mc->hal), msg,
+    int st = interp_settings_read(&mc->interp, hal_ini_lookup, mc->hal, hal_ini_dir(mc->hal), msg,
                                   sizeof msg);
     if (st != INTERP_OK)
         return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s",
@@ -95,11 +91,11 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
     }
     tooltable_init(mc->tt);
     snprintf(mc->ini, sizeof mc->ini, "%s", ini);
-    if (hal_load_ini(mc->hal, ini) != HAL_OK) {
+    if (hal_load_machine_ini(mc->hal, ini) != HAL_OK) {
         st = errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", hal_last_error(mc->hal));
         goto fail;
     }
-    struct kins_config kc = { ini_get, mc->hal };
+    struct kins_config kc = { hal_ini_lookup, mc->hal };
     const char *name = hal_ini_get(mc->hal, "KINS", "KINEMATICS");
     char msg[768];
     if (!name) {

@@ -19,7 +19,7 @@ static void print_d(double v)
 static void extra(const char *root)
 {
     static const char *const ini[2] = { "tests/check/tmu-path1-fine.ini",
-                                        "configs/sim/tmu-hexapod.ini" };
+                                        "tests/check/tmu-path1-vertical.ini" };
     static const char *const what[2] = { "drives with 0.25 nm steps", "head left vertical" };
     int n;
     printf("\nrun 1 on other machines:\n");

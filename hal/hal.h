@@ -58,8 +58,16 @@ int hal_error(struct hal *h, int status, const char *fmt, ...)
 /* Reads an INI file (libinih) into the runtime; `[SECTION]KEY` in HAL files and
  * hal_ini_get() then refer to it. Errors name the file and line. */
 int hal_load_ini(struct hal *h, const char *path);
+/* hal_load_ini, then the whole-file check of every section and key against hexcnc's table
+ * (common/config.h, docs/ini.md): what every command that runs a machine calls, so that a
+ * misspelt or out-of-range key stops it before anything starts. HAL_ERR_SYNTAX with every
+ * problem ("PATH:LINE: [SECTION] KEY ...", one per line) in the message. */
+int hal_load_machine_ini(struct hal *h, const char *path);
 /* Value of the first KEY in SECTION, or NULL. */
 const char *hal_ini_get(const struct hal *h, const char *section, const char *key);
+/* hal_ini_get for callers that hold the runtime as a void *: the one lookup behind the get()
+ * of struct kins_config, interp_setup() and the Modbus configuration reader. */
+const char *hal_ini_lookup(void *h, const char *section, const char *key);
 /* Value of the n-th (0-based) occurrence of a repeated key (e.g. [HAL] HALFILE), or NULL. */
 const char *hal_ini_get_n(const struct hal *h, const char *section, const char *key, int n);
 /* Typed readers: HAL_OK, HAL_ERR_NOT_FOUND when absent (out = def), HAL_ERR_SYNTAX when

@@ -1,8 +1,9 @@
-/* hal_ini.c: the runtime's INI file (common/inifile.c) and typed readers. */
-#include <errno.h>
+/* hal_ini.c: the runtime's INI file (common/inifile.c, checked by common/config.h) and typed
+ * readers (common/config_value.c's rules). */
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "hal/hal_priv.h"
 
 /* Frees the INI entries and paths. */
@@ -23,6 +24,19 @@ int hal_load_ini(struct hal *h, const char *path)
     return hal_error(h, hst, "%s", err);
 }
 
+/* Reads the INI and checks it whole against the key table. */
+int hal_load_machine_ini(struct hal *h, const char *path)
+{
+    int st = hal_load_ini(h, path);
+    if (st != HAL_OK)
+        return st;
+    char err[sizeof h->err];
+    if (config_check(&h->ini, err, sizeof err) == CONFIG_OK)
+        return HAL_OK;
+    inifile_free(&h->ini);
+    return hal_error(h, HAL_ERR_SYNTAX, "%s", err);
+}
+
 /* The n-th occurrence of [section]key, or NULL. */
 const char *hal_ini_get_n(const struct hal *h, const char *section, const char *key, int n)
 {
@@ -33,6 +47,12 @@ const char *hal_ini_get_n(const struct hal *h, const char *section, const char *
 const char *hal_ini_get(const struct hal *h, const char *section, const char *key)
 {
     return inifile_get(&h->ini, section, key);
+}
+
+/* hal_ini_get through a void * (kins_config, interp_setup, modbus_cfg). */
+const char *hal_ini_lookup(void *h, const char *section, const char *key)
+{
+    return hal_ini_get(h, section, key);
 }
 
 const char *hal_ini_path(const struct hal *h)
@@ -68,10 +88,8 @@ int hal_ini_double(struct hal *h, const char *section, const char *key, double d
     *out = def;
     if (!v)
         return HAL_ERR_NOT_FOUND;
-    char *end;
-    errno = 0;
-    double d = strtod(v, &end);
-    if (end == v || *end || errno == ERANGE)
+    double d;
+    if (config_parse_number(v, &d, NULL, 0) != 0)
         return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a number",
                          hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = d;
@@ -85,10 +103,8 @@ int hal_ini_int(struct hal *h, const char *section, const char *key, long def, l
     *out = def;
     if (!v)
         return HAL_ERR_NOT_FOUND;
-    char *end;
-    errno = 0;
-    long n = strtol(v, &end, 10);
-    if (end == v || *end || errno == ERANGE)
+    long n;
+    if (config_parse_integer(v, &n, NULL, 0) != 0)
         return hal_error(h, HAL_ERR_SYNTAX, "%s:%d: [%s]%s = '%s' is not a whole number",
                          hal_ini_path(h), inifile_line(&h->ini, section, key), section, key, v);
     *out = n;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "common/config.h"
 #include "hal/hal_priv.h"
 
 /* Lower-case type name as halcmd shows it. */
@@ -44,13 +45,8 @@ int hal_parse_value(enum hal_type type, const char *text, union hal_data *out)
         else
             return HAL_ERR_SYNTAX;
         return HAL_OK;
-    case HAL_FLOAT: {
-        double v = strtod(text, &end);
-        if (end == text || *end || errno == ERANGE)
-            return HAL_ERR_SYNTAX;
-        out->f = v;
-        return HAL_OK;
-    }
+    case HAL_FLOAT:   /* the configuration's number rules: finite, decimal, nothing after */
+        return config_parse_number(text, &out->f, NULL, 0) == 0 ? HAL_OK : HAL_ERR_SYNTAX;
     case HAL_S32: {
         long long v = strtoll(text, &end, 0);
         if (end == text || *end || errno == ERANGE || v < INT32_MIN || v > INT32_MAX)

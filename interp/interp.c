@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "interp/interp_int.h"
@@ -155,12 +156,12 @@ void interp_set_block_delete(struct interp *in, int on)
     in->block_delete = on != 0;
 }
 
-/* FEED_UNITS text to the F multiplier. */
+/* FEED_UNITS text to the F multiplier (any case, as every enum key of docs/ini.md). */
 int interp_feed_units_parse(const char *name, double *factor)
 {
-    if (strcmp(name, "mm/min") == 0)
+    if (strcasecmp(name, "mm/min") == 0)
         *factor = 1.0;
-    else if (strcmp(name, "m/min") == 0)
+    else if (strcasecmp(name, "m/min") == 0)
         *factor = 1000.0;
     else
         return -1;

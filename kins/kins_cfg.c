@@ -1,11 +1,11 @@
-/* kins_cfg.c: number parsing for kinematics configuration, with key-naming messages. */
-#include <errno.h>
-#include <math.h>
+/* kins_cfg.c: kinematics configuration values (common/config_value.c's rules), with
+ * key-naming messages. */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "kins/kins_cfg.h"
 
 /* Formats a configuration error so the user sees which section and key to fix. */
@@ -24,20 +24,8 @@ int kins_cfg_error(char *err, size_t errlen, const char *section, const char *ke
     return KINS_ERR_CONFIG;
 }
 
-/* Skips blanks and at most one comma, so "1 2 3" and "1, 2, 3" both read. */
-static const char *kins_cfg_skip_sep(const char *s, int allow_comma)
-{
-    while (*s == ' ' || *s == '\t')
-        s++;
-    if (allow_comma && *s == ',') {
-        s++;
-        while (*s == ' ' || *s == '\t')
-            s++;
-    }
-    return s;
-}
-
-/* Reads n numbers from one key; see kins_cfg.h for the absent-key rule. */
+/* Reads n numbers from one key (common/config_value.c's rules); see kins_cfg.h for the
+ * absent-key rule. */
 int kins_cfg_numbers(const struct kins_config *cfg, const char *section, const char *key,
                      double *out, int n, int *found, char *err, size_t errlen)
 {
@@ -49,34 +37,13 @@ int kins_cfg_numbers(const struct kins_config *cfg, const char *section, const c
             return KINS_OK;
         return kins_cfg_error(err, errlen, section, key, "missing");
     }
-    double vals[KINS_MAX_JOINTS];
     if (n < 1 || n > KINS_MAX_JOINTS)
         return kins_cfg_error(err, errlen, section, key, "internal: bad count %d", n);
-    const char *s = kins_cfg_skip_sep(text, 0);
-    for (int i = 0; i < n; i++) {
-        if (i > 0)
-            s = kins_cfg_skip_sep(s, 1);
-        char *end;
-        errno = 0;
-        double v = strtod(s, &end);
-        if (end == s || errno == ERANGE || !isfinite(v)) {
-            if (n == 1)
-                return kins_cfg_error(err, errlen, section, key, "'%s' is not a number", text);
-            return kins_cfg_error(err, errlen, section, key,
-                                  "'%s': expected %d numbers, number %d is missing or wrong",
-                                  text, n, i + 1);
-        }
-        vals[i] = v;
-        s = end;
-    }
-    s = kins_cfg_skip_sep(s, 0);
-    if (*s != '\0') {
-        if (n == 1)
-            return kins_cfg_error(err, errlen, section, key, "'%s' is not a number", text);
-        return kins_cfg_error(err, errlen, section, key,
-                              "'%s': expected %d numbers, found more text", text, n);
-    }
-    memcpy(out, vals, (size_t)n * sizeof *out);
+    char why[128];
+    if (n == 1 && config_parse_number(text, out, why, sizeof why) != 0)
+        return kins_cfg_error(err, errlen, section, key, "'%s' is not a number", text);
+    if (n > 1 && config_parse_numbers(text, out, n, why, sizeof why) != 0)
+        return kins_cfg_error(err, errlen, section, key, "'%s': %s", text, why);
     return KINS_OK;
 }
 

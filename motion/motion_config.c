@@ -1,11 +1,11 @@
 /* motion_config.c: motion configuration defaults, reading it from the INI, status texts. */
-#include <errno.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "motion/motion_priv.h"
 
 /* One text per status, in enum order. */
@@ -63,21 +63,25 @@ void motion_config_default(struct motion_config *c)
     }
 }
 
-/* Reads one number [sec]key into *out (times scale); absent keeps *out. */
+/* Reads one number [sec]key into *out (times scale). Absent: keeps *out, or fails when the
+ * key is a limit that protects the machine (required: no built-in default). */
 static int read_num(const struct kins_config *cfg, const char *sec, const char *key,
-                    double scale, int allow_zero, double *out, char *err, size_t errlen)
+                    double scale, int allow_zero, int required, double *out, char *err,
+                    size_t errlen)
 {
     const char *v = cfg->get(cfg->ctx, sec, key);
+    if (!v && required) {
+        snprintf(err, errlen, "[%s] %s: missing; a limit that protects the machine has no "
+                 "default (docs/ini.md)", sec, key);
+        return MOTION_ERR_CONFIG;
+    }
     if (!v)
         return MOTION_OK;
-    char *end;
-    errno = 0;
-    double d = strtod(v, &end);
-    while (*end == ' ' || *end == '\t')
-        end++;
-    if (end == v || *end || errno || !isfinite(d) || d < 0 || (d == 0 && !allow_zero)) {
-        snprintf(err, errlen, "[%s]%s = \"%s\": expected a %s number", sec, key, v,
-                 allow_zero ? "non-negative" : "positive");
+    double d;
+    char why[64];
+    if (config_parse_number(v, &d, why, sizeof why) != 0 ||
+        config_in_range(d, allow_zero ? ">= 0" : "> 0", why, sizeof why) != 0) {
+        snprintf(err, errlen, "[%s] %s = %s: %s", sec, key, v, why);
         return MOTION_ERR_CONFIG;
     }
     *out = d * scale;
@@ -103,23 +107,27 @@ static int check_config(const struct motion_config *c, char *err, size_t errlen)
     return MOTION_OK;
 }
 
-/* The machine-wide keys: section, key, scale to the field's unit, 0 allowed, field. */
+/* The machine-wide keys: section, key, scale to the field's unit, 0 allowed, required (the
+ * path limits have no default), field. Types and ranges: common/config_keys.c. */
 static const struct motion_key {
     const char *sec, *key;
     double scale;
-    int zero_ok;
+    int zero_ok, required;
     size_t off;
 } motion_keys[] = {
-    {"EMCMOT", "SERVO_PERIOD", 1e-9, 0, offsetof(struct motion_config, servo_period_s)},
-    {"TRAJ", "SETPOINT_PERIOD", 1e-9, 1, offsetof(struct motion_config, setpoint_period_s)},
-    {"TRAJ", "MAX_LINEAR_VELOCITY", 1, 0, offsetof(struct motion_config, max_lin_vel_mm_s)},
-    {"TRAJ", "MAX_LINEAR_ACCELERATION", 1, 0, offsetof(struct motion_config, max_lin_acc_mm_s2)},
-    {"TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, offsetof(struct motion_config, max_ang_vel_deg_s)},
-    {"TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, offsetof(struct motion_config, max_ang_acc_deg_s2)},
-    {"TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, offsetof(struct motion_config, default_lin_vel_mm_s)},
-    {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, offsetof(struct motion_config, kin_tol_mm)},
-    {"TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, offsetof(struct motion_config, kin_tol_deg)},
-    {"TRAJ", "BLEND_TOLERANCE", 1, 1, offsetof(struct motion_config, blend_tol_mm)},
+    {"EMCMOT", "SERVO_PERIOD", 1e-9, 0, 0, offsetof(struct motion_config, servo_period_s)},
+    {"TRAJ", "SETPOINT_PERIOD", 1e-9, 1, 0, offsetof(struct motion_config, setpoint_period_s)},
+    {"TRAJ", "MAX_LINEAR_VELOCITY", 1, 0, 1, offsetof(struct motion_config, max_lin_vel_mm_s)},
+    {"TRAJ", "MAX_LINEAR_ACCELERATION", 1, 0, 1,
+     offsetof(struct motion_config, max_lin_acc_mm_s2)},
+    {"TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, 1, offsetof(struct motion_config, max_ang_vel_deg_s)},
+    {"TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, 1,
+     offsetof(struct motion_config, max_ang_acc_deg_s2)},
+    {"TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, 0,
+     offsetof(struct motion_config, default_lin_vel_mm_s)},
+    {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_mm)},
+    {"TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_deg)},
+    {"TRAJ", "BLEND_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, blend_tol_mm)},
 };
 
 /* Reads [EMCMOT], [TRAJ] and [JOINT_n] through cfg (see motion.h). */
@@ -130,24 +138,29 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
         snprintf(err, errlen, "motion configuration: bad arguments");
         return MOTION_ERR_ARG;
     }
-    double opt = c->optional_stop;
     int st = MOTION_OK;
     c->njoints = njoints;
     for (size_t i = 0; i < sizeof motion_keys / sizeof motion_keys[0] && !st; i++) {
         const struct motion_key *k = &motion_keys[i];
-        st = read_num(cfg, k->sec, k->key, k->scale, k->zero_ok,
+        st = read_num(cfg, k->sec, k->key, k->scale, k->zero_ok, k->required,
                       (double *)(void *)((char *)c + k->off), err, errlen);
     }
-    st = st ? st : read_num(cfg, "TRAJ", "OPTIONAL_STOP", 1, 1, &opt, err, errlen);
+    const char *opt_text = cfg->get(cfg->ctx, "TRAJ", "OPTIONAL_STOP");
+    int opt = c->optional_stop;
+    if (!st && opt_text && config_parse_bool(opt_text, &opt, NULL, 0) != 0) {
+        snprintf(err, errlen, "[TRAJ] OPTIONAL_STOP = %s: expected 0 or 1", opt_text);
+        st = MOTION_ERR_CONFIG;
+    }
     for (int i = 0; i < njoints && !st; i++) {
         char sec[24];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
         struct motion_joint_config *j = &c->joint[i];
-        st = read_num(cfg, sec, "MAX_VELOCITY", 1, 0, &j->max_vel_mm_s, err, errlen);
-        st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, &j->max_acc_mm_s2, err,
+        st = read_num(cfg, sec, "MAX_VELOCITY", 1, 0, 1, &j->max_vel_mm_s, err, errlen);
+        st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, 1, &j->max_acc_mm_s2, err,
                                 errlen);
-        st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, &j->ferror_mm, err, errlen);
-        st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, &j->min_ferror_mm, err, errlen);
+        st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, 1, &j->ferror_mm, err, errlen);
+        st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, 0, &j->min_ferror_mm, err,
+                                errlen);
     }
     c->optional_stop = opt != 0;
     return st ? st : check_config(c, err, errlen);

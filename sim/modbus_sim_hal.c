@@ -28,12 +28,6 @@ static void modbus_sim_hal_free(void *arg)
     modbus_sim_destroy(arg);
 }
 
-/* The lookup the INI reader uses. */
-static const char *modbus_sim_hal_ini_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 /* Parses count= and section=. */
 static int modbus_sim_hal_args(struct hal *h, int argc, char **argv, long *count, char *section,
                                size_t len)
@@ -103,13 +97,13 @@ static int modbus_sim_hal_load(struct hal *h, int argc, char **argv)
     int rc = modbus_sim_hal_args(h, argc, argv, &count, section, sizeof(section));
     if (rc)
         return rc;
-    if (count < 0 && (count = modbus_cfg_drive_count(section, modbus_sim_hal_ini_get, h,
+    if (count < 0 && (count = modbus_cfg_drive_count(section, hal_ini_lookup, h,
                                                      hal_ini_path(h), 1, 64, err,
                                                      sizeof(err))) < 0)
         return hal_error(h, HAL_ERR_COMPONENT, "modbus-sim-server: %s", err);
     struct modbus_drive_cfg cfg[64];
     for (int i = 0; i < count; i++) {
-        if (modbus_cfg_read(&cfg[i], i, section, modbus_sim_hal_ini_get, h, hal_ini_path(h),
+        if (modbus_cfg_read(&cfg[i], i, section, hal_ini_lookup, h, hal_ini_path(h),
                             err, sizeof(err)))
             return hal_error(h, HAL_ERR_COMPONENT, "modbus-sim-server: %s", err);
         if (cfg[i].transport != MODBUS_DRIVE_TCP)

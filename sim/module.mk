@@ -13,15 +13,19 @@ HAL_COMPS += cia402_sim
 # `make run`: the simulated TMU hexapod on the paper's programs, each started the way a
 # machinist starts it (scripts/hexcnc-start): program (10) with the 20 mm tool and program
 # (11) with the 10 mm tool, with G141 and with G142, then path 1 with both tools in one
-# program, radii from the tool table. Each prints its plan, progress and summary.
+# program, radii from the tool table. Each prints its plan, progress and summary. They run on
+# the paper's machine for path 1 (examples/paper/experiment/tmu-path1.ini: F in m/min as the
+# paper writes it, the head tilted to the table's normal at B-4 so the compensated wall lies
+# on the contour, docs/experiment.md), the simulated TMU hexapod of configs/sim otherwise.
 SIM_RUN_PROGRAMS := prog10_g141_d20 prog11_g141_d10 prog10_g142_d20 prog11_g142_d10 \
                     path1_tooltable
+SIM_RUN_INI := examples/paper/experiment/tmu-path1.ini
 run: all
 	@for p in $(SIM_RUN_PROGRAMS); do \
 	    echo; echo "== examples/paper/$$p.ngc"; \
-	    $(RUN_ENV) sh scripts/hexcnc-start configs/sim/tmu-hexapod.ini \
+	    $(RUN_ENV) sh scripts/hexcnc-start $(SIM_RUN_INI) \
 	        examples/paper/$$p.ngc || exit $$?; \
 	    mkdir -p $(BUILD)/plots/$$p; \
-	    $(RUN_ENV) $(HEXCNC) check --plot $(BUILD)/plots/$$p configs/sim/tmu-hexapod.ini \
+	    $(RUN_ENV) $(HEXCNC) check --plot $(BUILD)/plots/$$p $(SIM_RUN_INI) \
 	        examples/paper/$$p.ngc > $(BUILD)/plots/$$p/check.txt || exit $$?; \
 	done; echo; echo "plots (contour vs tool path, legs, deviation): $(BUILD)/plots/*/*.svg"

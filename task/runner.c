@@ -134,7 +134,7 @@ int runner_create(const struct runner_opts *opts, struct runner **out, char *err
         return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
     int st;
-    if (hal_load_ini(r->hal, opts->ini_path) != HAL_OK) {
+    if (hal_load_machine_ini(r->hal, opts->ini_path) != HAL_OK) {
         st = errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
         goto fail;
     }
@@ -174,19 +174,13 @@ const char *runner_default_program(const struct runner *r)
     return r->default_program[0] ? r->default_program : NULL;
 }
 
-/* The INI lookup interp_setup reads through. */
-static const char *runner_ini_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 /* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE (interp_setup: the same code
  * hexcnc check and hexcnc interp use); a bad value is pointed at its INI line. */
 int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt, char *err,
                         size_t errlen)
 {
     char msg[1024];
-    int st = interp_setup(in, tt, runner_ini_get, r->hal, hal_ini_dir(r->hal), 0, msg,
+    int st = interp_setup(in, tt, hal_ini_lookup, r->hal, hal_ini_dir(r->hal), 0, msg,
                           sizeof msg);
     if (st == INTERP_OK)
         return RUNNER_OK;

@@ -12,6 +12,8 @@
 #include "tests/test_check_util.h"
 
 #define TMU_INI "configs/sim/tmu-hexapod.ini"
+/* The paper's programs run on the paper's machine: F in m/min, the head tilted at B-4. */
+#define PAPER_INI "examples/paper/experiment/tmu-path1.ini"
 #define PAPER_PROG "examples/paper/prog10_g141_d20.ngc"
 
 /* Runs the check of program on ini; returns the status, res filled (caller frees). */
@@ -41,7 +43,7 @@ static const struct check_problem *find(const struct check_result *r, enum check
 START_TEST(test_good_program)
 {
     struct check_result r;
-    ck_assert_int_eq(run(TMU_INI, PAPER_PROG, NULL, &r), CHECK_OK);
+    ck_assert_int_eq(run(PAPER_INI, PAPER_PROG, NULL, &r), CHECK_OK);
     ck_assert_uint_eq(r.nproblems, 0);
     ck_assert(r.simulated);
     ck_assert_int_eq(r.njoints, 6);
@@ -178,7 +180,7 @@ START_TEST(test_json_and_exit_status)
     int fd = mkstemp(out);
     ck_assert(fd >= 0);
     close(fd);
-    ck_assert_int_eq(run_binary("--json " TMU_INI " " PAPER_PROG, out), 0);
+    ck_assert_int_eq(run_binary("--json " PAPER_INI " " PAPER_PROG, out), 0);
     char *j = tc_read(out);
     ck_assert(j && tj_valid(j));
     const char *keys[] = { "\"ok\":true", "\"machining_time_s\":", "\"deviation\":{",
@@ -280,7 +282,7 @@ START_TEST(test_plots_written)
     int fd = mkstemp(out);
     close(fd);
     char args[1200];
-    snprintf(args, sizeof args, "--plot %s " TMU_INI " " PAPER_PROG, dir);
+    snprintf(args, sizeof args, "--plot %s " PAPER_INI " " PAPER_PROG, dir);
     ck_assert_int_eq(run_binary(args, out), 0);
     const char *files[] = { "toolpath_top.svg", "toolpath_3d.svg", "legs.svg", "leg_rates.svg",
                             "deviation.svg" };
@@ -303,7 +305,7 @@ START_TEST(test_plots_written)
 }
 END_TEST
 
-/* A bad kinematics value in the INI: the message names the file and the key's line. */
+/* A bad value in the INI: the check at load names the file and the key's line. */
 START_TEST(test_config_error_names_the_ini_line)
 {
     char path[] = "/tmp/hexcnc-check-ini-XXXXXX", err[1024], want[256];
@@ -313,11 +315,12 @@ START_TEST(test_config_error_names_the_ini_line)
     fprintf(f, "[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\nPLATFORM_RADIUS = 300\n"
                "BASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = 10\n");
     for (int i = 0; i < 6; i++)
-        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\n", i, i == 3 ? "abc" : "980");
+        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\nMAX_VELOCITY = 100\n"
+                   "MAX_ACCELERATION = 1000\nFERROR = 1\n", i, i == 3 ? "abc" : "980");
     fclose(f);
     struct check_machine *mc = NULL;
-    ck_assert_int_eq(check_machine_open(path, &mc, err, sizeof err), CHECK_ERR_KINS);
-    snprintf(want, sizeof want, "%s:18: [JOINT_3] MAX_LIMIT: 'abc' is not a number", path);
+    ck_assert_int_eq(check_machine_open(path, &mc, err, sizeof err), CHECK_ERR_CONFIG);
+    snprintf(want, sizeof want, "%s:27: [JOINT_3] MAX_LIMIT = abc: not a number (mm)", path);
     ck_assert_str_eq(err, want);
     ck_assert_ptr_null(mc);
     unlink(path);

@@ -57,7 +57,7 @@ static void compare(const char *ini_rel, const char *prog_rel)
 
 START_TEST(test_check_agrees_with_run)
 {
-    compare("configs/sim/tmu-hexapod.ini", "examples/paper/path1_tooltable.ngc");
+    compare("examples/paper/experiment/tmu-path1.ini", "examples/paper/path1_tooltable.ngc");
     compare("examples/paper/experiment/tmu-path2.ini", "examples/paper/experiment/run4_g141.ngc");
 }
 END_TEST
@@ -109,7 +109,7 @@ START_TEST(test_check_uses_the_parameter_file)
     const char *param_text = "5220\t1.000000\n5221\t40.000000\n5222\t-30.000000\n"
                              "5223\t-12.000000\n";
     put_file(dir, "params.var", param_text, params, sizeof params);
-    put_file(dir, "g54.ngc", "G21 G90 G54\nG1 X10 Y5 Z640 A0 B0 C0 F1\nG1 X-10 Y-5 Z635\n"
+    put_file(dir, "g54.ngc", "G21 G90 G54\nG1 X10 Y5 Z640 A0 B0 C0 F1000\nG1 X-10 Y-5 Z635\n"
              "M2\n", prog, sizeof prog);
 
     struct check_machine *mc;

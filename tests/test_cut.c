@@ -106,7 +106,7 @@ START_TEST(test_untilted_head_breaks_coincidence)
 {   /* the tool left vertical on the tilted table: the compensation's V is in the table plane,
      * the tool's radius is not, and the two tools' walls part by W2 - W1 times (1/cos B - 1)
      * and more at the top face */
-    struct exp_result r = run_exp(0, "configs/sim/tmu-hexapod.ini");
+    struct exp_result r = run_exp(0, "tests/check/tmu-path1-vertical.ini");
     ck_assert_msg(fabs(r.part_diff_um) > 5, "%.3f um", r.part_diff_um);
 }
 END_TEST

@@ -89,10 +89,20 @@ static void observe(void *ctx, const struct runner_sample *s)
     w->have_prev = 1;
 }
 
+/* The paper's machine for path 1 (F in m/min, as the paper's programs and these tests write
+ * it; the head tilted at B-4), on the HAL files of configs/sim. */
+static const char *paper_ini(void)
+{
+    static char path[1024];
+    const char *root = getenv("HEXCNC_ROOT");
+    snprintf(path, sizeof path, "%s/examples/paper/experiment/tmu-path1.ini", root ? root : ".");
+    return path;
+}
+
 /* A runner on the simulated machine with the observer set up from its configuration. */
 static struct runner *make_runner(struct watch *w)
 {
-    struct runner_opts o = { sim_ini(), RUNNER_CLOCK_SIM };
+    struct runner_opts o = { paper_ini(), RUNNER_CLOCK_SIM };
     struct runner *r;
     char err[1024];
     int st = runner_create(&o, &r, err, sizeof err);

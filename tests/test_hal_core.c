@@ -166,6 +166,11 @@ START_TEST(setp_rules_and_values)
                      "'t.0.in1'");
     ck_assert_int_eq(hal_setp(h, "t.0.gain", "0.25"), HAL_OK);
     ck_assert(c.gain == 0.25);
+    /* floats follow the configuration's number rules: no NaN, infinity or hexadecimal */
+    ck_assert_int_eq(hal_setp(h, "t.0.gain", "nan"), HAL_ERR_SYNTAX);
+    ck_assert_int_eq(hal_setp(h, "t.0.gain", "inf"), HAL_ERR_SYNTAX);
+    ck_assert_int_eq(hal_setp(h, "t.0.gain", "0x10"), HAL_ERR_SYNTAX);
+    ck_assert(c.gain == 0.25);
     ck_assert_int_eq(hal_setp(h, "t.0.count", "3"), HAL_ERR_DIR);
     ck_assert_str_eq(hal_last_error(h), "setp: parameter 't.0.count' is read-only");
     ck_assert_int_eq(hal_setp(h, "t.0.nope", "3"), HAL_ERR_NOT_FOUND);

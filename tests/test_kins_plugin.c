@@ -265,12 +265,13 @@ START_TEST(test_cli_config_errors)
     fprintf(f, "[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\nPLATFORM_RADIUS = 300\n"
                "BASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = 10\n");
     for (int i = 0; i < 6; i++)
-        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\n", i, i == 3 ? "abc" : "980");
+        fprintf(f, "[JOINT_%d]\nMIN_LIMIT = 520\nMAX_LIMIT = %s\nMAX_VELOCITY = 100\n"
+                   "MAX_ACCELERATION = 1000\nFERROR = 1\n", i, i == 3 ? "abc" : "980");
     fclose(f);
     snprintf(cmd, sizeof cmd, "'%s' kins '%s' inverse 0 0 645 0 0 0", bin, path);
     ck_assert_int_eq(run(cmd, out, sizeof out), 1);
     char want[256];
-    snprintf(want, sizeof want, "%s:18: [JOINT_3] MAX_LIMIT: 'abc' is not a number", path);
+    snprintf(want, sizeof want, "%s:27: [JOINT_3] MAX_LIMIT = abc: not a number (mm)", path);
     ck_assert_msg(strstr(out, want), "%s", out);
 
     f = fopen(path, "w");

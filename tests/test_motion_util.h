@@ -36,6 +36,7 @@ static inline struct tk_cfg *tm_trivial_cfg(void)
         tk_set(c, sec, "MAX_LIMIT", "1000");
         tk_set(c, sec, "MAX_VELOCITY", "1000");
         tk_set(c, sec, "MAX_ACCELERATION", "10000");
+        tk_set(c, sec, "FERROR", "1");
     }
     tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "100");
     tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "1000");

@@ -92,7 +92,7 @@ int cmd_halcmd(int argc, char **argv)
     }
     hal_set_sim_clock(h, sim);
     hal_set_start_run(h, (int64_t)run_ms * 1000000);
-    int st = ini ? hal_load_ini(h, ini) : HAL_OK;
+    int st = ini ? hal_load_machine_ini(h, ini) : HAL_OK;
     if (st == HAL_OK)
         st = file ? hal_source(h, file) : i < argc ? halcmd_words(h, argc - i, argv + i)
                                                    : halcmd_stdin(h);

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/inifile.h"
+#include "common/config.h"
 #include "interp/interp.h"
 #include "interp/interp_setup.h"
 #include "interp/printer.h"
@@ -26,7 +26,7 @@ static int apply_ini(struct interp *in, const char *path, struct tooltable *tt)
 {
     struct inifile ini = { 0 };
     char err[1024], msg[1536];
-    if (inifile_load(&ini, path, err, sizeof err) != INIFILE_OK) {
+    if (config_load(&ini, path, err, sizeof err) != CONFIG_OK) {
         fprintf(stderr, "error: %s\n", err);
         return -1;
     }

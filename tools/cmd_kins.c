@@ -1,11 +1,10 @@
 /* cmd_kins.c: `hexcnc kins CONFIG.ini inverse X Y Z A B C | forward L1..L6`. */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/inifile.h"
+#include "common/config.h"
 #include "kins/kins.h"
 #include "tools/cmd.h"
 
@@ -16,10 +15,7 @@ const char cmd_kins_usage[] =
 static int kins_parse_args(char **argv, int n, const char *const *names, double *out)
 {
     for (int i = 0; i < n; i++) {
-        char *end;
-        errno = 0;
-        out[i] = strtod(argv[i], &end);
-        if (end == argv[i] || *end != '\0' || errno == ERANGE || !isfinite(out[i])) {
+        if (config_parse_number(argv[i], &out[i], NULL, 0) != 0) {
             fprintf(stderr, "hexcnc kins: %s: '%s' is not a number\n", names[i], argv[i]);
             return -1;
         }
@@ -110,7 +106,7 @@ int cmd_kins(int argc, char **argv)
     }
     struct inifile ini = { 0 };
     char err[1024], msg[1536];
-    if (inifile_load(&ini, argv[1], err, sizeof err) != INIFILE_OK) {
+    if (config_load(&ini, argv[1], err, sizeof err) != CONFIG_OK) {
         fprintf(stderr, "hexcnc kins: %s\n", err);
         return 1;
     }

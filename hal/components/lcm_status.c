@@ -1,5 +1,4 @@
 /* lcm_status.c: the `lcm-status` HAL component: pins, the servo-thread sample, events, API. */
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -7,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "common/config.h"
 #include "hal/components/lcm_status_priv.h"
 
 static const char lcm_axis_letter[LCM_AXES] = { 'x', 'y', 'z', 'a', 'b', 'c' };
@@ -250,12 +250,9 @@ static int lcm_config(struct hal *h, struct lcm_status *s, int argc, char **argv
     snprintf(s->url, sizeof s->url, "%s", url ? url : "");
 
     const char *rate = hal_arg(argc, argv, "rate");
-    char *end = NULL;
     int st = HAL_OK;
     if (rate) {
-        errno = 0;
-        s->rate_hz = strtod(rate, &end);
-        if (errno || end == rate || *end)
+        if (config_parse_number(rate, &s->rate_hz, NULL, 0) != 0)
             s->rate_hz = NAN;
     } else {
         st = hal_ini_double(h, "LCM", "RATE_HZ", 20.0, &s->rate_hz);
@@ -273,8 +270,7 @@ static int lcm_config(struct hal *h, struct lcm_status *s, int argc, char **argv
     const char *ring = hal_arg(argc, argv, "ring");
     *slots = LCM_RING_DEFAULT;
     if (ring) {
-        *slots = strtol(ring, &end, 10);
-        if (end == ring || *end || *slots < 2 || *slots > (1L << 20) || (*slots & (*slots - 1)))
+        if (config_parse_integer(ring, slots, NULL, 0) != 0 || *slots < 2 || *slots > (1L << 20) || (*slots & (*slots - 1)))
             return hal_error(h, HAL_ERR_ARG, "loadrt lcm-status: ring=%s: the ring size must "
                              "be a power of two from 2 to 1048576 samples", ring);
     }

@@ -99,12 +99,6 @@ static void motion_comp_free(void *arg)
     free(c);
 }
 
-/* kins_config over the runtime's INI. */
-static const char *motion_comp_ini(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 /* Pins, one group per call so each stays short. */
 static int motion_comp_joint_pins(struct hal *h, struct motion_comp *c)
 {
@@ -155,7 +149,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     if (st != HAL_OK)
         return st;
     struct motion_config cfg;
-    struct kins_config kc = { motion_comp_ini, h };
+    struct kins_config kc = { hal_ini_lookup, h };
     char err[400] = "";
     motion_config_default(&cfg);
     if (motion_config_read(&cfg, &kc, k->njoints, err, sizeof err) != MOTION_OK)

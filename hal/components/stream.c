@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "hal/hal.h"
 
 #define STREAM_MAX_COLS 32
@@ -129,10 +130,8 @@ static bool stream_parse(char t, const char *w, union stream_val *v)
         v->b = w[0] == '1';
         return true;
     }
-    if (t == 'f') {
-        v->f = strtod(w, &end);
-        return end != w && !*end && errno != ERANGE;
-    }
+    if (t == 'f')   /* the configuration's number rules (common/config_value.c) */
+        return config_parse_number(w, &v->f, NULL, 0) == 0;
     long long n = strtoll(w, &end, 0);
     if (end == w || *end || errno == ERANGE)
         return false;

@@ -8,6 +8,8 @@
 #include <string.h>
 #include <strings.h>
 
+#include "common/config.h"
+
 /* One lookup session: where to look and where to report. */
 struct modbus_cfg_reader {
     const char *section;          /* common section, e.g. MODBUS */
@@ -48,10 +50,8 @@ static int modbus_cfg_long(const struct modbus_cfg_reader *r, const char *key, l
     const char *where, *v = modbus_cfg_get(r, key, &where);
     if (!v)
         return MODBUS_DRIVE_OK;
-    char *end;
-    errno = 0;
-    long n = strtol(v, &end, 0);
-    if (end == v || *end || errno || n < lo || n > hi) {
+    long n;
+    if (config_parse_integer(v, &n, NULL, 0) != 0 || n < lo || n > hi) {
         char want[96];
         snprintf(want, sizeof(want), "expected a whole number from %ld to %ld", lo, hi);
         return modbus_cfg_bad(r, where, key, v, want);
@@ -67,9 +67,8 @@ static int modbus_cfg_double(const struct modbus_cfg_reader *r, const char *key,
     const char *where, *v = modbus_cfg_get(r, key, &where);
     if (!v)
         return MODBUS_DRIVE_OK;
-    char *end;
-    double x = strtod(v, &end);
-    if (end == v || *end || !isfinite(x) || (positive ? x <= 0.0 : x == 0.0))
+    double x;
+    if (config_parse_number(v, &x, NULL, 0) != 0 || (positive ? x <= 0.0 : x == 0.0))
         return modbus_cfg_bad(r, where, key, v, positive ? "expected a number above 0"
                                                          : "expected a non-zero number");
     *out = x;
@@ -194,9 +193,8 @@ int modbus_cfg_drive_count(const char *section, modbus_ini_get_fn get, void *ctx
     const char *v = get(ctx, section, "DRIVES");
     if (!v)
         return def;
-    char *end;
-    long n = strtol(v, &end, 10);
-    if (end == v || *end || n < 1 || n > max) {
+    long n;
+    if (config_parse_integer(v, &n, NULL, 0) != 0 || n < 1 || n > max) {
         snprintf(err, errlen, "%s: [%s] DRIVES = %s: expected a whole number from 1 to %d",
                  file ? file : "INI", section, v, max);
         return -1;

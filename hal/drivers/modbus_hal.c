@@ -49,12 +49,6 @@ struct modbus_hal {
     struct modbus_hal_drive d[MODBUS_HAL_MAX_DRIVES];
 };
 
-/* The lookup the INI reader uses. */
-static const char *modbus_hal_ini_get(void *ctx, const char *section, const char *key)
-{
-    return hal_ini_get(ctx, section, key);
-}
-
 /* Hands a fault to the shell once, when it is raised (from the I/O side). */
 static void modbus_hal_report(void *arg, const char *msg)
 {
@@ -167,7 +161,7 @@ static int modbus_hal_drive_new(struct hal *h, struct modbus_hal *c, int i, cons
 {
     struct modbus_drive_cfg cfg;
     char err[320];
-    if (modbus_cfg_read(&cfg, i, section, modbus_hal_ini_get, h, hal_ini_path(h), err,
+    if (modbus_cfg_read(&cfg, i, section, hal_ini_lookup, h, hal_ini_path(h), err,
                         sizeof(err)))
         return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s", err);
     struct modbus_hal_drive *d = &c->d[i];
@@ -220,7 +214,7 @@ static int modbus_hal_load(struct hal *h, int argc, char **argv)
     if (rc)
         return rc;
     if (count < 0) {
-        count = modbus_cfg_drive_count(section, modbus_hal_ini_get, h, hal_ini_path(h), 1,
+        count = modbus_cfg_drive_count(section, hal_ini_lookup, h, hal_ini_path(h), 1,
                                        MODBUS_HAL_MAX_DRIVES, err, sizeof(err));
         if (count < 0)
             return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s", err);

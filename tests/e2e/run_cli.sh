@@ -6,7 +6,9 @@ set -u
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
 start="$root/scripts/hexcnc-start"
-ini="$root/configs/sim/tmu-hexapod.ini"
+# The paper's machine for path 1: F in m/min as the paper's programs write it (configs/sim
+# reads mm/min), HAL files and tool table of configs/sim.
+ini="$root/examples/paper/experiment/tmu-path1.ini"
 tmp=$(mktemp -d /tmp/hexcnc-run-cli.XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 export HEXCNC_BIN="$bin"
@@ -47,14 +49,15 @@ check "unreachable point names line 3" has "$tmp/err" "far.ngc:3"
 
 # 5. A HAL file error names the HAL file and line.
 printf 'loadrt stepgen count=6\nnet leg-0-cmd nosuch.pin\n' >"$tmp/broken.hal"
-sed "s|^HALFILE = .*|HALFILE = $tmp/broken.hal|" "$ini" >"$tmp/broken.ini"
+sed "s|^HALFILE = .*|HALFILE = $tmp/broken.hal|; s|^TOOL_TABLE = \.\./\.\./\.\./|TOOL_TABLE = $root/|" \
+    "$ini" >"$tmp/broken.ini"
 "$bin" run "$tmp/broken.ini" "$tmp/far.ngc" >"$tmp/out" 2>"$tmp/err"
 check "HAL error exits 1" [ $? -eq 1 ]
 check "HAL error names file:line" has "$tmp/err" "broken.hal:2"
 
 # 6. Without the task's e-stop wiring the machine stays in e-stop: said at once, not hung.
-grep -v "^HALFILE = tmu-hexapod-task.hal" "$ini" | sed "s|^HALFILE = |HALFILE = $root/configs/sim/|" \
-    | sed "s|^TOOL_TABLE = |TOOL_TABLE = $root/configs/sim/|" >"$tmp/noreset.ini"
+grep -v "^HALFILE = .*tmu-hexapod-task.hal" "$ini" | sed "s|^HALFILE = \.\./\.\./\.\./|HALFILE = $root/|" \
+    | sed "s|^TOOL_TABLE = \.\./\.\./\.\./|TOOL_TABLE = $root/|" >"$tmp/noreset.ini"
 "$bin" run "$tmp/noreset.ini" "$root/examples/paper/prog10_g141_d20.ngc" >"$tmp/out" 2>"$tmp/err"
 check "held in e-stop exits 3" [ $? -eq 3 ]
 check "held in e-stop says so" has "$tmp/err" "did not come out of e-stop"

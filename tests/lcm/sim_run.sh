@@ -10,9 +10,11 @@ check=${HEXCNC_BUILD:-$root/build}/tests/lcm/lcm_check
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 
+# The paper's program runs on the paper's machine (F in m/min): its INI with the relative paths
+# made absolute, beside the copy of configs/sim's HAL files.
 cp "$root"/configs/sim/* "$tmp/"
-sed -i "s|^URL = .*|URL = file://$tmp/run.lcmlog?mode=w|; s|^RATE_HZ = .*|RATE_HZ = 20|" \
-    "$tmp/tmu-hexapod.ini"
+sed "s|^URL = .*|URL = file://$tmp/run.lcmlog?mode=w|; s|^RATE_HZ = .*|RATE_HZ = 20|; s|= \.\./\.\./\.\./configs/sim/|= $tmp/|" \
+    "$root/examples/paper/experiment/tmu-path1.ini" > "$tmp/tmu-hexapod.ini"
 if ! timeout 120 "$bin" run --quiet --sim-clock "$tmp/tmu-hexapod.ini" \
         "$root/examples/paper/prog10_g141_d20.ngc" > "$tmp/run.out" 2>&1; then
     echo "FAIL sim_run.sh: hexcnc run failed:"; cat "$tmp/run.out"; exit 1

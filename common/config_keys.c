@@ -1,0 +1,227 @@
+/* config_keys.c: every INI section and key hexcnc reads, with type, unit, range, default and
+ * meaning: the one place to add a key (grouped per section, one line per key). The whole-file
+ * check (config_check.c) and docs/ini.md (`make ini-doc`) are made from it.
+ *
+ * Columns: section, key, type, unit, range (numbers: "", "> A", ">= A", "A..B", "!= 0";
+ * enums: the words "a|b"), count (NUMBERS), flags, default ("" = none), meaning.
+ * '#' in a section or key name stands for an index: JOINT_# is JOINT_0, JOINT_1, ...; a
+ * final '*' for any ending (AXIS_* is AXIS_X, AXIS_Y, ...). */
+#include "common/config.h"
+
+#define NUM CONFIG_NUMBER
+#define NUMS CONFIG_NUMBERS
+#define INT CONFIG_INTEGER
+#define BOOL CONFIG_BOOL
+#define STR CONFIG_STRING
+#define PATH CONFIG_PATH
+#define ENUM CONFIG_ENUM
+#define REQ CONFIG_REQUIRED
+#define REP CONFIG_REPEAT
+#define IGN CONFIG_IGNORED
+
+const struct config_section config_sections[] = {
+    { "EMC", CONFIG_OPEN, "LinuxCNC's machine description; hexcnc reads none of it" },
+    { "KINS", CONFIG_STRICT, "kinematics model and hexapod geometry (docs/kinematics.md)" },
+    { "TRAJ", CONFIG_STRICT, "path limits and the kinematic-error bound (docs/motion.md)" },
+    { "EMCMOT", CONFIG_STRICT, "servo period and clock" },
+    { "JOINT_#", CONFIG_STRICT, "one leg: length limits, speed limits, following error, "
+      "step generator" },
+    { "RS274NGC", CONFIG_STRICT, "interpreter settings (docs/gcode.md)" },
+    { "EMCIO", CONFIG_OPEN, "LinuxCNC's I/O controller; hexcnc reads TOOL_TABLE only" },
+    { "HAL", CONFIG_STRICT, "HAL files run when the machine starts (docs/hal.md)" },
+    { "TASK", CONFIG_STRICT, "`hexcnc run` (docs/running.md)" },
+    { "DISPLAY", CONFIG_OPEN, "LinuxCNC's GUI settings; hexcnc reads OPEN_FILE only" },
+    { "LCM", CONFIG_STRICT, "status publishing over LCM (docs/lcm.md)" },
+    { "MODBUS", CONFIG_STRICT, "Modbus drives, settings common to all (docs/modbus.md)" },
+    { "MODBUS_DRIVE_#", CONFIG_STRICT, "one Modbus drive: any [MODBUS] key except DRIVES, "
+      "for this drive only" },
+    { "MODBUS_SIM", CONFIG_STRICT, "the simulated Modbus drives" },
+    { "CAN", CONFIG_STRICT, "CANopen bus and CiA 402 master (docs/can.md)" },
+    { "CAN_NODE_#", CONFIG_STRICT, "one CiA 402 drive, joint #" },
+    /* Other programs' sections, accepted and ignored so a LinuxCNC INI can be used. */
+    { "HALUI", CONFIG_FOREIGN, "LinuxCNC's halui" },
+    { "FILTER", CONFIG_FOREIGN, "LinuxCNC's program filters" },
+    { "AXIS_*", CONFIG_FOREIGN, "LinuxCNC's per-axis limits (hexcnc limits legs, [JOINT_#], "
+      "and the path, [TRAJ])" },
+    { "SPINDLE_#", CONFIG_FOREIGN, "LinuxCNC's spindle settings" },
+    { "PYTHON", CONFIG_FOREIGN, "LinuxCNC's Python plugins" },
+    { "TOOLSENSOR", CONFIG_FOREIGN, "LinuxCNC GUIs' tool sensor" },
+};
+const int config_nsections = sizeof config_sections / sizeof config_sections[0];
+
+const struct config_key config_keys[] = {
+    /* [EMC]: LinuxCNC's, documented here because hexcnc's own INIs carry them. */
+    { "EMC", "MACHINE", STR, "", "", 0, IGN, "", "machine name shown by LinuxCNC GUIs" },
+    { "EMC", "VERSION", STR, "", "", 0, IGN, "", "INI format version (LinuxCNC)" },
+
+    /* [KINS] */
+    { "KINS", "KINEMATICS", STR, "", "", 0, REQ, "", "kinematics model: hexapod or trivial "
+      "(a plugin lib/kins/NAME.so)" },
+    { "KINS", "JOINTS", INT, "", "1..9", 0, 0, "6", "number of joints (legs)" },
+    { "KINS", "BASE_RADIUS", NUM, "mm", "0.001..1e6", 0, 0, "", "hexapod: radius of the base "
+      "joint circle (required unless BASE_#/PLATFORM_# are given)" },
+    { "KINS", "PLATFORM_RADIUS", NUM, "mm", "0..1e6", 0, 0, "", "hexapod: radius of the "
+      "platform joint circle (required unless BASE_#/PLATFORM_# are given)" },
+    { "KINS", "BASE_HALF_ANGLE", NUM, "deg", "0..59", 0, 0, "", "hexapod: half the angle "
+      "between the two base joints of a pair (required with BASE_RADIUS)" },
+    { "KINS", "PLATFORM_HALF_ANGLE", NUM, "deg", "0..59", 0, 0, "", "hexapod: half the angle "
+      "between the two platform joints of a pair (required with PLATFORM_RADIUS)" },
+    { "KINS", "BASE_Z", NUM, "mm", "", 0, 0, "0", "hexapod: height of the base joint centres" },
+    { "KINS", "PLATFORM_Z", NUM, "mm", "", 0, 0, "0", "hexapod: height of the platform joint "
+      "centres in the platform frame" },
+    { "KINS", "BASE_#", NUMS, "mm", "", 3, 0, "", "hexapod: base joint # (0..5) as x y z, "
+      "instead of the radius and angle keys" },
+    { "KINS", "PLATFORM_#", NUMS, "mm", "", 3, 0, "", "hexapod: platform joint # (0..5) as "
+      "x y z in the platform frame" },
+    { "KINS", "HOME", NUMS, "mm, deg", "", 6, 0, "level, legs mid-range", "pose X Y Z A B C "
+      "the forward solver starts from" },
+    { "KINS", "PLATFORM_CARRIES", ENUM, "", "WORKPIECE|SPINDLE", 0, 0, "WORKPIECE", "what "
+      "the hexapod's platform carries" },
+    { "KINS", "TOOL_POINT", NUMS, "mm", "", 3, 0, "HOME's X Y Z", "spindle gauge point, in "
+      "the frame the spindle is fixed to" },
+    { "KINS", "TOOL_AXIS", NUMS, "", "", 3, 0, "0 0 -1", "direction the tool points (any "
+      "length but zero)" },
+    { "KINS", "TOOL_LENGTH", NUM, "mm", "", 0, 0, "0", "tool tip beyond TOOL_POINT along "
+      "TOOL_AXIS" },
+    { "KINS", "FWD_TOLERANCE", NUM, "mm", "1e-15..1", 0, 0, "1e-9", "forward solve stops "
+      "below this Newton step" },
+    { "KINS", "FWD_MAX_ITERATIONS", INT, "", "1..1000", 0, 0, "20", "forward solve iteration "
+      "limit" },
+    { "KINS", "SINGULAR_CONDITION", NUM, "", "1..1e15", 0, 0, "100", "Jacobian condition "
+      "number above which a pose counts as near-singular" },
+    { "KINS", "CHARACTERISTIC_LENGTH", NUM, "mm", "0.001..1e6", 0, 0, "platform joint "
+      "radius", "lever arm that scales rotations against lengths in the condition number" },
+
+    /* [TRAJ] */
+    { "TRAJ", "MAX_LINEAR_VELOCITY", NUM, "mm/s", "> 0", 0, REQ, "", "path speed limit, X Y "
+      "Z (also the rapid rate)" },
+    { "TRAJ", "MAX_LINEAR_ACCELERATION", NUM, "mm/s^2", "> 0", 0, REQ, "", "path "
+      "acceleration limit, X Y Z" },
+    { "TRAJ", "MAX_ANGULAR_VELOCITY", NUM, "deg/s", "> 0", 0, REQ, "", "speed limit of each "
+      "of A B C" },
+    { "TRAJ", "MAX_ANGULAR_ACCELERATION", NUM, "deg/s^2", "> 0", 0, REQ, "", "acceleration "
+      "limit of each of A B C" },
+    { "TRAJ", "DEFAULT_LINEAR_VELOCITY", NUM, "mm/s", "> 0", 0, 0, "10", "feed of a move "
+      "programmed before any F word" },
+    { "TRAJ", "KINEMATIC_TOLERANCE", NUM, "mm", ">= 0", 0, 0, "0.001", "largest distance of "
+      "the tool from the programmed line between set points" },
+    { "TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", NUM, "deg", ">= 0", 0, 0, "0.001", "the same "
+      "bound for the orientation" },
+    { "TRAJ", "BLEND_TOLERANCE", NUM, "mm", ">= 0", 0, 0, "0.01", "G64 without P: largest "
+      "corner cut when blending" },
+    { "TRAJ", "SETPOINT_PERIOD", INT, "ns", ">= 0", 0, 0, "servo period", "period at which "
+      "drives take set points, for the kinematic-error bound" },
+    { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },
+    { "TRAJ", "COORDINATES", STR, "", "", 0, IGN, "", "LinuxCNC's axis letters; hexcnc's are "
+      "always X Y Z A B C" },
+    { "TRAJ", "LINEAR_UNITS", ENUM, "", "mm|metric", 0, 0, "mm", "machine length unit: "
+      "hexcnc machines are metric" },
+    { "TRAJ", "ANGULAR_UNITS", ENUM, "", "degree|deg", 0, 0, "degree", "machine angle unit" },
+
+    /* [EMCMOT] */
+    { "EMCMOT", "SERVO_PERIOD", INT, "ns", "1000..1e9", 0, 0, "1000000", "servo thread "
+      "period" },
+    { "EMCMOT", "SIM_CLOCK", INT, "", "0..1", 0, 0, "0", "`hexcnc run` runs on the simulated "
+      "clock (1) or paces the servo thread on the wall clock (0)" },
+    { "EMCMOT", "EMCMOT", STR, "", "", 0, IGN, "", "LinuxCNC's motion module" },
+    { "EMCMOT", "COMM_TIMEOUT", NUM, "s", "", 0, IGN, "", "LinuxCNC's" },
+    { "EMCMOT", "BASE_PERIOD", INT, "ns", "", 0, IGN, "", "LinuxCNC's base thread" },
+
+    /* [JOINT_#]: the limits that protect the machine have no default. */
+    { "JOINT_#", "MIN_LIMIT", NUM, "mm", "", 0, REQ, "", "shortest leg length" },
+    { "JOINT_#", "MAX_LIMIT", NUM, "mm", "", 0, REQ, "", "longest leg length" },
+    { "JOINT_#", "MAX_VELOCITY", NUM, "mm/s", "> 0", 0, REQ, "", "leg speed limit" },
+    { "JOINT_#", "MAX_ACCELERATION", NUM, "mm/s^2", "> 0", 0, REQ, "", "leg acceleration "
+      "limit" },
+    { "JOINT_#", "FERROR", NUM, "mm", "> 0", 0, REQ, "", "following-error limit at "
+      "MAX_VELOCITY" },
+    { "JOINT_#", "MIN_FERROR", NUM, "mm", "> 0", 0, 0, "0.1", "following-error limit at "
+      "standstill (it grows with speed up to FERROR)" },
+    { "JOINT_#", "SCALE", NUM, "steps/mm", "!= 0", 0, 0, "", "step generator scale (HAL "
+      "files, `hexcnc check`)" },
+    { "JOINT_#", "STEPGEN_MAXVEL", NUM, "mm/s", ">= 0", 0, 0, "", "step generator speed "
+      "limit (0 or absent: none)" },
+    { "JOINT_#", "STEPGEN_MAXACCEL", NUM, "mm/s^2", ">= 0", 0, 0, "", "step generator "
+      "acceleration limit (0 or absent: none)" },
+    { "JOINT_#", "TYPE", STR, "", "", 0, IGN, "", "LinuxCNC's joint type; legs are linear" },
+
+    /* [RS274NGC] */
+    { "RS274NGC", "FEED_UNITS", ENUM, "", "mm/min|m/min", 0, 0, "mm/min", "unit of F in G21 "
+      "programs (RS274/NGC's is mm/min)" },
+    { "RS274NGC", "TOOL_TABLE", PATH, "", "", 0, 0, "", "tool table (LinuxCNC's format)" },
+    { "RS274NGC", "PARAMETER_FILE", PATH, "", "", 0, 0, "", "numbered parameters kept "
+      "between runs" },
+    { "EMCIO", "TOOL_TABLE", PATH, "", "", 0, 0, "", "tool table, when [RS274NGC] has none "
+      "(LinuxCNC's place for it)" },
+
+    /* [HAL], [TASK], [DISPLAY] */
+    { "HAL", "HALFILE", PATH, "", "", 0, REP, "", "HAL file run at start, in order" },
+    { "HAL", "TWOPASS", STR, "", "", 0, IGN, "", "LinuxCNC's two-pass HAL loading" },
+    { "HAL", "POSTGUI_HALFILE", PATH, "", "", 0, IGN, "", "LinuxCNC GUIs' HAL file" },
+    { "TASK", "HALFILE", PATH, "", "", 0, REP, "", "HAL file `hexcnc run` runs after [HAL]'s "
+      "(its task.* pins)" },
+    { "TASK", "PROGRESS_INTERVAL", INT, "s", ">= 0", 0, 0, "5", "machine time between "
+      "progress lines when the output is not a terminal (0: none)" },
+    { "TASK", "TASK", STR, "", "", 0, IGN, "", "LinuxCNC's task program" },
+    { "TASK", "CYCLE_TIME", NUM, "s", "", 0, IGN, "", "LinuxCNC's task period" },
+    { "DISPLAY", "OPEN_FILE", PATH, "", "", 0, 0, "", "program `hexcnc run` runs when none "
+      "is given" },
+
+    /* [LCM] */
+    { "LCM", "URL", STR, "", "", 0, 0, "", "LCM URL to publish status on (empty: none)" },
+    { "LCM", "RATE_HZ", NUM, "1/s", "> 0", 0, 0, "20", "status messages per second" },
+
+    /* [MODBUS] (and [MODBUS_DRIVE_#]) */
+    { "MODBUS", "DRIVES", INT, "", "1..64", 0, 0, "1", "number of drives" },
+    { "MODBUS", "TRANSPORT", ENUM, "", "tcp|rtu", 0, 0, "tcp", "Modbus TCP or RTU (serial)" },
+    { "MODBUS", "HOST", STR, "", "", 0, 0, "127.0.0.1", "TCP: the drive's IPv4 address" },
+    { "MODBUS", "PORT", INT, "", "1..65535", 0, 0, "502", "TCP port" },
+    { "MODBUS", "BASE_PORT", INT, "", "1..65535", 0, 0, "", "TCP: drive n listens on "
+      "BASE_PORT + n" },
+    { "MODBUS", "DEVICE", STR, "", "", 0, 0, "", "RTU: serial device (/dev/ttyUSB0)" },
+    { "MODBUS", "BAUD", INT, "bit/s", "50..4000000", 0, 0, "115200", "RTU: baud rate" },
+    { "MODBUS", "PARITY", ENUM, "", "N|E|O", 0, 0, "N", "RTU: parity" },
+    { "MODBUS", "DATA_BITS", INT, "", "5..8", 0, 0, "8", "RTU: data bits" },
+    { "MODBUS", "STOP_BITS", INT, "", "1..2", 0, 0, "1", "RTU: stop bits" },
+    { "MODBUS", "UNIT", INT, "", "0..255", 0, 0, "1", "Modbus unit (slave) id" },
+    { "MODBUS", "REG_CONTROL", INT, "", "0..65535", 0, 0, "0", "control word register" },
+    { "MODBUS", "REG_TARGET", INT, "", "0..65534", 0, 0, "1", "target position (two "
+      "registers)" },
+    { "MODBUS", "REG_STATUS", INT, "", "0..65535", 0, 0, "10", "status word register" },
+    { "MODBUS", "REG_ACTUAL", INT, "", "0..65534", 0, 0, "11", "actual position (two "
+      "registers)" },
+    { "MODBUS", "WORD_ORDER", ENUM, "", "high-first|low-first", 0, 0, "high-first", "order of "
+      "a position's two registers" },
+    { "MODBUS", "COUNTS_PER_MM", NUM, "counts/mm", "!= 0", 0, 0, "1000", "position counts per "
+      "mm of leg (negative reverses)" },
+    { "MODBUS", "SETPOINT_PERIOD", INT, "ns", "10000..1e9", 0, 0, "1000000", "period of the "
+      "exchanges with a drive" },
+    { "MODBUS", "TIMEOUT", NUM, "ms", "> 0", 0, 0, "20", "reply time-out of one exchange" },
+    { "MODBUS", "EXCHANGE", ENUM, "", "fc23|separate", 0, 0, "fc23", "one read/write request "
+      "(FC 23) or a write and a read" },
+    { "MODBUS_SIM", "TAU", NUM, "s", "> 0", 0, 0, "0.002", "simulated drive's position lag "
+      "time constant" },
+    { "MODBUS_SIM", "MAX_VELOCITY", NUM, "mm/s", ">= 0", 0, 0, "0", "simulated drive's speed "
+      "limit (0: none)" },
+
+    /* [CAN], [CAN_NODE_#] */
+    { "CAN", "INTERFACE", STR, "", "", 0, 0, "", "SocketCAN interface (can0, vcan0)" },
+    { "CAN", "SYNC_PERIOD", INT, "ns", "> 0", 0, 0, "servo period", "SYNC period, a multiple "
+      "of the servo period" },
+    { "CAN", "BITRATE", INT, "bit/s", "> 0", 0, 0, "1000000", "bus bit rate, for the bus "
+      "load check" },
+    { "CAN", "HEARTBEAT_PERIOD", INT, "ms", "> 0", 0, 0, "20", "drives' heartbeat period" },
+    { "CAN", "HEARTBEAT_TIMEOUT", INT, "ms", "> 0", 0, 0, "100", "a drive is lost after this "
+      "long without a heartbeat" },
+    { "CAN", "BOOT_TIMEOUT", INT, "ms", "> 0", 0, 0, "1000", "time a drive has to boot" },
+    { "CAN_NODE_#", "NODE_ID", INT, "", "1..127", 0, REQ, "", "CANopen node id" },
+    { "CAN_NODE_#", "COUNTS_PER_MM", NUM, "counts/mm", "!= 0", 0, REQ, "", "position counts "
+      "per mm of leg (negative reverses)" },
+    { "CAN_NODE_#", "OFFSET", NUM, "mm", "", 0, 0, "0", "leg length at position 0" },
+    { "CAN_NODE_#", "SDO_TIMEOUT", INT, "ms", "> 0", 0, 0, "100", "SDO reply time-out" },
+    { "CAN_NODE_#", "SIM_START", NUM, "mm", "", 0, 0, "OFFSET", "simulated drive: leg length "
+      "at power-on" },
+    { "CAN_NODE_#", "SIM_MAX_VELOCITY", NUM, "mm/s", ">= 0", 0, 0, "0", "simulated drive: "
+      "speed limit (0: none)" },
+};
+const int config_nkeys = sizeof config_keys / sizeof config_keys[0];
