@@ -77,7 +77,7 @@ check "Ctrl-C still prints the summary" has "$tmp/out" "machine time"
 #    their line runs on the machine: interp and check leave both files byte for byte as they
 #    were, and so does a run refused before motion; a full run saves them.
 m="$tmp/settings"; mkdir -p "$m"
-sed "s|^HALFILE = |HALFILE = $root/configs/sim/|" "$ini" \
+sed "s|^HALFILE = \.\./\.\./\.\./|HALFILE = $root/|" "$ini" \
     | sed "s|^TOOL_TABLE = .*|TOOL_TABLE = $m/tool.tbl\nPARAMETER_FILE = $m/hexcnc.var|" >"$m/m.ini"
 printf 'T1 P1 D10 ;ten\n' >"$m/tool.tbl"
 printf '5221\t0.000000\n' >"$m/hexcnc.var"
