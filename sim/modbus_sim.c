@@ -172,7 +172,11 @@ static bool modbus_sim_drive_handle(struct modbus_sim_drive *d, const uint8_t *r
         modbus_reply_exception(d->ctx, req, (unsigned)arg);
         return true;
     }
-    if (f == MODBUS_SIM_FAULT_DELAY && arg > 0) {
+    const struct modbus_sim_opts *o = &d->sim->opts;
+    if (f == MODBUS_SIM_FAULT_DELAY && arg > 0 && o->step_ns > 0 && o->timeout_us > 0) {
+        if (arg >= o->timeout_us)
+            return true;    /* simulated time: the answer would come after the client gave up */
+    } else if (f == MODBUS_SIM_FAULT_DELAY && arg > 0) {
         struct timespec ts = { arg / 1000000, (arg % 1000000) * 1000 };
         nanosleep(&ts, NULL);
     }

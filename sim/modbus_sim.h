@@ -47,7 +47,11 @@ struct modbus_sim_opts {
     int nb_registers;             /* holding registers 0..nb-1 (default 64) */
     double tau_s;                 /* first-order lag time constant, s (default 0.002) */
     double vmax_counts_s;         /* velocity limit, counts/s (default 1e9) */
-    long step_ns;                 /* > 0: model time advances this much per request */
+    long step_ns;                 /* > 0: lockstep, model time advances this much per read
+                                   * request; 0: the model runs on wall time */
+    long timeout_us;              /* lockstep: the client's TIMEOUT, us; > 0 makes an injected
+                                   * delay simulated (answer at once, or none when later than
+                                   * this); 0: a delay sleeps on the wall clock */
     int unit;                     /* RTU unit id (default 1); TCP answers any unit */
 };
 void modbus_sim_opts_default(struct modbus_sim_opts *o);
