@@ -14,8 +14,10 @@
  * (modbus_tcp_listen, modbus_receive, modbus_reply on a modbus_mapping_t). The holding
  * registers follow the same map as the client (struct modbus_regmap). Before each reply the
  * drive model runs: the actual position follows the target through a first-order lag
- * (time constant tau) with a velocity limit, over the time since the last request: wall
- * time, or a fixed step per request ("lockstep") for deterministic tests.
+ * (time constant tau) with a velocity limit: on wall time (the model is brought up to the
+ * present before every reply and every state read, whether or not a client stays connected,
+ * so a client that connects per request sees the drive move), or a fixed step per read
+ * request ("lockstep", the simulated clock) for deterministic runs.
  */
 
 enum modbus_sim_status {
