@@ -67,6 +67,7 @@ struct modbus_sim_run {
     struct modbus_sim *s;         /* the drives */
     struct hal *h;                /* with --ini: the runtime that owns s; else NULL */
     double counts_per_mm[64];     /* per drive */
+    enum modbus_word_order order; /* drive 0's word order, for the banner */
     char buf[1024];               /* stdin bytes not yet ending in a newline */
     size_t len;
 };
@@ -220,6 +221,8 @@ static int modbus_sim_from_ini(struct modbus_sim_run *r, const struct modbus_sim
             return 1;
         }
         r->counts_per_mm[i] = cfg.counts_per_mm;
+        if (i == 0)
+            r->order = cfg.map.order;
     }
     return 0;
 }
@@ -236,6 +239,7 @@ static int modbus_sim_from_args(struct modbus_sim_run *r, const struct modbus_si
     }
     for (int i = 0; i < a->drives; i++)
         r->counts_per_mm[i] = a->counts_per_mm;
+    r->order = a->opts.map.order;
     return 0;
 }
 
@@ -403,7 +407,7 @@ static void modbus_sim_banner(struct modbus_sim_run *r, const struct modbus_sim_
                                                     : "127.0.0.1";
     printf("modbus_sim: %d drives on %s:%d..%d (%s word first, %s)\n", n, host,
            modbus_sim_port(r->s, 0), modbus_sim_port(r->s, n - 1),
-           a->opts.map.order == MODBUS_WORDS_HIGH_FIRST ? "high" : "low",
+           r->order == MODBUS_WORDS_HIGH_FIRST ? "high" : "low",
            a->lockstep ? "one set-point period per read request" : "moving on wall time");
     printf("modbus_sim: positions mm:");
     for (int i = 0; i < n; i++) {
@@ -439,11 +443,6 @@ int cmd_modbus_sim(int argc, char **argv)
         rc = modbus_sim_start_positions(r, a.start);
     if (rc)
         goto out;
-    if (r->h) {       /* the banner's word order */
-        const char *wo = hal_ini_get(r->h, "MODBUS", "WORD_ORDER");
-        a.opts.map.order = wo && !strcmp(wo, "low-first") ? MODBUS_WORDS_LOW_FIRST
-                                                          : MODBUS_WORDS_HIGH_FIRST;
-    }
     modbus_sim_banner(r, &a);
     modbus_sim_loop(r, sfd, a.seconds);
 out:
