@@ -3,9 +3,10 @@
 # Used by `make deps`; safe to run again.
 # linuxcnc-uspace is there for tests only: its `rs274` and the programs and tool tables it
 # ships are the reference that hexcnc's G-code and tool-table reading are compared with.
+# mbpoll is there for tests only: a third-party Modbus client for `hexcnc modbus_sim`.
 set -eu
 PKGS="build-essential pkg-config check libmodbus-dev libeigen3-dev liblcm-dev liblcm-bin \
-libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace"
+libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -36,7 +36,7 @@ struct modbus_sim_drive {
     enum modbus_sim_fault fault;  /* injected fault */
     long fault_arg;               /* exception code or delay, us */
     uint32_t requests, connections;
-    int64_t last_ns;              /* wall time of the last model update, 0 = none yet */
+    int64_t last_ns;              /* wall time the model has been advanced to, ns */
 };
 
 struct modbus_sim {
@@ -107,6 +107,7 @@ int modbus_sim_create(struct modbus_sim **out, int ndrives, const struct modbus_
         d->sim = s;
         d->index = i;
         d->listen_fd = d->pty_fd = -1;
+        d->last_ns = modbus_sim_now_ns();
         pthread_mutex_init(&d->lock, NULL);
         d->map = modbus_mapping_new(0, 0, nb, 0);
         if (!d->map) {
@@ -120,20 +121,22 @@ int modbus_sim_create(struct modbus_sim **out, int ndrives, const struct modbus_
 }
 
 /* Advances the model to now (or one lockstep) and writes status and actual into the map.
- * Lockstep advances only on requests that read, i.e. once per client cycle. */
+ * Lockstep advances only on requests that read, i.e. once per client cycle (function 0:
+ * not at all). On wall time the model covers the whole time since its last update, however
+ * many connections came and went in between. Called with d->lock held. */
 static void modbus_sim_drive_update(struct modbus_sim_drive *d, int function)
 {
     const struct modbus_sim_opts *o = &d->sim->opts;
-    int64_t now = modbus_sim_now_ns();
     double dt_s = 0.0;
     if (o->step_ns > 0) {
         if (function == MODBUS_FC_READ_HOLDING_REGISTERS ||
             function == MODBUS_FC_WRITE_AND_READ_REGISTERS)
             dt_s = o->step_ns * 1e-9;
-    } else if (d->last_ns) {
+    } else {
+        int64_t now = modbus_sim_now_ns();
         dt_s = (now - d->last_ns) * 1e-9;
+        d->last_ns = now;
     }
-    d->last_ns = now;
     modbus_sim_model_step(&d->model, o, dt_s);
     uint16_t *r = d->map->tab_registers;
     r[o->map.status] = modbus_sim_model_status(&d->model);
@@ -172,7 +175,11 @@ static bool modbus_sim_drive_handle(struct modbus_sim_drive *d, const uint8_t *r
         modbus_reply_exception(d->ctx, req, (unsigned)arg);
         return true;
     }
-    if (f == MODBUS_SIM_FAULT_DELAY && arg > 0) {
+    const struct modbus_sim_opts *o = &d->sim->opts;
+    if (f == MODBUS_SIM_FAULT_DELAY && arg > 0 && o->step_ns > 0 && o->timeout_us > 0) {
+        if (arg >= o->timeout_us)
+            return true;    /* simulated time: the answer would come after the client gave up */
+    } else if (f == MODBUS_SIM_FAULT_DELAY && arg > 0) {
         struct timespec ts = { arg / 1000000, (arg % 1000000) * 1000 };
         nanosleep(&ts, NULL);
     }
@@ -228,7 +235,6 @@ static void *modbus_sim_tcp_thread(void *arg)
         setsockopt(modbus_get_socket(d->ctx), IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
         pthread_mutex_lock(&d->lock);
         d->connections++;
-        d->last_ns = 0;
         pthread_mutex_unlock(&d->lock);
         modbus_sim_drive_serve(d);
         modbus_close(d->ctx);
@@ -381,6 +387,7 @@ int modbus_sim_state(struct modbus_sim *s, int i, struct modbus_sim_drive_state 
         return MODBUS_SIM_ERR_ARG;
     struct modbus_sim_drive *d = &s->d[i];
     pthread_mutex_lock(&d->lock);
+    modbus_sim_drive_update(d, 0);      /* on wall time: where the drive is now */
     st->target_counts = d->model.target_counts;
     st->actual_counts = d->model.actual_counts;
     st->control_word = d->map->tab_registers[s->opts.map.control];

@@ -14,8 +14,10 @@
  * (modbus_tcp_listen, modbus_receive, modbus_reply on a modbus_mapping_t). The holding
  * registers follow the same map as the client (struct modbus_regmap). Before each reply the
  * drive model runs: the actual position follows the target through a first-order lag
- * (time constant tau) with a velocity limit, over the time since the last request: wall
- * time, or a fixed step per request ("lockstep") for deterministic tests.
+ * (time constant tau) with a velocity limit: on wall time (the model is brought up to the
+ * present before every reply and every state read, whether or not a client stays connected,
+ * so a client that connects per request sees the drive move), or a fixed step per read
+ * request ("lockstep", the simulated clock) for deterministic runs.
  */
 
 enum modbus_sim_status {
@@ -47,7 +49,11 @@ struct modbus_sim_opts {
     int nb_registers;             /* holding registers 0..nb-1 (default 64) */
     double tau_s;                 /* first-order lag time constant, s (default 0.002) */
     double vmax_counts_s;         /* velocity limit, counts/s (default 1e9) */
-    long step_ns;                 /* > 0: model time advances this much per request */
+    long step_ns;                 /* > 0: lockstep, model time advances this much per read
+                                   * request; 0: the model runs on wall time */
+    long timeout_us;              /* lockstep: the client's TIMEOUT, us; > 0 makes an injected
+                                   * delay simulated (answer at once, or none when later than
+                                   * this); 0: a delay sleeps on the wall clock */
     int unit;                     /* RTU unit id (default 1); TCP answers any unit */
 };
 void modbus_sim_opts_default(struct modbus_sim_opts *o);

@@ -68,6 +68,7 @@ static int modbus_sim_hal_opts(struct hal *h, const struct modbus_drive_cfg *c0,
     if (vmax_mm_s > 0.0)
         o->vmax_counts_s = vmax_mm_s * fabs(c0->counts_per_mm);
     o->step_ns = hal_sim_clock(h) ? c0->period_ns : 0;
+    o->timeout_us = hal_sim_clock(h) ? c0->timeout_us : 0;
     o->unit = c0->unit;
     return HAL_OK;
 }

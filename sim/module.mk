@@ -6,6 +6,8 @@ TESTS += test_stepgen test_stepgen_hal
 LIB_SRCS += sim/modbus_sim.c sim/modbus_sim_model.c sim/modbus_sim_hal.c
 HAL_COMPS += modbus_sim_server
 TESTS += test_modbus test_modbus_faults test_modbus_hal test_modbus_e2e
+SCRIPT_TESTS += tests/test_modbus_simclock_load.sh tests/test_modbus_two_process.sh \
+                tests/test_modbus_mbpoll.sh
 # Simulated CiA 402 drives on CANopen.
 LIB_SRCS += sim/cia402_sim.c sim/cia402_sim_od.c sim/cia402_sim_hal.c
 HAL_COMPS += cia402_sim

@@ -3,18 +3,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "hal/drivers/modbus_cfg.h"
 #include "hal/drivers/modbus_drive.h"
 #include "sim/modbus_sim.h"
 
-/* A client config for simulated drive i of s (lockstep model, FC23, 20 ms timeout). */
+/* A client config for simulated drive i of s (FC23; a 200 ms wall-clock timeout, so a
+ * loaded machine never times out a healthy drive). */
 static void client_cfg(struct modbus_drive_cfg *c, struct modbus_sim *s, int i)
 {
     modbus_drive_cfg_default(c, i);
     c->port = modbus_sim_port(s, i);
     c->counts_per_mm = 1000.0;
-    c->timeout_us = 20000;
+    c->timeout_us = 200000;
 }
 
 /* One simulated drive on an ephemeral port with a lockstep model of 1 ms per cycle. */
@@ -181,6 +183,41 @@ START_TEST(test_drive_model_lag)
 }
 END_TEST
 
+/* On wall time the drive moves whether or not a client is connected: a client that connects
+ * for each request (as mbpoll does) sees it arrive, and so does a state read. */
+START_TEST(test_wall_time_model_moves_between_connections)
+{
+    struct modbus_sim_opts o;
+    modbus_sim_opts_default(&o);
+    o.tau_s = 0.002;
+    struct modbus_sim *s;
+    ck_assert_int_eq(modbus_sim_create(&s, 1, &o), MODBUS_SIM_OK);
+    ck_assert_int_eq(modbus_sim_start_tcp(s, "127.0.0.1", 0), MODBUS_SIM_OK);
+    modbus_sim_set_position(s, 0, 5000);
+    struct modbus_drive_cfg c;
+    client_cfg(&c, s, 0);
+    struct modbus_drive d;
+    ck_assert_int_eq(modbus_drive_open(&d, &c), MODBUS_DRIVE_OK);
+    ck_assert_int_eq(modbus_drive_connect(&d), MODBUS_DRIVE_OK);
+    uint16_t st;
+    ck_assert_int_eq(run_cycles(&d, 15000, MODBUS_CTRL_ENABLE, 1, &st), 5000);
+    modbus_drive_disconnect(&d);
+    struct timespec nap = { 0, 60000000 };      /* 30 time constants: within one count */
+    nanosleep(&nap, NULL);
+    struct modbus_sim_drive_state ss;
+    modbus_sim_state(s, 0, &ss);
+    ck_assert_double_eq_tol(ss.actual_counts, 15000.0, 1.0);
+    ck_assert_uint_eq(ss.connections, 1);
+    ck_assert_int_eq(modbus_drive_connect(&d), MODBUS_DRIVE_OK);
+    int32_t act;
+    ck_assert_int_eq(modbus_drive_read(&d, &act, &st), MODBUS_DRIVE_OK);
+    ck_assert_int_eq(act, 15000);
+    ck_assert_uint_eq(st, MODBUS_STAT_READY | MODBUS_STAT_ENABLED | MODBUS_STAT_AT_TARGET);
+    modbus_drive_close(&d);
+    modbus_sim_destroy(s);
+}
+END_TEST
+
 /* A tiny INI: {section, key, value} triples. */
 static const char *const ini_table[][3] = {
     { "MODBUS", "BASE_PORT", "15020" },
@@ -259,6 +296,7 @@ static Suite *modbus_suite(void)
     tcase_add_test(tc, test_exchange_low_first_separate);
     tcase_add_test(tc, test_word_order_mismatch_garbles);
     tcase_add_test(tc, test_drive_model_lag);
+    tcase_add_test(tc, test_wall_time_model_moves_between_connections);
     suite_add_tcase(s, tc);
     return s;
 }

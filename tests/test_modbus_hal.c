@@ -274,6 +274,38 @@ START_TEST(test_drive_fault_trips_estop_and_resets)
 }
 END_TEST
 
+/* On the simulated clock an injected delay is simulated time: the in-process drives read the
+ * same TIMEOUT (20 ms), answer a 19 ms delay at once and leave a 21 ms one unanswered, so the
+ * outcome never depends on how busy the computer is. */
+START_TEST(test_simclock_delay_is_simulated_time)
+{
+    int ports[NDRIVES];
+    free_ports(ports);
+    char ini[64];
+    write_ini(ini, sizeof(ini), ports, "");
+    struct hal *h = make_graph(ini, true);
+    struct modbus_sim *s = hal_get_object(h, "modbus-sim");
+    ck_assert_ptr_nonnull(s);
+    bool *fault2 = test_pin(h, "modbus.2.fault", HAL_BIT);
+    int k = 0;
+    press_reset(h, &k);
+    ck_assert_int_eq(modbus_sim_inject(s, 2, MODBUS_SIM_FAULT_DELAY, 19000), MODBUS_SIM_OK);
+    for (int n = 0; n < 40; n++)
+        step(h, k++);
+    ck_assert(!*fault2);
+    struct modbus_sim_drive_state st;
+    modbus_sim_state(s, 2, &st);
+    ck_assert_uint_ge(st.requests, 10);
+    ck_assert_int_eq(modbus_sim_inject(s, 2, MODBUS_SIM_FAULT_DELAY, 21000), MODBUS_SIM_OK);
+    for (int n = 0; n < 8; n++)
+        step(h, k++);
+    ck_assert(*fault2);
+    ck_assert(!*(bool *)test_pin(h, "modbus.1.fault", HAL_BIT));
+    hal_destroy(h);
+    unlink(ini);
+}
+END_TEST
+
 START_TEST(test_bad_ini_value_names_key)
 {
     int ports[NDRIVES] = { 1, 2, 3, 4, 5, 6 };
@@ -345,6 +377,7 @@ static Suite *modbus_hal_suite(void)
     tcase_add_test(tc, test_six_drives_follow_slower_setpoints);
     tcase_add_test(tc, test_server_component_end_to_end);
     tcase_add_test(tc, test_drive_fault_trips_estop_and_resets);
+    tcase_add_test(tc, test_simclock_delay_is_simulated_time);
     tcase_add_test(tc, test_bad_ini_value_names_key);
     tcase_add_test(tc, test_rtu_drive_through_hal);
     suite_add_tcase(s, tc);

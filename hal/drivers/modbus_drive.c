@@ -219,7 +219,8 @@ int modbus_drive_open(struct modbus_drive *d, const struct modbus_drive_cfg *cfg
     if (!d->ctx)
         return modbus_drive_fail(d, MODBUS_DRIVE_ERR_CONFIG, "cannot set up the connection: %s",
                                  modbus_strerror(errno));
-    uint32_t sec = (uint32_t)(cfg->timeout_us / 1000000), usec = (uint32_t)(cfg->timeout_us % 1000000);
+    long wait_us = cfg->wait_us > 0 ? cfg->wait_us : cfg->timeout_us;
+    uint32_t sec = (uint32_t)(wait_us / 1000000), usec = (uint32_t)(wait_us % 1000000);
     if (modbus_set_slave(d->ctx, cfg->unit) || modbus_set_response_timeout(d->ctx, sec, usec) ||
         modbus_set_byte_timeout(d->ctx, sec, usec) ||
         modbus_set_error_recovery(d->ctx, MODBUS_ERROR_RECOVERY_NONE)) {

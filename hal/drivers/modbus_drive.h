@@ -79,9 +79,18 @@ struct modbus_drive_cfg {
     struct modbus_regmap map;     /* where the values live */
     double counts_per_mm;         /* drive counts per mm of leg travel (sign sets direction) */
     long period_ns;               /* set-point period: one exchange per period */
-    long timeout_us;              /* response timeout, us */
+    long timeout_us;              /* response timeout, us (TIMEOUT) */
+    long wait_us;                 /* wall time to wait for an answer, us; 0 = timeout_us.
+                                   * Simulated clock: MODBUS_DRIVE_INLINE_WAIT_US, because an
+                                   * exchange takes no simulated time (see below) */
     enum modbus_exchange exchange;
 };
+/* With the simulated clock (exchanges inline in modbus.update) an answer takes no simulated
+ * time however long the computer takes to produce it: an answer that comes at all comes
+ * within TIMEOUT. Wall time is then only a guard against a drive that never answers, long
+ * enough that no load on the computer reaches it (the simulated drives model delays in
+ * simulated time, see modbus_sim_opts.timeout_us). */
+#define MODBUS_DRIVE_INLINE_WAIT_US 2000000L
 /* Defaults: TCP 127.0.0.1:502 unit 1, default map, 1000 counts/mm, 1 ms, 20 ms, FC23. */
 void modbus_drive_cfg_default(struct modbus_drive_cfg *c, int index);
 /* "127.0.0.1:5023" or "/dev/ttyUSB0@115200,8N1": the address as messages show it. */

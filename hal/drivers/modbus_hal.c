@@ -164,6 +164,8 @@ static int modbus_hal_drive_new(struct hal *h, struct modbus_hal *c, int i, cons
     if (modbus_cfg_read(&cfg, i, section, hal_ini_lookup, h, hal_ini_path(h), err,
                         sizeof(err)))
         return hal_error(h, HAL_ERR_COMPONENT, "modbus: %s", err);
+    if (c->inline_io)       /* simulated time: the load on the computer must not matter */
+        cfg.wait_us = MODBUS_DRIVE_INLINE_WAIT_US;
     struct modbus_hal_drive *d = &c->d[i];
     if (modbus_link_init(&d->link, &cfg)) {
         snprintf(err, sizeof(err), "%s", modbus_drive_message(&d->link.drive));
