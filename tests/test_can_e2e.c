@@ -131,6 +131,36 @@ START_TEST(test_drive_fault_stops_machine)
 }
 END_TEST
 
+/* Position feedback of one drive stops in the middle of the program (its heartbeat goes on):
+ * the first fault is the lost feedback, naming the node and the time, not a following
+ * error; the machine stops. */
+START_TEST(test_feedback_loss_named)
+{
+    struct hal *h = machine_with_program();
+    ck_assert_int_eq(hal_sim_advance(h, 1500 * PERIOD_NS), HAL_OK);
+    ck_assert(test_pin_value(h, "motion.path-vel") > 1.0);  /* moving */
+    struct hal_msg msg;
+    while (hal_msg_take(h, &msg))
+        ;
+    ck_assert_int_eq(hal_setp(h, "cia402-sim.2.tpdo-stop", "1"), HAL_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 20 * PERIOD_NS), HAL_OK);
+    ck_assert(test_pin_value(h, "motion.fault") != 0.0);
+    bool first = true;
+    while (hal_msg_take(h, &msg)) {
+        if (msg.severity != HAL_MSG_FAULT || !first)
+            continue;
+        first = false;
+        ck_assert_str_eq(msg.source, "cia402.2");
+        ck_assert_msg(strstr(msg.text, "no position feedback (TPDO1) from node 3 for 7 ms") !=
+                      NULL, "%s", msg.text);
+    }
+    ck_assert(!first);
+    ck_assert_msg(strstr(motion_hal_fault(h), "following error") == NULL, "%s",
+                  motion_hal_fault(h));
+    hal_destroy(h);
+}
+END_TEST
+
 /* The suite. */
 static Suite *can_e2e_suite(void)
 {
@@ -139,6 +169,7 @@ static Suite *can_e2e_suite(void)
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, test_paper_program_on_can);
     tcase_add_test(tc, test_drive_fault_stops_machine);
+    tcase_add_test(tc, test_feedback_loss_named);
     suite_add_tcase(s, tc);
     return s;
 }

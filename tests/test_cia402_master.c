@@ -1,5 +1,6 @@
 /* test_cia402_master.c: the CANopen master against simulated CiA 402 drives, in process. */
 #include <check.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -367,6 +368,58 @@ START_TEST(test_heartbeat_loss)
 }
 END_TEST
 
+/* Lost position feedback: a running drive whose TPDO1 stops (heartbeats going on) is
+ * reported once more than FEEDBACK_TIMEOUT_SYNCS SYNC periods (default 3, at 2 ms: 6 ms)
+ * passed without it, not before and within one servo period after; with the bound set
+ * to 6 the same takes 12 ms. */
+START_TEST(test_feedback_loss)
+{
+    for (int syncs = 0; syncs <= 6; syncs += 6) {
+        struct rig r;
+        rig_init(&r, 3, 2000000);
+        if (syncs) {  /* a different bound through the configuration */
+            struct canopen_master_cfg cfg = r.m.cfg;
+            cfg.feedback_timeout_syncs = syncs;
+            char err[200];
+            ck_assert_int_eq(canopen_master_init(&r.m, &cfg, err, sizeof err), CANOPEN_OK);
+        }
+        int64_t bound_ns = (syncs ? syncs : 3) * 2000000LL;
+        rig_run_ms(&r, 80);
+        rig_enable(&r, true);
+        rig_run_ms(&r, 20);
+        ck_assert(canopen_master_all_enabled(&r.m));
+        cia402_sim_inject(&r.sim[2], CIA402_SIM_TPDO_STOP);
+        int64_t detected = -1;
+        for (int i = 0; i < 200 && detected < 0; i++) {
+            rig_cycle(&r);
+            if (r.m.node[2].fault)
+                detected = r.now_ns - CYCLE_NS;
+        }
+        struct canopen_node *n = &r.m.node[2];
+        ck_assert_int_ge(detected, 0);
+        int64_t silence_ns = detected - n->last_tpdo_ns;
+        ck_assert_int_gt(silence_ns, bound_ns);
+        ck_assert_int_le(silence_ns, bound_ns + CYCLE_NS);
+        ck_assert_int_eq(n->fault_status, CANOPEN_ERR_PDO_TIMEOUT);
+        char want[96];
+        snprintf(want, sizeof want, "no position feedback (TPDO1) from node 3 for %lld ms",
+                 (long long)(silence_ns / 1000000));
+        ck_assert_msg(strstr(n->message, want) != NULL, "%s", n->message);
+        ck_assert_ptr_nonnull(strstr(n->message, "CAN node 3 (joint 2)"));
+        ck_assert(!r.m.node[0].fault && !r.m.node[1].fault);  /* the others go on */
+        ck_assert(r.sim[2].heartbeat_ms > 0);  /* its heartbeat was on: not a lost node */
+    }
+    /* out of range */
+    struct rig r;
+    rig_init(&r, 1, 2000000);
+    struct canopen_master_cfg cfg = r.m.cfg;
+    cfg.feedback_timeout_syncs = -1;
+    char err[200];
+    ck_assert_int_eq(canopen_master_init(&r.m, &cfg, err, sizeof err), CANOPEN_ERR_ARG);
+    ck_assert_ptr_nonnull(strstr(err, "FEEDBACK_TIMEOUT_SYNCS"));
+}
+END_TEST
+
 /* Quick stop: an enabled drive goes to Quick stop active and holds its position whatever
  * the command does; released, it passes Switch on disabled and climbs back to enabled. */
 START_TEST(test_quick_stop)
@@ -452,6 +505,7 @@ static Suite *master_suite(void)
     tcase_add_test(tc, test_nmt_boot);
     tcase_add_test(tc, test_fault_and_reset);
     tcase_add_test(tc, test_heartbeat_loss);
+    tcase_add_test(tc, test_feedback_loss);
     tcase_add_test(tc, test_quick_stop);
     tcase_add_test(tc, test_config_errors);
     suite_add_tcase(s, tc);

@@ -142,6 +142,12 @@ static bool bus_cfg_ok(const struct canopen_master_cfg *cfg, char *err, size_t l
         snprintf(err, len, "BOOT_TIMEOUT must be at least 1 ms");
         return false;
     }
+    if (cfg->feedback_timeout_syncs < 0 ||
+        cfg->feedback_timeout_syncs > CANOPEN_FEEDBACK_SYNCS_MAX) {
+        snprintf(err, len, "FEEDBACK_TIMEOUT_SYNCS %d is outside 1..%d SYNC periods",
+                 cfg->feedback_timeout_syncs, CANOPEN_FEEDBACK_SYNCS_MAX);
+        return false;
+    }
     return true;
 }
 
@@ -161,6 +167,8 @@ int canopen_master_init(struct canopen_master *m, const struct canopen_master_cf
         return CANOPEN_ERR_ARG;
     }
     m->cfg = *cfg;
+    if (m->cfg.feedback_timeout_syncs == 0)
+        m->cfg.feedback_timeout_syncs = CANOPEN_FEEDBACK_SYNCS_DEFAULT;
     for (int i = 0; i < cfg->n_nodes; i++) {
         m->node[i].cfg = cfg->node[i];
         m->node[i].phase = CANOPEN_PHASE_RESET;

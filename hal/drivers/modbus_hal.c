@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "hal/hal.h"
+#include "hal/drivers/drive_startup.h"
 #include "hal/drivers/modbus_cfg.h"
 #include "hal/drivers/modbus_link.h"
 
@@ -46,6 +47,7 @@ struct modbus_hal {
     int count;                /* drives */
     bool inline_io;           /* exchanges in modbus.update instead of I/O threads */
     bool *fault_any;          /* out: any drive faulted (to the e-stop chain) */
+    struct drive_startup startup;  /* for the runner: starting / ready / failed */
     struct modbus_hal_drive d[MODBUS_HAL_MAX_DRIVES];
 };
 
@@ -55,11 +57,47 @@ static const char *modbus_hal_ini_get(void *ctx, const char *section, const char
     return hal_ini_get(ctx, section, key);
 }
 
-/* Hands a fault to the shell once, when it is raised (from the I/O side). */
+/* Hands a fault to the shell once, when it is raised (from the I/O side); a fault before
+ * the drive's first exchange is said to be one at start-up, with the drive's unit id. */
 static void modbus_hal_report(void *arg, const char *msg)
 {
     struct modbus_hal_drive *d = arg;
-    hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s", msg);
+    struct modbus_feedback fb;
+    modbus_link_feedback(&d->link, &fb);
+    if (fb.exchanges == 0)
+        hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s (unit %d; at start-up, before its "
+                     "first exchange)", msg, d->link.drive.cfg.unit);
+    else
+        hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s", msg);
+}
+
+/* Starting until every drive has exchanged once, failed as soon as one has a fault. */
+static void modbus_hal_startup(struct modbus_hal *c)
+{
+    int st = DRIVE_STARTUP_READY;
+    for (int i = 0; i < c->count && st != DRIVE_STARTUP_FAILED; i++) {
+        struct modbus_feedback fb;
+        modbus_link_feedback(&c->d[i].link, &fb);
+        if (fb.fault)
+            st = DRIVE_STARTUP_FAILED;
+        else if (fb.exchanges == 0)
+            st = DRIVE_STARTUP_STARTING;
+    }
+    atomic_store(&c->startup.state, st);
+}
+
+/* The longest start-up the drives' settings allow: a connect and a first answer, each within
+ * the response time-out, and two set-point periods, ns. */
+static int64_t modbus_hal_startup_budget_ns(const struct modbus_hal *c)
+{
+    int64_t worst = 0;
+    for (int i = 0; i < c->count; i++) {
+        const struct modbus_drive_cfg *cfg = &c->d[i].link.drive.cfg;
+        int64_t t = 2 * (int64_t)cfg->timeout_us * 1000 + 2 * (int64_t)cfg->period_ns;
+        if (t > worst)
+            worst = t;
+    }
+    return worst;
 }
 
 /* Copies drive d's latest feedback to its pins; returns its fault. */
@@ -108,6 +146,7 @@ static void modbus_hal_update(void *arg, long period_ns)
         any = modbus_hal_publish(d) || any;
     }
     *c->fault_any = any;
+    modbus_hal_startup(c);
 }
 
 /* Stops the I/O threads and closes the connections (hal_destroy). */
@@ -246,7 +285,10 @@ static int modbus_hal_load(struct hal *h, int argc, char **argv)
             return hal_error(h, HAL_ERR_RT, "modbus: drive %d: %s", i,
                              modbus_drive_strerror(MODBUS_DRIVE_ERR_THREAD));
     modbus_hal_first_read(c);
-    return HAL_OK;
+    modbus_hal_startup(c);
+    c->startup.budget_ns = modbus_hal_startup_budget_ns(c);
+    c->startup.what = "Modbus drives (modbus)";
+    return hal_set_object(h, DRIVE_STARTUP_OBJ_MODBUS, &c->startup);
 }
 
 const struct hal_comp_type hal_comp_modbus = { "modbus", modbus_hal_load };
