@@ -7,6 +7,7 @@
 #include "hal/drivers/cia402_hal.h"
 #include "hal/hal.h"
 #include "sim/cia402_sim.h"
+#include "sim/cia402_sim_hal.h"
 
 /*
  * `loadrt cia402-sim [count=N]` after `loadrt cia402` with [CAN]INTERFACE = sim: one
@@ -96,8 +97,8 @@ static void sim_update(void *arg, long period_ns)
     c->now_ns += period_ns;
 }
 
-/* Drive i from [CAN_NODE_i]. */
-static int chan_cfg(struct hal *h, int i, struct cia402_sim_cfg *sc)
+/* Drive i from [CAN_NODE_i] (also used by `hexcnc can_sim`). */
+int cia402_sim_cfg_read(struct hal *h, int i, struct cia402_sim_cfg *sc)
 {
     char sec[32];
     long id;
@@ -165,7 +166,7 @@ static int sim_load(struct hal *h, int argc, char **argv)
     c->count = count;
     for (int i = 0; i < count; i++) {
         struct cia402_sim_cfg sc = { 0 };
-        if ((st = chan_cfg(h, i, &sc)) || (st = chan_pins(h, &c->chan[i], i)))
+        if ((st = cia402_sim_cfg_read(h, i, &sc)) || (st = chan_pins(h, &c->chan[i], i)))
             return st;
         cia402_sim_init(&c->chan[i].sim, &sc);
     }

@@ -311,6 +311,16 @@ bool canopen_master_all_enabled(const struct canopen_master *m)
     return true;
 }
 
+/* Every node loses its bus at once; one message for all. */
+void canopen_master_bus_lost(struct canopen_master *m, const char *why)
+{
+    for (int i = 0; i < m->cfg.n_nodes; i++) {
+        struct canopen_node *n = &m->node[i];
+        node_comm_fault(n, CANOPEN_ERR_BUS_LOST, "%s", why);
+        n->message_new = false;
+    }
+}
+
 /* Failed if any node has a fault latched, ready when all run with a statusword. */
 enum canopen_startup canopen_master_startup(const struct canopen_master *m, int *failed_node)
 {

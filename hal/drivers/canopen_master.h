@@ -130,6 +130,9 @@ int canopen_master_step(struct canopen_master *m, int64_t now_ns, struct can_fra
                         int max_out);
 /* True when every node is in RUN and Operation enabled. */
 bool canopen_master_all_enabled(const struct canopen_master *m);
+/* The transport is gone: every node gets a communication fault with `why` as its message
+ * (message_new stays false: the caller reports the bus once, not each node). */
+void canopen_master_bus_lost(struct canopen_master *m, const char *why);
 /* The bus's start-up: starting, ready or failed (then *failed_node = its index, else -1). */
 enum canopen_startup canopen_master_startup(const struct canopen_master *m, int *failed_node);
 /* The longest start-up the configuration allows, ns: BOOT_TIMEOUT, every configuration write

@@ -47,10 +47,11 @@ static void cia402_update(void *arg, long period_ns)
     struct cia402_comp *c = arg;
     struct canopen_master *m = &c->m;
     uint32_t dropped = c->bus.tx_dropped, rxerr = c->bus.rx_errors;
+    bool closed_before = c->bus.peer_closed;
     int nrx = can_bus_recv_batch(&c->bus, c->rx, CIA402_RX_MAX);
     for (int i = 0; i < nrx; i++)
         canopen_master_rx(m, &c->rx[i], c->now_ns);
-    bool any = c->bus.bus_off;
+    bool any = c->bus.bus_off || c->bus.peer_closed;
     for (int i = 0; i < m->cfg.n_nodes; i++) {
         struct canopen_node *n = &m->node[i];
         struct cia402_chan *ch = &c->chan[i];
@@ -61,6 +62,13 @@ static void cia402_update(void *arg, long period_ns)
     }
     int ntx = canopen_master_step(m, c->now_ns, c->tx, (int)(sizeof c->tx / sizeof c->tx[0]));
     can_bus_send_batch(&c->bus, c->tx, ntx);
+    if (c->bus.peer_closed && !closed_before) {  /* once: every drive is gone with it */
+        char why[CANOPEN_MSG_LEN];
+        snprintf(why, sizeof why, "CAN bus %s: the other end closed the connection (%s): "
+                 "every drive is off the bus", c->bus.ifname, strerror(c->bus.last_errno));
+        canopen_master_bus_lost(m, why);
+        hal_msg_post(c->h, HAL_MSG_FAULT, "cia402", "%s", why);
+    }
     for (int i = 0; i < m->cfg.n_nodes; i++) {
         struct canopen_node *n = &m->node[i];
         struct cia402_chan *ch = &c->chan[i];
@@ -82,7 +90,7 @@ static void cia402_update(void *arg, long period_ns)
     *c->fault_any = any;
     *c->all_enabled = canopen_master_all_enabled(m);
     *c->bus_off = c->bus.bus_off;
-    *c->bus_error = c->bus.bus_off || c->bus.tx_dropped != dropped || c->bus.rx_errors != rxerr;
+    *c->bus_error = c->bus.bus_off || c->bus.peer_closed || c->bus.tx_dropped != dropped || c->bus.rx_errors != rxerr;
     *c->tx_dropped = c->bus.tx_dropped;
     *c->rx_errors = c->bus.rx_errors;
     *c->err_frames = c->bus.err_frames;
@@ -92,7 +100,7 @@ static void cia402_update(void *arg, long period_ns)
                                       [CANOPEN_READY] = DRIVE_STARTUP_READY,
                                       [CANOPEN_FAILED] = DRIVE_STARTUP_FAILED };
     enum canopen_startup su = canopen_master_startup(m, &failed);
-    atomic_store(&c->startup.state, c->bus.bus_off ? DRIVE_STARTUP_FAILED : startup_of[su]);
+    atomic_store(&c->startup.state, c->bus.bus_off || c->bus.peer_closed ? DRIVE_STARTUP_FAILED : startup_of[su]);
     c->now_ns += period_ns;
 }
 
@@ -245,7 +253,7 @@ static int open_bus(struct hal *h, struct cia402_comp *c)
     char err[300];
     if (!ifname)
         return hal_error(h, HAL_ERR_COMPONENT, "cia402: %s: [CAN]INTERFACE is missing (a "
-                         "SocketCAN interface such as can0, or sim)",
+                         "SocketCAN interface such as can0, sim, or unix:PATH)",
                          hal_ini_path(h) ? hal_ini_path(h) : "(no INI file)");
     if (can_bus_open(&c->bus, ifname, err, sizeof err) != CAN_BUS_OK)
         return hal_error(h, HAL_ERR_COMPONENT, "cia402: %s: [CAN]INTERFACE = %s: %s",
