@@ -39,6 +39,7 @@ void cia402_sim_init(struct cia402_sim *s, const struct cia402_sim_cfg *cfg)
     s->cfg = *cfg;
     s->actual_counts = s->target_counts = cfg->start_counts;
     s->state = CIA402_NOT_READY;
+    s->quick_stop_option = 2;  /* the CiA 402 default: stop, then Switch on disabled */
     s->fault_code = 0x5000;  /* device hardware, unless the test says otherwise */
     s->fault_reg = 0x01;     /* generic error */
     reset_comm(s);
@@ -165,6 +166,9 @@ static int on_sync(struct cia402_sim *s, struct can_frame *out, int max)
         s->state = CIA402_FAULT_REACTION;                 /* transition 13 */
         if (k < max)
             canopen_emcy(&out[k++], s->cfg.node_id, s->fault_code, s->fault_reg);
+    } else if (s->state == CIA402_QUICK_STOP && before == CIA402_QUICK_STOP &&
+               s->quick_stop_option >= 0 && s->quick_stop_option <= 4) {
+        s->state = CIA402_SWITCH_ON_DISABLED;  /* stopped: the option drops the power stage */
     } else {
         s->state = drive_transition(s->state, cw);
     }

@@ -18,7 +18,9 @@
  *  - synchronous PDOs: an RPDO is stored and actuated at the next SYNC; at each SYNC the
  *    TPDO is sent with the objects its mapping names (any mapping of the objects above);
  *  - the CiA 402 state machine driven by the controlword, and in Operation enabled a CSP
- *    position model: the actual position follows the target, velocity-limited;
+ *    position model: the actual position follows the target, velocity-limited; a quick stop
+ *    as 0x605A says: codes 0..4 stop and then drop to Switch on disabled by themselves one
+ *    SYNC later (power stage off), 5..8 stay in Quick stop active holding; default 2;
  *  - fault injection: drive fault with EMCY, heartbeat stop, TPDO stop, SDO abort, silence;
  *  - a start-up time: the boot-up message comes boot_delay_ns after power-on or reset.
  */
@@ -61,6 +63,7 @@ struct cia402_sim {
     uint32_t tpdo_map[4];            /* 0x1A00:01..04 */
     uint16_t controlword;            /* 0x6040 */
     uint16_t statusword;             /* 0x6041 */
+    int16_t quick_stop_option;       /* 0x605A: 0..4 end in Switch on disabled, 5..8 hold */
     int8_t mode;                     /* 0x6060 */
     int8_t mode_display;             /* 0x6061 */
     int32_t actual_counts;           /* 0x6064 */

@@ -119,6 +119,15 @@ START_TEST(test_drive_fault_stops_machine)
         ck_assert_double_eq(m->node[i].position_fb_mm, held[i]);
     for (int i = 0; i < NLEGS; i++)  /* the others quick-stopped and holding; one in Fault */
         ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_QUICK_STOP);
+    /* and still so 200 ms later: quick stop option 6 keeps them under power (the CiA 402
+     * default would have dropped them to Switch on disabled after the ramp) */
+    ck_assert_int_eq(hal_sim_advance(h, 200 * PERIOD_NS), HAL_OK);
+    for (int i = 0; i < NLEGS; i++) {
+        ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_QUICK_STOP);
+        ck_assert_uint_eq(m->node[i].controlword, i == 2 ? CIA402_CW_DISABLE_VOLTAGE
+                                                         : CIA402_CW_QUICK_STOP);
+        ck_assert_double_eq(m->node[i].position_fb_mm, held[i]);
+    }
     /* reset: drives first, then the latch; all six come back to Operation enabled */
     ck_assert_int_eq(hal_sets(h, "drive-reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "0"), HAL_OK);

@@ -461,6 +461,46 @@ START_TEST(test_quick_stop)
 }
 END_TEST
 
+/* A fault stop as configs/can-sim wires it (enable false and quick-stop true together): the
+ * master has written quick stop option code 6 (0x605A), so every frame to the drive carries
+ * quick stop 0x0002 for as long as the stop lasts, never disable voltage 0x0000, and the
+ * drive stays in Quick stop active holding its position under power. A drive left at the
+ * CiA 402 default option 2 would drop to Switch on disabled one SYNC after stopping (power
+ * off) and be sent 0x0000 - what the write prevents. */
+START_TEST(test_fault_stop_holds)
+{
+    for (int option = 6; option >= 2; option -= 4) {
+        struct rig r;
+        rig_init(&r, 2, 2000000);
+        rig_run_ms(&r, 80);
+        ck_assert_int_eq(r.sim[0].quick_stop_option, 6);   /* written at configuration */
+        r.sim[0].quick_stop_option = (int16_t)option;      /* 2: as if it had not been */
+        for (int i = 0; i < r.n; i++)
+            r.m.node[i].position_cmd_mm = r.m.node[i].position_fb_mm;
+        rig_enable(&r, true);
+        rig_run_ms(&r, 20);
+        ck_assert(canopen_master_all_enabled(&r.m));
+        int32_t held = r.sim[0].actual_counts;
+        r.ncw = 0;
+        for (int i = 0; i < r.n; i++) {
+            r.m.node[i].enable = false;
+            r.m.node[i].quick_stop = true;
+        }
+        rig_run_ms(&r, 200);
+        if (option == 6) {
+            ck_assert_int_eq(r.ncw, 1);
+            ck_assert_uint_eq(r.cw_seen[0], CIA402_CW_QUICK_STOP);
+            ck_assert_int_eq(r.sim[0].state, CIA402_QUICK_STOP);
+            ck_assert_int_eq(r.m.node[0].state, CIA402_QUICK_STOP);
+            ck_assert_int_eq(r.sim[0].actual_counts, held);
+        } else {
+            ck_assert_int_eq(r.sim[0].state, CIA402_SWITCH_ON_DISABLED);
+            ck_assert_uint_eq(r.cw_seen[r.ncw - 1], CIA402_CW_DISABLE_VOLTAGE);
+        }
+    }
+}
+END_TEST
+
 /* Bad configurations are refused with a message naming the value. */
 START_TEST(test_config_errors)
 {
@@ -507,6 +547,7 @@ static Suite *master_suite(void)
     tcase_add_test(tc, test_heartbeat_loss);
     tcase_add_test(tc, test_feedback_loss);
     tcase_add_test(tc, test_quick_stop);
+    tcase_add_test(tc, test_fault_stop_holds);
     tcase_add_test(tc, test_config_errors);
     suite_add_tcase(s, tc);
     return s;

@@ -22,6 +22,8 @@ static const struct {
 } config_writes[] = {
     { CANOPEN_OD_HEARTBEAT_PRODUCER, 0, 2, HB_PERIOD, 0, "heartbeat producer time" },
     { CIA402_OD_MODES_OF_OP, 0, 1, 0, CIA402_MODE_CSP, "modes of operation (8 = CSP)" },
+    { CIA402_OD_QUICK_STOP_OPTION, 0, 2, 0, CIA402_QUICK_STOP_HOLD,
+      "quick stop option code (6 = stop and hold in Quick stop active)" },
     { CIA402_OD_INTERP_PERIOD, 1, 1, INTERP_VALUE, 0, "interpolation time period value" },
     { CIA402_OD_INTERP_PERIOD, 2, 1, INTERP_INDEX, 0, "interpolation time index" },
     { CANOPEN_OD_RPDO1_COMM, 1, 4, ADD_NODE, CANOPEN_PDO_COBID_INVALID | CANOPEN_COB_RPDO1,

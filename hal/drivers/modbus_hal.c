@@ -16,6 +16,12 @@
  * default on the real-time clock) or, with the simulated clock (io=inline), in modbus.update
  * itself once every set-point period, so simulated runs are deterministic.
  *
+ * After a fault stop a hexapod's legs must keep carrying the platform: while `hold` is true
+ * (the e-stop latch's fault-out) and `enable` false, a drive that is not itself faulted
+ * keeps ENABLE set with its target frozen at the command of the moment the hold began, so
+ * it holds position under power; enable false without hold clears ENABLE (power stage off,
+ * the drive's brake takes the load).
+ *
  *   loadrt modbus [count=N] [section=MODBUS] [io=thread|inline]
  */
 
@@ -28,6 +34,7 @@ struct modbus_hal_drive {
     double *pos_cmd;          /* in: commanded position, mm */
     bool *enable;             /* in: enable the drive */
     bool *fault_reset;        /* in: rising edge clears the fault and reconnects */
+    bool *hold;               /* in: while true and enable false, stay enabled holding */
     double *pos_fb;           /* out: actual position, mm */
     bool *fault;              /* out: latched communication or drive fault */
     bool *connected;          /* out: a connection is open */
@@ -36,6 +43,8 @@ struct modbus_hal_drive {
     uint32_t *errors;         /* out: failed connects and exchanges */
     uint32_t *status_word;    /* out: the drive's status word */
     bool reset_last;          /* fault-reset in the previous period (edge detection) */
+    bool holding;             /* hold in force: ENABLE kept, target frozen at hold_mm */
+    double hold_mm;           /* the command when the hold began, mm */
     long setpoint_ticks;      /* inline: servo periods per set-point period (0 = not yet) */
     long tick;                /* inline: servo periods since the last exchange */
     bool linked;              /* link initialised (needs fini) */
@@ -140,7 +149,11 @@ static void modbus_hal_update(void *arg, long period_ns)
         if (*d->fault_reset && !d->reset_last)
             modbus_link_reset(&d->link);
         d->reset_last = *d->fault_reset;
-        modbus_link_command(&d->link, *d->pos_cmd, *d->enable);
+        bool hold = *d->hold && !*d->enable && !*d->fault;
+        if (hold && !d->holding)
+            d->hold_mm = *d->pos_cmd;
+        d->holding = hold;
+        modbus_link_command(&d->link, hold ? d->hold_mm : *d->pos_cmd, *d->enable || hold);
         if (c->inline_io && modbus_hal_due(d, period_ns))
             modbus_link_cycle(&d->link);
         any = modbus_hal_publish(d) || any;
@@ -166,6 +179,7 @@ static int modbus_hal_pins(struct hal *h, struct modbus_hal_drive *d, int i)
     if ((rc = hal_pin_float_newf(h, HAL_IN, &d->pos_cmd, "modbus.%d.position-cmd", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_IN, &d->enable, "modbus.%d.enable", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_IN, &d->fault_reset, "modbus.%d.fault-reset", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &d->hold, "modbus.%d.hold", i)) ||
         (rc = hal_pin_float_newf(h, HAL_OUT, &d->pos_fb, "modbus.%d.position-fb", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &d->fault, "modbus.%d.fault", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &d->connected, "modbus.%d.connected", i)) ||
