@@ -205,7 +205,8 @@ const struct config_key config_keys[] = {
       "limit (0: none)" },
 
     /* [CAN], [CAN_NODE_#] */
-    { "CAN", "INTERFACE", STR, "", "", 0, 0, "", "SocketCAN interface (can0, vcan0)" },
+    { "CAN", "INTERFACE", STR, "", "", 0, 0, "", "SocketCAN interface (can0, vcan0), or "
+      "unix:PATH: a SOCK_SEQPACKET socket carrying one CAN frame a message" },
     { "CAN", "SYNC_PERIOD", INT, "ns", "> 0", 0, 0, "servo period", "SYNC period, a multiple "
       "of the servo period" },
     { "CAN", "BITRATE", INT, "bit/s", "> 0", 0, 0, "1000000", "bus bit rate, for the bus "
@@ -214,6 +215,8 @@ const struct config_key config_keys[] = {
     { "CAN", "HEARTBEAT_TIMEOUT", INT, "ms", "> 0", 0, 0, "100", "a drive is lost after this "
       "long without a heartbeat" },
     { "CAN", "BOOT_TIMEOUT", INT, "ms", "> 0", 0, 0, "1000", "time a drive has to boot" },
+    { "CAN", "FEEDBACK_TIMEOUT_SYNCS", INT, "SYNC periods", "1..1000", 0, 0, "3", "position "
+      "feedback (TPDO1) missing for longer than this many SYNC periods is a fault" },
     { "CAN_NODE_#", "NODE_ID", INT, "", "1..127", 0, REQ, "", "CANopen node id" },
     { "CAN_NODE_#", "COUNTS_PER_MM", NUM, "counts/mm", "!= 0", 0, REQ, "", "position counts "
       "per mm of leg (negative reverses)" },
@@ -221,6 +224,8 @@ const struct config_key config_keys[] = {
     { "CAN_NODE_#", "SDO_TIMEOUT", INT, "ms", "> 0", 0, 0, "100", "SDO reply time-out" },
     { "CAN_NODE_#", "SIM_START", NUM, "mm", "", 0, 0, "OFFSET", "simulated drive: leg length "
       "at power-on" },
+    { "CAN_NODE_#", "SIM_BOOT_DELAY", NUM, "ms", "0..60000", 0, 0, "0", "simulated drive: "
+      "boot-up delay after power-on or NMT reset" },
     { "CAN_NODE_#", "SIM_MAX_VELOCITY", NUM, "mm/s", ">= 0", 0, 0, "0", "simulated drive: "
       "speed limit (0: none)" },
 };

@@ -2,6 +2,7 @@
 #include "sim/cia402_sim.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "sim/cia402_sim_od.h"
@@ -21,6 +22,14 @@ static void reset_comm(struct cia402_sim *s)
     s->rpdo_fresh = false;
     s->nmt = CANOPEN_STATE_PREOP;
     s->boot_pending = true;
+    s->boot_due_ns = INT64_MIN;  /* the caller's clock starts the start-up time */
+}
+
+/* Times a pending boot-up from now_ns if it is not timed yet. */
+static void boot_schedule(struct cia402_sim *s, int64_t now_ns)
+{
+    if (s->boot_pending && s->boot_due_ns == INT64_MIN)
+        s->boot_due_ns = now_ns + s->cfg.boot_delay_ns;
 }
 
 /* Power-on: dictionary defaults, drive Not ready to switch on. */
@@ -30,6 +39,7 @@ void cia402_sim_init(struct cia402_sim *s, const struct cia402_sim_cfg *cfg)
     s->cfg = *cfg;
     s->actual_counts = s->target_counts = cfg->start_counts;
     s->state = CIA402_NOT_READY;
+    s->quick_stop_option = 2;  /* the CiA 402 default: stop, then Switch on disabled */
     s->fault_code = 0x5000;  /* device hardware, unless the test says otherwise */
     s->fault_reg = 0x01;     /* generic error */
     reset_comm(s);
@@ -156,6 +166,9 @@ static int on_sync(struct cia402_sim *s, struct can_frame *out, int max)
         s->state = CIA402_FAULT_REACTION;                 /* transition 13 */
         if (k < max)
             canopen_emcy(&out[k++], s->cfg.node_id, s->fault_code, s->fault_reg);
+    } else if (s->state == CIA402_QUICK_STOP && before == CIA402_QUICK_STOP &&
+               s->quick_stop_option >= 0 && s->quick_stop_option <= 4) {
+        s->state = CIA402_SWITCH_ON_DISABLED;  /* stopped: the option drops the power stage */
     } else {
         s->state = drive_transition(s->state, cw);
     }
@@ -167,7 +180,7 @@ static int on_sync(struct cia402_sim *s, struct can_frame *out, int max)
     s->statusword = statusword_of(s->state);
     s->mode_display = s->mode;
     if (!(s->tpdo_cob & CANOPEN_PDO_COBID_INVALID) && s->tpdo_tt >= 1 && s->tpdo_tt <= 240 &&
-        k < max)
+        !(s->inject & CIA402_SIM_TPDO_STOP) && k < max)
         build_tpdo(s, &out[k++]);
     return k;
 }
@@ -197,10 +210,10 @@ int cia402_sim_rx(struct cia402_sim *s, const struct can_frame *in, int64_t now_
     int node;
     if (s->inject & CIA402_SIM_SILENT)
         return 0;
-    (void)now_ns;
     switch (canopen_classify(in, &node)) {
     case CANOPEN_KIND_NMT:
         on_nmt(s, in);
+        boot_schedule(s, now_ns);  /* a reset's start-up time runs from its NMT frame */
         return 0;
     case CANOPEN_KIND_SYNC:
         return s->nmt == CANOPEN_STATE_OPERATIONAL ? on_sync(s, out, max_out) : 0;
@@ -232,7 +245,8 @@ int cia402_sim_step(struct cia402_sim *s, int64_t now_ns, struct can_frame *out,
     s->statusword = statusword_of(s->state);
     if (s->inject & CIA402_SIM_SILENT)
         return 0;
-    if (s->boot_pending && k < max_out) {
+    boot_schedule(s, now_ns);
+    if (s->boot_pending && now_ns >= s->boot_due_ns && k < max_out) {
         canopen_heartbeat(&out[k++], s->cfg.node_id, CANOPEN_STATE_BOOTUP);
         s->boot_pending = false;
         s->next_heartbeat_ns = now_ns;

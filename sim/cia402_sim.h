@@ -18,8 +18,11 @@
  *  - synchronous PDOs: an RPDO is stored and actuated at the next SYNC; at each SYNC the
  *    TPDO is sent with the objects its mapping names (any mapping of the objects above);
  *  - the CiA 402 state machine driven by the controlword, and in Operation enabled a CSP
- *    position model: the actual position follows the target, velocity-limited;
- *  - fault injection: drive fault with EMCY, heartbeat stop, SDO abort, silence.
+ *    position model: the actual position follows the target, velocity-limited; a quick stop
+ *    as 0x605A says: codes 0..4 stop and then drop to Switch on disabled by themselves one
+ *    SYNC later (power stage off), 5..8 stay in Quick stop active holding; default 2;
+ *  - fault injection: drive fault with EMCY, heartbeat stop, TPDO stop, SDO abort, silence;
+ *  - a start-up time: the boot-up message comes boot_delay_ns after power-on or reset.
  */
 
 /* Faults to inject (a bit set). */
@@ -29,6 +32,7 @@ enum cia402_sim_fault {
     CIA402_SIM_SDO_ABORT = 1u << 2,      /* abort writes to abort_index:abort_sub */
     CIA402_SIM_SDO_MUTE = 1u << 3,       /* SDO requests go unanswered */
     CIA402_SIM_SILENT = 1u << 4,         /* the node sends nothing at all (unplugged) */
+    CIA402_SIM_TPDO_STOP = 1u << 5,      /* no more TPDOs (position feedback); heartbeats go on */
 };
 
 /* How one simulated drive is set up. */
@@ -36,13 +40,16 @@ struct cia402_sim_cfg {
     int node_id;                    /* 1..127 */
     double max_velocity_counts_s;   /* CSP following limit, counts/s; 0 = follows exactly */
     int32_t start_counts;           /* position actual value at power-on */
+    int64_t boot_delay_ns;          /* boot-up sent this long after power-on or NMT reset
+                                     * (a real drive's start-up takes 0.1..2 s), ns */
 };
 
 /* One simulated drive: its object dictionary, state machine, position and injected faults. */
 struct cia402_sim {
     struct cia402_sim_cfg cfg;       /* as given */
     enum canopen_nmt_state nmt;      /* NMT state */
-    bool boot_pending;               /* a boot-up message is due at the next step */
+    bool boot_pending;               /* a boot-up message is due (at boot_due_ns) */
+    int64_t boot_due_ns;             /* when it goes out; INT64_MIN: timed from the next call */
     int64_t next_heartbeat_ns;       /* when the next heartbeat is due */
     /* object dictionary (the SDO server reads and writes these through a table) */
     uint16_t heartbeat_ms;           /* 0x1017 */
@@ -56,6 +63,7 @@ struct cia402_sim {
     uint32_t tpdo_map[4];            /* 0x1A00:01..04 */
     uint16_t controlword;            /* 0x6040 */
     uint16_t statusword;             /* 0x6041 */
+    int16_t quick_stop_option;       /* 0x605A: 0..4 end in Switch on disabled, 5..8 hold */
     int8_t mode;                     /* 0x6060 */
     int8_t mode_display;             /* 0x6061 */
     int32_t actual_counts;           /* 0x6064 */

@@ -28,6 +28,7 @@ static const struct cia402_sim_obj od[] = {
     OBJ(0x1A00, 4, 4, 0, tpdo_map[3]),
     OBJ(0x6040, 0, 2, MAP, controlword),
     OBJ(0x6041, 0, 2, MAP | RO, statusword),
+    OBJ(0x605A, 0, 2, 0, quick_stop_option),
     OBJ(0x6060, 0, 1, MAP, mode),
     OBJ(0x6061, 0, 1, MAP | RO, mode_display),
     OBJ(0x6064, 0, 4, MAP | RO, actual_counts),
@@ -105,6 +106,8 @@ static uint32_t write_check(const struct cia402_sim *s, const struct cia402_sim_
 {
     if (o->index == 0x6060 && (int8_t)v != CIA402_MODE_CSP)
         return 0x06090030u;  /* this drive simulates CSP only */
+    if (o->index == 0x605A && ((int16_t)v < 0 || (int16_t)v > 8))
+        return 0x06090030u;  /* manufacturer-specific codes are not simulated */
     bool map = o->index == 0x1600 || o->index == 0x1A00;
     if (map && o->sub >= 1 && !map_entry_ok(v, o->index == 0x1600))
         return 0x06040041u;

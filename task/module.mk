@@ -1,6 +1,6 @@
 # task/: the runner behind `hexcnc run`: INI + HAL files, interpret and plan the whole
 # program, run it on the servo thread, watch every period, summarise.
 LIB_SRCS += task/runner.c task/runner_exec.c task/runner_settings.c
-TESTS += test_e2e test_run_faults test_run_settings
+TESTS += test_e2e test_run_faults test_run_settings test_run_startup
 BENCHES += bench_servo
 SCRIPT_TESTS += tests/e2e/run_cli.sh

@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include "common/errbuf.h"
+#include "hal/drivers/drive_startup.h"
 #include "hal/components/lcm_status.h"
 #include "motion/motion_hal.h"
 
@@ -119,6 +120,8 @@ int runner_start(struct runner *r, char *err, size_t errlen)
     r->settings_applied = 0;
     r->save_err[0] = '\0';
     atomic_store(&r->mon_settings, 0);
+    r->ready_since = -1;
+    r->first_fault[0] = '\0';  /* the cause of this run's stop, not of an earlier one */
     /* Machine on: out of e-stop (reset pulse to the latch), then enabled. */
     *r->user_enable_out = true;
     if (!*r->emc_enable_in)
@@ -248,16 +251,64 @@ static int runner_outcome(struct runner *r, char *err, size_t errlen)
     return RUNNER_OK;
 }
 
-/* A program that has not started moving after this many periods never will: the machine
- * is held in e-stop (motion.enable false). */
+/* Once the drives are ready, a program that has not started moving after this many periods
+ * never will: the machine is held in e-stop (motion.enable false). */
 #define RUNNER_START_PERIODS 100
 
-/* Says why a started program stays idle, instead of waiting for the time-out. */
+/* The drives' start-up as the drive components report it (drive_startup.h): the worst state
+ * and the longest budget; ready when no drive component is loaded. */
+static enum drive_startup_state runner_drives_startup(struct runner *r, int64_t *budget_ns,
+                                                      const char **what)
+{
+    static const char *const names[] = DRIVE_STARTUP_OBJECTS;
+    enum drive_startup_state worst = DRIVE_STARTUP_READY;
+    *budget_ns = 0;
+    *what = "the drives";
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        struct drive_startup *d = hal_get_object(r->hal, names[i]);
+        if (!d)
+            continue;
+        int st = atomic_load(&d->state);
+        if (d->budget_ns > *budget_ns)
+            *budget_ns = d->budget_ns;
+        if (st == DRIVE_STARTUP_FAILED || (st == DRIVE_STARTUP_STARTING &&
+                                           worst == DRIVE_STARTUP_READY)) {
+            worst = (enum drive_startup_state)st;
+            *what = d->what;
+        }
+    }
+    return worst;
+}
+
+/* Says why a started program stays idle: a drive that failed to start (its own message),
+ * drives still starting past the time their configuration allows, or, with every drive
+ * ready, an e-stop chain that never released. Waits meanwhile. */
 static int runner_check_started(struct runner *r, char *err, size_t errlen)
 {
     if (r->aborting || r->running_periods > 0 ||
-        atomic_load(&r->mon_periods) < RUNNER_START_PERIODS ||
         (enum motion_state)atomic_load(&r->mon_state) != MOTION_IDLE)
+        return RUNNER_OK;
+    int64_t budget_ns;
+    const char *what;
+    enum drive_startup_state st = runner_drives_startup(r, &budget_ns, &what);
+    long periods = atomic_load(&r->mon_periods);
+    double waited_ms = (double)periods * (double)r->period_ns * 1e-6;
+    if (st == DRIVE_STARTUP_FAILED || r->first_fault[0])
+        return errbuf_set(err, errlen, RUNNER_ERR_FAULT, "a drive faulted before motion, the "
+                           "program did not start: %s", r->first_fault[0] ? r->first_fault
+                           : what);
+    if (st == DRIVE_STARTUP_STARTING) {
+        r->ready_since = -1;
+        if ((double)periods * (double)r->period_ns <= (double)budget_ns +
+            RUNNER_START_PERIODS * (double)r->period_ns)
+            return RUNNER_OK;
+        return errbuf_set(err, errlen, RUNNER_ERR_TIMEOUT, "%s still starting after %.0f ms, "
+                           "longer than their configured time-outs allow (%.0f ms): the "
+                           "program did not start", what, waited_ms, (double)budget_ns * 1e-6);
+    }
+    if (r->ready_since < 0)
+        r->ready_since = periods;
+    if (periods - r->ready_since < RUNNER_START_PERIODS)
         return RUNNER_OK;
     return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine did not come out of "
                        "e-stop: motion.enable stayed false (task.emc-enable-in %s); the HAL "

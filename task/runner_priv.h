@@ -21,6 +21,8 @@ struct runner {
     bool loaded;                        /* a program is planned */
     bool started;                       /* runner_start succeeded */
     bool aborting;                      /* runner_abort was called */
+    long ready_since;                   /* monitor periods when the drives were first seen
+                                         * ready after the start; -1 not yet */
     runner_message_fn msg_fn;           /* gets every component message (may be NULL) */
     void *msg_ctx;
     char first_fault[300];              /* "source: text" of the first fault message: the cause */

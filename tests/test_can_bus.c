@@ -3,10 +3,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "hal/drivers/can_bus.h"
 #include "hal/drivers/canopen_master.h"
+#include "hal/drivers/cia402_hal.h"
 #include "hal/hal.h"
 #include "sim/cia402_sim.h"
 
@@ -182,6 +186,131 @@ START_TEST(test_real_interface_error)
 }
 END_TEST
 
+/* The other end of the pair closes: reads end at once (a zero-length message is the end of
+ * the stream; recvmmsg used to return it forever and the servo thread spun), writes fail
+ * without SIGPIPE, and the bus says the peer is gone. */
+START_TEST(test_peer_closed)
+{
+    for (int batched = 0; batched <= 1; batched++) {
+        struct can_bus b;
+        char err[200];
+        ck_assert_int_eq(can_bus_open(&b, CAN_BUS_SIM, err, sizeof err), CAN_BUS_OK);
+        struct can_frame f[8];
+        memset(f, 0, sizeof f);
+        close(b.sim_peer_fd);
+        b.sim_peer_fd = -1;
+        int n = batched ? can_bus_recv_batch(&b, f, 8) : can_bus_recv(&b, f, 8);
+        ck_assert_int_eq(n, 0);
+        ck_assert(b.peer_closed);
+        ck_assert_int_eq(batched ? can_bus_send_batch(&b, f, 3) : can_bus_send(&b, f, 3), 0);
+        ck_assert_uint_eq(b.tx_dropped, 3);
+        can_bus_close(&b);
+    }
+    struct can_bus b;  /* sending first finds it too */
+    char err[200];
+    ck_assert_int_eq(can_bus_open(&b, CAN_BUS_SIM, err, sizeof err), CAN_BUS_OK);
+    close(b.sim_peer_fd);
+    b.sim_peer_fd = -1;
+    struct can_frame f = { .can_id = 0x80 };
+    ck_assert_int_eq(can_bus_send_batch(&b, &f, 1), 0);
+    ck_assert(b.peer_closed);
+    can_bus_close(&b);
+}
+END_TEST
+
+/* The HAL component on a closed pair: one fault message naming the bus, fault-any, every
+ * drive faulted, and the servo period returns (within 2 s of wall time for 50 periods). */
+START_TEST(test_cia402_peer_closed)
+{
+    char path[] = "/tmp/test_can_bus_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    const char ini[] = "[KINS]\nJOINTS = 2\n[CAN]\nINTERFACE = sim\n"
+                       "[CAN_NODE_0]\nNODE_ID = 1\nCOUNTS_PER_MM = 1000\n"
+                       "[CAN_NODE_1]\nNODE_ID = 2\nCOUNTS_PER_MM = 1000\n";
+    ck_assert_int_eq(write(fd, ini, sizeof ini - 1), (ssize_t)(sizeof ini - 1));
+    close(fd);
+    struct hal *h = hal_create();
+    ck_assert_int_eq(hal_load_ini(h, path), HAL_OK);
+    hal_set_sim_clock(h, true);
+    const char *cmds[] = { "newthread servo-thread 1000000", "loadrt cia402",
+                           "loadrt cia402-sim", "addf cia402.update servo-thread",
+                           "addf cia402-sim.update servo-thread" };
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++)
+        ck_assert_msg(hal_cmd(h, cmds[i], "test.hal", (int)i + 1, stdout) == HAL_OK, "%s",
+                      hal_last_error(h));
+    ck_assert_int_eq(hal_start(h), HAL_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 100 * 1000000L), HAL_OK);
+    const struct canopen_master *m = hal_get_object(h, CIA402_OBJ_MASTER);
+    ck_assert(m->node[0].phase == CANOPEN_PHASE_RUN && m->node[1].phase == CANOPEN_PHASE_RUN);
+    int *peer = hal_get_object(h, CIA402_OBJ_SIM_PEER);
+    shutdown(*peer, SHUT_RDWR);  /* the drives' end goes away (the component still owns it) */
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    ck_assert_int_eq(hal_sim_advance(h, 50 * 1000000L), HAL_OK);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    ck_assert_int_lt(t1.tv_sec - t0.tv_sec, 2);
+    char any[16];
+    ck_assert_int_eq(hal_getp(h, "cia402.fault-any", any, sizeof any), HAL_OK);
+    ck_assert_msg(strcmp(any, "TRUE") == 0 || strcmp(any, "true") == 0 || strcmp(any, "1") == 0,
+                  "%s", any);
+    ck_assert(m->node[0].fault && m->node[1].fault);
+    ck_assert_int_eq(m->node[1].fault_status, CANOPEN_ERR_BUS_LOST);
+    struct hal_msg msg;
+    int faults = 0;
+    while (hal_msg_take(h, &msg))
+        if (msg.severity == HAL_MSG_FAULT) {
+            faults++;
+            ck_assert_str_eq(msg.source, "cia402");
+            ck_assert_msg(strstr(msg.text, "CAN bus sim: the other end closed the connection")
+                          != NULL, "%s", msg.text);
+        }
+    ck_assert_int_eq(faults, 1);
+    hal_destroy(h);
+    unlink(path);
+}
+END_TEST
+
+/* [CAN]INTERFACE = unix:PATH connects to a SEQPACKET listener and carries frames both ways;
+ * a path nobody listens on is refused with the path and the command that would serve it. */
+START_TEST(test_unix_interface)
+{
+    char dir[] = "/tmp/test_can_unix_XXXXXX", path[96], name[160];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/can.sock", dir);
+    snprintf(name, sizeof name, "unix:%s", path);
+    struct can_bus b;
+    char err[300];
+    ck_assert_int_eq(can_bus_open(&b, name, err, sizeof err), CAN_BUS_ERR_SOCKET);
+    ck_assert_ptr_nonnull(strstr(err, path));
+    ck_assert_ptr_nonnull(strstr(err, "hexcnc can_sim"));
+    int lfd = socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    struct sockaddr_un sa = { .sun_family = AF_UNIX };
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", path);
+    ck_assert_int_eq(bind(lfd, (struct sockaddr *)&sa, sizeof sa), 0);
+    ck_assert_int_eq(listen(lfd, 1), 0);
+    ck_assert_msg(can_bus_open(&b, name, err, sizeof err) == CAN_BUS_OK, "%s", err);
+    int peer = accept(lfd, NULL, NULL);
+    ck_assert_int_ge(peer, 0);
+    struct can_frame out = { .can_id = 0x601, .can_dlc = 8, .data = { 0x2B, 0x17, 0x10 } }, in;
+    ck_assert_int_eq(can_bus_send_batch(&b, &out, 1), 1);
+    ck_assert_int_eq(can_fd_read(peer, &in), 1);
+    ck_assert_uint_eq(in.can_id, 0x601);
+    ck_assert_int_eq(memcmp(in.data, out.data, 8), 0);
+    struct can_frame ans = { .can_id = 0x581, .can_dlc = 8, .data = { 0x60 } }, got[4];
+    ck_assert_int_eq(can_fd_write(peer, &ans), 1);
+    ck_assert_int_eq(can_bus_recv_batch(&b, got, 4), 1);
+    ck_assert_uint_eq(got[0].can_id, 0x581);
+    close(peer);
+    ck_assert_int_eq(can_bus_recv_batch(&b, got, 4), 0);
+    ck_assert(b.peer_closed);
+    can_bus_close(&b);
+    close(lfd);
+    unlink(path);
+    rmdir(dir);
+}
+END_TEST
+
 /* The suite. */
 static Suite *can_bus_suite(void)
 {
@@ -192,6 +321,9 @@ static Suite *can_bus_suite(void)
     tcase_add_test(tc, test_full_queue_never_blocks);
     tcase_add_test(tc, test_master_over_pair);
     tcase_add_test(tc, test_real_interface_error);
+    tcase_add_test(tc, test_peer_closed);
+    tcase_add_test(tc, test_cia402_peer_closed);
+    tcase_add_test(tc, test_unix_interface);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -119,6 +119,15 @@ START_TEST(test_drive_fault_stops_machine)
         ck_assert_double_eq(m->node[i].position_fb_mm, held[i]);
     for (int i = 0; i < NLEGS; i++)  /* the others quick-stopped and holding; one in Fault */
         ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_QUICK_STOP);
+    /* and still so 200 ms later: quick stop option 6 keeps them under power (the CiA 402
+     * default would have dropped them to Switch on disabled after the ramp) */
+    ck_assert_int_eq(hal_sim_advance(h, 200 * PERIOD_NS), HAL_OK);
+    for (int i = 0; i < NLEGS; i++) {
+        ck_assert_int_eq(m->node[i].state, i == 2 ? CIA402_FAULT : CIA402_QUICK_STOP);
+        ck_assert_uint_eq(m->node[i].controlword, i == 2 ? CIA402_CW_DISABLE_VOLTAGE
+                                                         : CIA402_CW_QUICK_STOP);
+        ck_assert_double_eq(m->node[i].position_fb_mm, held[i]);
+    }
     /* reset: drives first, then the latch; all six come back to Operation enabled */
     ck_assert_int_eq(hal_sets(h, "drive-reset", "1"), HAL_OK);
     ck_assert_int_eq(hal_setp(h, "estop-latch.0.reset", "0"), HAL_OK);
@@ -131,6 +140,36 @@ START_TEST(test_drive_fault_stops_machine)
 }
 END_TEST
 
+/* Position feedback of one drive stops in the middle of the program (its heartbeat goes on):
+ * the first fault is the lost feedback, naming the node and the time, not a following
+ * error; the machine stops. */
+START_TEST(test_feedback_loss_named)
+{
+    struct hal *h = machine_with_program();
+    ck_assert_int_eq(hal_sim_advance(h, 1500 * PERIOD_NS), HAL_OK);
+    ck_assert(test_pin_value(h, "motion.path-vel") > 1.0);  /* moving */
+    struct hal_msg msg;
+    while (hal_msg_take(h, &msg))
+        ;
+    ck_assert_int_eq(hal_setp(h, "cia402-sim.2.tpdo-stop", "1"), HAL_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 20 * PERIOD_NS), HAL_OK);
+    ck_assert(test_pin_value(h, "motion.fault") != 0.0);
+    bool first = true;
+    while (hal_msg_take(h, &msg)) {
+        if (msg.severity != HAL_MSG_FAULT || !first)
+            continue;
+        first = false;
+        ck_assert_str_eq(msg.source, "cia402.2");
+        ck_assert_msg(strstr(msg.text, "no position feedback (TPDO1) from node 3 for 7 ms") !=
+                      NULL, "%s", msg.text);
+    }
+    ck_assert(!first);
+    ck_assert_msg(strstr(motion_hal_fault(h), "following error") == NULL, "%s",
+                  motion_hal_fault(h));
+    hal_destroy(h);
+}
+END_TEST
+
 /* The suite. */
 static Suite *can_e2e_suite(void)
 {
@@ -139,6 +178,7 @@ static Suite *can_e2e_suite(void)
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, test_paper_program_on_can);
     tcase_add_test(tc, test_drive_fault_stops_machine);
+    tcase_add_test(tc, test_feedback_loss_named);
     suite_add_tcase(s, tc);
     return s;
 }

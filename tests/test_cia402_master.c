@@ -1,5 +1,6 @@
 /* test_cia402_master.c: the CANopen master against simulated CiA 402 drives, in process. */
 #include <check.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -367,6 +368,58 @@ START_TEST(test_heartbeat_loss)
 }
 END_TEST
 
+/* Lost position feedback: a running drive whose TPDO1 stops (heartbeats going on) is
+ * reported once more than FEEDBACK_TIMEOUT_SYNCS SYNC periods (default 3, at 2 ms: 6 ms)
+ * passed without it, not before and within one servo period after; with the bound set
+ * to 6 the same takes 12 ms. */
+START_TEST(test_feedback_loss)
+{
+    for (int syncs = 0; syncs <= 6; syncs += 6) {
+        struct rig r;
+        rig_init(&r, 3, 2000000);
+        if (syncs) {  /* a different bound through the configuration */
+            struct canopen_master_cfg cfg = r.m.cfg;
+            cfg.feedback_timeout_syncs = syncs;
+            char err[200];
+            ck_assert_int_eq(canopen_master_init(&r.m, &cfg, err, sizeof err), CANOPEN_OK);
+        }
+        int64_t bound_ns = (syncs ? syncs : 3) * 2000000LL;
+        rig_run_ms(&r, 80);
+        rig_enable(&r, true);
+        rig_run_ms(&r, 20);
+        ck_assert(canopen_master_all_enabled(&r.m));
+        cia402_sim_inject(&r.sim[2], CIA402_SIM_TPDO_STOP);
+        int64_t detected = -1;
+        for (int i = 0; i < 200 && detected < 0; i++) {
+            rig_cycle(&r);
+            if (r.m.node[2].fault)
+                detected = r.now_ns - CYCLE_NS;
+        }
+        struct canopen_node *n = &r.m.node[2];
+        ck_assert_int_ge(detected, 0);
+        int64_t silence_ns = detected - n->last_tpdo_ns;
+        ck_assert_int_gt(silence_ns, bound_ns);
+        ck_assert_int_le(silence_ns, bound_ns + CYCLE_NS);
+        ck_assert_int_eq(n->fault_status, CANOPEN_ERR_PDO_TIMEOUT);
+        char want[96];
+        snprintf(want, sizeof want, "no position feedback (TPDO1) from node 3 for %lld ms",
+                 (long long)(silence_ns / 1000000));
+        ck_assert_msg(strstr(n->message, want) != NULL, "%s", n->message);
+        ck_assert_ptr_nonnull(strstr(n->message, "CAN node 3 (joint 2)"));
+        ck_assert(!r.m.node[0].fault && !r.m.node[1].fault);  /* the others go on */
+        ck_assert(r.sim[2].heartbeat_ms > 0);  /* its heartbeat was on: not a lost node */
+    }
+    /* out of range */
+    struct rig r;
+    rig_init(&r, 1, 2000000);
+    struct canopen_master_cfg cfg = r.m.cfg;
+    cfg.feedback_timeout_syncs = -1;
+    char err[200];
+    ck_assert_int_eq(canopen_master_init(&r.m, &cfg, err, sizeof err), CANOPEN_ERR_ARG);
+    ck_assert_ptr_nonnull(strstr(err, "FEEDBACK_TIMEOUT_SYNCS"));
+}
+END_TEST
+
 /* Quick stop: an enabled drive goes to Quick stop active and holds its position whatever
  * the command does; released, it passes Switch on disabled and climbs back to enabled. */
 START_TEST(test_quick_stop)
@@ -405,6 +458,46 @@ START_TEST(test_quick_stop)
     ck_assert_int_eq(nseen, 5);
     ck_assert_int_eq(seen[1], CIA402_SWITCH_ON_DISABLED);
     ck_assert_int_eq(seen[4], CIA402_OP_ENABLED);
+}
+END_TEST
+
+/* A fault stop as configs/can-sim wires it (enable false and quick-stop true together): the
+ * master has written quick stop option code 6 (0x605A), so every frame to the drive carries
+ * quick stop 0x0002 for as long as the stop lasts, never disable voltage 0x0000, and the
+ * drive stays in Quick stop active holding its position under power. A drive left at the
+ * CiA 402 default option 2 would drop to Switch on disabled one SYNC after stopping (power
+ * off) and be sent 0x0000 - what the write prevents. */
+START_TEST(test_fault_stop_holds)
+{
+    for (int option = 6; option >= 2; option -= 4) {
+        struct rig r;
+        rig_init(&r, 2, 2000000);
+        rig_run_ms(&r, 80);
+        ck_assert_int_eq(r.sim[0].quick_stop_option, 6);   /* written at configuration */
+        r.sim[0].quick_stop_option = (int16_t)option;      /* 2: as if it had not been */
+        for (int i = 0; i < r.n; i++)
+            r.m.node[i].position_cmd_mm = r.m.node[i].position_fb_mm;
+        rig_enable(&r, true);
+        rig_run_ms(&r, 20);
+        ck_assert(canopen_master_all_enabled(&r.m));
+        int32_t held = r.sim[0].actual_counts;
+        r.ncw = 0;
+        for (int i = 0; i < r.n; i++) {
+            r.m.node[i].enable = false;
+            r.m.node[i].quick_stop = true;
+        }
+        rig_run_ms(&r, 200);
+        if (option == 6) {
+            ck_assert_int_eq(r.ncw, 1);
+            ck_assert_uint_eq(r.cw_seen[0], CIA402_CW_QUICK_STOP);
+            ck_assert_int_eq(r.sim[0].state, CIA402_QUICK_STOP);
+            ck_assert_int_eq(r.m.node[0].state, CIA402_QUICK_STOP);
+            ck_assert_int_eq(r.sim[0].actual_counts, held);
+        } else {
+            ck_assert_int_eq(r.sim[0].state, CIA402_SWITCH_ON_DISABLED);
+            ck_assert_uint_eq(r.cw_seen[r.ncw - 1], CIA402_CW_DISABLE_VOLTAGE);
+        }
+    }
 }
 END_TEST
 
@@ -452,7 +545,9 @@ static Suite *master_suite(void)
     tcase_add_test(tc, test_nmt_boot);
     tcase_add_test(tc, test_fault_and_reset);
     tcase_add_test(tc, test_heartbeat_loss);
+    tcase_add_test(tc, test_feedback_loss);
     tcase_add_test(tc, test_quick_stop);
+    tcase_add_test(tc, test_fault_stop_holds);
     tcase_add_test(tc, test_config_errors);
     suite_add_tcase(s, tc);
     return s;

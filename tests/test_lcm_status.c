@@ -24,7 +24,7 @@ struct got {
     hexcnc_status_t status[MAX_MSGS];   /* fault_text not kept */
     char fault_text[MAX_MSGS][64];
     hexcnc_event_t event[16];           /* source/text copied below */
-    char source[16][32], text[16][160];
+    char source[16][32], text[16][1400];
 };
 
 /* Keeps one decoded status message. */
@@ -42,7 +42,7 @@ static void got_event(struct got *g, const hexcnc_event_t *m)
     ck_assert_int_lt(g->n_event, 16);
     g->event[g->n_event] = *m;
     snprintf(g->source[g->n_event], 32, "%s", m->source);
-    snprintf(g->text[g->n_event], 160, "%s", m->text);
+    snprintf(g->text[g->n_event], sizeof g->text[0], "%s", m->text);
     g->n_event++;
 }
 
@@ -116,7 +116,7 @@ static void sort_events(struct got *g)
     for (int i = 1; i < g->n_event; i++)
         for (int j = i; j > 0 && g->event[j].utime < g->event[j - 1].utime; j--) {
             hexcnc_event_t e = g->event[j];
-            char src[32], txt[160];
+            char src[32], txt[sizeof g->text[0]];
             memcpy(src, g->source[j], sizeof src);
             memcpy(txt, g->text[j], sizeof txt);
             g->event[j] = g->event[j - 1];
@@ -190,6 +190,47 @@ START_TEST(test_memq_stream)
     ck_assert_uint_eq(st.status_sent, 51);
     ck_assert_uint_eq(st.events_sent, 3);
     ck_assert_uint_eq(st.samples_dropped + st.events_dropped + st.publish_errors, 0);
+    hexcnc_status_t_unsubscribe(lcm, ss);
+    hexcnc_event_t_unsubscribe(lcm, se);
+    hal_destroy(h);
+}
+END_TEST
+
+/* The whole text of a long event arrives (a runner's fault outcome with its cause at the
+ * end was cut at 159 characters), and on the simulated clock the stop is published: a
+ * change of the state input between grid points gives a sample at once, with its state. */
+START_TEST(test_long_event_and_final_sample)
+{
+    static struct got g;
+    memset(&g, 0, sizeof g);
+    struct hal *h = make_graph("loadrt lcm-status url=memq:// rate=50");
+    lcm_t *lcm = lcm_status_lcm(h);
+    hexcnc_status_t_subscription_t *ss =
+        hexcnc_status_t_subscribe(lcm, LCM_STATUS_CHANNEL, on_status, &g);
+    hexcnc_event_t_subscription_t *se =
+        hexcnc_event_t_subscribe(lcm, LCM_EVENT_CHANNEL, on_event, &g);
+    char cause[1100];
+    memset(cause, 'x', sizeof cause);
+    memcpy(cause + sizeof cause - 41, " (cause: cia402.2: CAN node 3 (joint 2))", 40);
+    cause[sizeof cause - 1] = '\0';
+    ck_assert_int_eq(hal_start(h), HAL_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 95 * PERIOD_NS), HAL_OK);   /* samples 1..80 ms */
+    cmd(h, "setp lcm-status.state 4");                              /* the run stops */
+    ck_assert_int_eq(lcm_status_post_event(h, LCM_SEV_FAULT, LCM_CODE_USER + 2, "task", -1,
+                                           "fault: %s", cause), LCM_STATUS_OK);
+    ck_assert_int_eq(hal_sim_advance(h, 2 * PERIOD_NS), HAL_OK);
+    ck_assert_int_eq(lcm_status_flush(h, 5000), LCM_STATUS_OK);
+    while (lcm_handle_timeout(lcm, 50) > 0) {
+    }
+    ck_assert_int_eq(g.n_event, 1);
+    ck_assert_uint_eq(strlen(g.text[0]), strlen("fault: ") + strlen(cause));
+    ck_assert_ptr_nonnull(strstr(g.text[0], "(cause: cia402.2: CAN node 3 (joint 2))"));
+    ck_assert_int_eq(g.n_status, 6);                      /* 1, 20, 40, 60, 80, and 96 ms */
+    ck_assert_int_eq(g.status[4].machine_time_ns, 80 * PERIOD_NS);
+    ck_assert_int_eq(g.status[4].state, 1);
+    ck_assert_int_eq(g.status[5].machine_time_ns, 96 * PERIOD_NS);  /* first period seeing it */
+    ck_assert_int_eq(g.status[5].state, 4);
+    ck_assert(g.status[5].pose_cmd[0] == 96.0);
     hexcnc_status_t_unsubscribe(lcm, ss);
     hexcnc_event_t_unsubscribe(lcm, se);
     hal_destroy(h);
@@ -421,6 +462,7 @@ int main(void)
     Suite *s = suite_create("lcm_status");
     TCase *tc = tcase_create("lcm_status");
     tcase_add_test(tc, test_memq_stream);
+    tcase_add_test(tc, test_long_event_and_final_sample);
     tcase_add_test(tc, test_file_log);
     tcase_add_test(tc, test_rate_from_ini);
     tcase_add_test(tc, test_disabled);

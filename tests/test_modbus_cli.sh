@@ -85,7 +85,7 @@ echo "fault 1 exception 4" >&3
 sleep 0.2
 out=$(printf 'source %s\nstart\ngetp modbus.0.fault\ngetp modbus.1.fault\n' "$tmp/m.hal" |
       "$HEXCNC_BIN" halcmd -i "$tmp/m.ini" --run-ms 100 2>&1)
-want=$(printf 'halcmd: fault: modbus.1: modbus drive 1 (127.0.0.1:%d): exception 4 server device failure at register 0 (write 0..2, read 10..12)\nFALSE\nTRUE' $((base + 1)))
+want=$(printf 'halcmd: fault: modbus.1: modbus drive 1 (127.0.0.1:%d): exception 4 server device failure at register 0 (write 0..2, read 10..12) (unit 1; at start-up, before its first exchange)\nFALSE\nTRUE' $((base + 1)))
 if [ "$out" != "$want" ]; then
     echo "exception: got '$out', want '$want'"; fail=1
 fi

@@ -130,7 +130,7 @@ START_TEST(test_paper_program_on_modbus)
 END_TEST
 
 /* A drive that stops answering in the middle of the program: the latch trips, motion stops
- * with a fault, the other drives are disabled; one reset reconnects it. */
+ * with a fault, the other drives stay enabled and hold; one reset reconnects it. */
 START_TEST(test_drive_timeout_stops_machine)
 {
     struct hal *h = machine_with_program();
@@ -146,11 +146,21 @@ START_TEST(test_drive_timeout_stops_machine)
     ck_assert(test_pin_value(h, "motion.fault") != 0.0);
     ck_assert(test_pin_value(h, "motion.amp-enable") == 0.0);
     ck_assert_int_eq(hal_sim_advance(h, 10 * PERIOD_NS), HAL_OK);
-    for (int i = 0; i < NLEGS; i++) {          /* the healthy drives got ENABLE cleared */
+    /* the healthy drives keep ENABLE (modbus.N.hold from the latch's fault-out) with their
+     * targets frozen: they hold the platform under power */
+    struct modbus_sim_drive_state held[NLEGS];
+    for (int i = 0; i < NLEGS; i++)
+        modbus_sim_state(s, i, &held[i]);
+    ck_assert_int_eq(hal_sim_advance(h, 100 * PERIOD_NS), HAL_OK);
+    for (int i = 0; i < NLEGS; i++) {
         struct modbus_sim_drive_state st;
         modbus_sim_state(s, i, &st);
-        if (i != 2)
-            ck_assert_uint_eq(st.control_word & MODBUS_CTRL_ENABLE, 0);
+        if (i == 2)
+            continue;
+        ck_assert_uint_eq(st.control_word & MODBUS_CTRL_ENABLE, MODBUS_CTRL_ENABLE);
+        ck_assert_int_eq(st.target_counts, held[i].target_counts);
+        ck_assert(st.requests > held[i].requests);          /* still exchanging */
+        ck_assert_double_eq_tol(st.actual_counts, (double)st.target_counts, 1.0);
     }
     modbus_sim_inject(s, 2, MODBUS_SIM_FAULT_NONE, 0);
     ck_assert_int_eq(hal_sets(h, "estop-reset", "1"), HAL_OK);

@@ -74,8 +74,10 @@ static void lcm_push(struct lcm_status *s, int32_t kind, uint32_t faults, uint32
 
 /* lcm-status.sample, on the servo thread. Real time: every period goes into the ring and
  * the publisher keeps the newest per publish period. Simulated clock: one sample per
- * publish period of machine time, so the stream depends only on the machine. A change of
- * any fault input goes in at once, whatever the decimation. */
+ * publish period of machine time, so the stream depends only on the machine, plus one at
+ * once when the state input changes: the stop (done, fault, abort) is published with its
+ * own time and state, not only at the next grid point, which a stopped run never reaches.
+ * A change of any fault input goes in at once, whatever the decimation. */
 static void lcm_sample_run(void *arg, long period_ns)
 {
     struct lcm_status *s = arg;
@@ -99,8 +101,10 @@ static void lcm_sample_run(void *arg, long period_ns)
         lcm_push(s, LCM_SLOT_EDGE, faults, faults ^ s->last_faults, t_ns, mono_ns);
     s->last_faults = faults;
 
+    bool state_changed = *s->state != s->last_state;
+    s->last_state = *s->state;
     if (sim) {
-        if (t_ns < s->next_due_ns)
+        if (t_ns < s->next_due_ns && !state_changed)
             return;
         /* The next sample on the grid of publish periods after now. */
         s->next_due_ns = (t_ns / s->period_ns + 1) * s->period_ns;

@@ -47,7 +47,7 @@ enum lcm_status_code {
 
 /* Posts an event: copied into a lock-free queue (no lock, no allocation, no system call), so
  * any thread may call it, a servo-thread function included; the publisher sends it on
- * HEXCNC_EVENT. source and text are cut to 31 and 159 characters. line < 0 means "the
+ * HEXCNC_EVENT. source and text are cut to 31 and 1279 characters. line < 0 means "the
  * program line the last sample saw". Returns LCM_STATUS_OK, or NOT_LOADED / DISABLED
  * (nothing to do: callers may ignore them) or FULL. */
 int lcm_status_post_event(struct hal *h, enum lcm_status_severity severity, int32_t code,

@@ -19,7 +19,9 @@
 #define LCM_FAULTS_MAX 16           /* fault input pins */
 #define LCM_FAULT_NAME_MAX 32
 #define LCM_SOURCE_MAX 32
-#define LCM_TEXT_MAX 160
+/* An event's text, bytes with the NUL: the runner's whole outcome (its 1024-byte error with
+ * the cause of the stop, behind the status word) fits, so the cause is never cut off. */
+#define LCM_TEXT_MAX 1280
 #define LCM_URL_MAX 256
 #define LCM_RING_DEFAULT 1024       /* samples: 50 s at 20 Hz, 1 s at 1 kHz */
 #define LCM_EVENTS_SLOTS 256
@@ -85,6 +87,7 @@ struct lcm_status {
     int64_t last_t_ns;              /* machine time of the previous call */
     _Atomic int64_t seq;            /* next sample number (only this funct writes it) */
     uint32_t last_faults;           /* fault inputs in the previous period */
+    int32_t last_state;             /* state input in the previous period */
     _Atomic int32_t last_line;      /* line of the last call, for events posted with line < 0 */
 
     struct ring_spsc samples;       /* servo thread -> publisher */

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include "hal/drivers/canopen.h"
@@ -42,6 +43,31 @@ static int open_sim(struct can_bus *b, char *err, size_t errlen)
     }
     b->fd = sv[0];
     b->sim_peer_fd = sv[1];
+    return CAN_BUS_OK;
+}
+
+/* "unix:PATH": a connection to nodes served by another process on a SEQPACKET socket. */
+static int open_unix(struct can_bus *b, const char *path, char *err, size_t errlen)
+{
+    struct sockaddr_un sa = { .sun_family = AF_UNIX };
+    if (!path[0] || strlen(path) >= sizeof sa.sun_path) {
+        snprintf(err, errlen, "CAN over unix socket: path '%s' is empty or longer than %zu "
+                 "bytes", path, sizeof sa.sun_path - 1);
+        return CAN_BUS_ERR_SOCKET;
+    }
+    memcpy(sa.sun_path, path, strlen(path) + 1);
+    int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&sa, sizeof sa) < 0 ||
+        fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK) < 0) {
+        b->last_errno = errno;
+        snprintf(err, errlen, "CAN over unix socket '%s': cannot connect: %s (is the other "
+                 "side running, e.g. `hexcnc can_sim CONFIG.ini --listen unix:%s`?)", path,
+                 strerror(errno), path);
+        if (fd >= 0)
+            close(fd);
+        return CAN_BUS_ERR_SOCKET;
+    }
+    b->fd = fd;
     return CAN_BUS_OK;
 }
 
@@ -107,6 +133,8 @@ int can_bus_open(struct can_bus *b, const char *ifname, char *err, size_t errlen
     snprintf(b->ifname, sizeof b->ifname, "%s", ifname);
     if (strcmp(ifname, CAN_BUS_SIM) == 0)
         return open_sim(b, err, errlen);
+    if (strncmp(ifname, CAN_BUS_UNIX, strlen(CAN_BUS_UNIX)) == 0)
+        return open_unix(b, ifname + strlen(CAN_BUS_UNIX), err, errlen);
     return open_socketcan(b, ifname, err, errlen);
 }
 
@@ -120,10 +148,10 @@ void can_bus_close(struct can_bus *b)
     b->fd = b->sim_peer_fd = -1;
 }
 
-/* One frame out without waiting. */
+/* One frame out without waiting (MSG_NOSIGNAL: a closed peer is EPIPE, not a SIGPIPE). */
 int can_fd_write(int fd, const struct can_frame *f)
 {
-    ssize_t r = write(fd, f, sizeof *f);
+    ssize_t r = send(fd, f, sizeof *f, MSG_NOSIGNAL | MSG_DONTWAIT);
     if (r == (ssize_t)sizeof *f)
         return 1;
     if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS))
@@ -139,9 +167,19 @@ int can_fd_read(int fd, struct can_frame *f)
         return 1;
     if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
         return 0;
-    if (r >= 0)
+    if (r == 0)
+        errno = EPIPE;     /* end of stream: no CAN frame is zero bytes long */
+    else if (r > 0)
         errno = EMSGSIZE;  /* a message that is not one frame: skipped by the callers */
     return -1;
+}
+
+/* True (and the bus marked) when errno says the other end is gone. */
+static bool peer_gone(struct can_bus *b, int e)
+{
+    if (e == EPIPE || e == ECONNRESET || e == ENOTCONN)
+        b->peer_closed = true;
+    return b->peer_closed;
 }
 
 /* Counts an error frame; true if the frame was one. */
@@ -160,10 +198,12 @@ int can_bus_send(struct can_bus *b, const struct can_frame *f, int n)
 {
     int sent = 0;
     for (int i = 0; i < n; i++) {
-        int r = can_fd_write(b->fd, &f[i]);
+        int r = b->peer_closed ? -1 : can_fd_write(b->fd, &f[i]);
         if (r <= 0) {
-            if (r < 0)
+            if (r < 0 && !b->peer_closed) {
                 b->last_errno = errno;
+                peer_gone(b, errno);
+            }
             b->tx_dropped += (uint32_t)(n - i);
             break;
         }
@@ -178,12 +218,14 @@ int can_bus_recv(struct can_bus *b, struct can_frame *f, int max)
 {
     int k = 0;
     while (k < max) {
-        int r = can_fd_read(b->fd, &f[k]);
+        int r = b->peer_closed ? 0 : can_fd_read(b->fd, &f[k]);
         if (r == 0)
             break;
         if (r < 0) {
             b->last_errno = errno;
             b->rx_errors++;
+            if (peer_gone(b, errno))
+                break;
             if (errno == EMSGSIZE || errno == EINTR)
                 continue;  /* skip the odd message, keep reading */
             break;
@@ -203,7 +245,7 @@ int can_bus_send_batch(struct can_bus *b, const struct can_frame *f, int n)
     struct mmsghdr msg[CAN_BUS_BATCH];
     struct iovec iov[CAN_BUS_BATCH];
     int sent = 0;
-    while (sent < n) {
+    while (sent < n && !b->peer_closed) {
         int m = n - sent < CAN_BUS_BATCH ? n - sent : CAN_BUS_BATCH;
         memset(msg, 0, sizeof(msg[0]) * (size_t)m);
         for (int i = 0; i < m; i++) {
@@ -212,10 +254,12 @@ int can_bus_send_batch(struct can_bus *b, const struct can_frame *f, int n)
             msg[i].msg_hdr.msg_iov = &iov[i];
             msg[i].msg_hdr.msg_iovlen = 1;
         }
-        int r = sendmmsg(b->fd, msg, (unsigned)m, MSG_DONTWAIT);
+        int r = sendmmsg(b->fd, msg, (unsigned)m, MSG_DONTWAIT | MSG_NOSIGNAL);
         if (r <= 0) {
-            if (r < 0)
+            if (r < 0) {
                 b->last_errno = errno;
+                peer_gone(b, errno);
+            }
             break;
         }
         sent += r;
@@ -233,7 +277,7 @@ int can_bus_recv_batch(struct can_bus *b, struct can_frame *f, int max)
     struct mmsghdr msg[CAN_BUS_BATCH];
     struct iovec iov[CAN_BUS_BATCH];
     int k = 0;
-    while (k < max) {
+    while (k < max && !b->peer_closed) {
         int m = max - k < CAN_BUS_BATCH ? max - k : CAN_BUS_BATCH;
         memset(msg, 0, sizeof(msg[0]) * (size_t)m);
         for (int i = 0; i < m; i++) {
@@ -247,12 +291,20 @@ int can_bus_recv_batch(struct can_bus *b, struct can_frame *f, int max)
             if (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
                 b->last_errno = errno;
                 b->rx_errors++;
+                peer_gone(b, errno);
             }
             break;
         }
-        /* Compact in place: drop short messages and error frames. */
+        /* Compact in place: drop short messages and error frames. A zero-length message is
+         * the end of the stream (peer closed): recvmmsg would return it again and again. */
         int got = 0;
         for (int i = 0; i < r; i++) {
+            if (msg[i].msg_len == 0) {
+                b->peer_closed = true;
+                b->last_errno = EPIPE;
+                r = i;
+                break;
+            }
             if (msg[i].msg_len != sizeof f[0]) {
                 b->rx_errors++;
                 continue;

@@ -12,10 +12,15 @@
  * interface name "sim" gives instead one end of socketpair(AF_UNIX, SOCK_SEQPACKET), which
  * keeps message boundaries and so carries exactly the same frames through the same calls;
  * the other end (sim_peer_fd) belongs to the simulated drives. Everything after opening is
- * shared: what the tests exercise over the pair is what runs on a real bus.
+ * shared: what the tests exercise over the pair is what runs on a real bus. "unix:PATH"
+ * connects to an AF_UNIX SOCK_SEQPACKET socket listening at PATH that carries the same
+ * frames, one per message: CANopen nodes in another process (`hexcnc can_sim`, a bridge to
+ * hardware, another stack). A peer that closes (a zero-length message, EPIPE) sets
+ * peer_closed; the bus then stays quiet instead of retrying.
  */
 
 #define CAN_BUS_SIM "sim"   /* the interface name that selects the simulated pair */
+#define CAN_BUS_UNIX "unix:"  /* prefix of a unix socket path to connect to */
 
 enum can_bus_status {
     CAN_BUS_OK = 0,
@@ -31,13 +36,14 @@ const char *can_bus_strerror(int status);
 struct can_bus {
     int fd;                    /* the master's socket, non-blocking; -1 when closed */
     int sim_peer_fd;           /* the simulated drives' end of the pair, else -1 */
-    char ifname[32];           /* the interface name as given */
+    char ifname[120];          /* the interface name as given (unix: and a socket path) */
     uint32_t tx_frames;        /* frames written */
     uint32_t tx_dropped;       /* frames not written: the socket's queue was full */
     uint32_t rx_frames;        /* data frames read */
     uint32_t rx_errors;        /* short reads and read errors */
     uint32_t err_frames;       /* SocketCAN error frames (controller, bus-off, ...) */
     bool bus_off;              /* an error frame reported bus-off */
+    bool peer_closed;          /* the other end of a pair or unix socket is gone */
     int last_errno;            /* errno of the last failed call */
 };
 

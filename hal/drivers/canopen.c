@@ -257,6 +257,7 @@ static const char *const status_texts[CANOPEN_STATUS_COUNT] = {
     [CANOPEN_ERR_DRIVE_FAULT] = "the drive reports a fault",
     [CANOPEN_ERR_PDO_TIMEOUT] = "no position feedback from the drive",
     [CANOPEN_ERR_RANGE] = "position beyond the drive's count range",
+    [CANOPEN_ERR_BUS_LOST] = "the CAN connection is gone",
 };
 
 /* Text of a status code. */

@@ -127,6 +127,7 @@ enum canopen_status {
     CANOPEN_ERR_DRIVE_FAULT,  /* the drive's statusword reports Fault */
     CANOPEN_ERR_PDO_TIMEOUT,  /* no TPDO from a node although its heartbeat goes on */
     CANOPEN_ERR_RANGE,        /* a position beyond the drive's 32-bit count range */
+    CANOPEN_ERR_BUS_LOST,     /* the transport is gone (peer closed, socket error) */
     CANOPEN_STATUS_COUNT
 };
 const char *canopen_strerror(int status);

@@ -22,6 +22,8 @@ static const struct {
 } config_writes[] = {
     { CANOPEN_OD_HEARTBEAT_PRODUCER, 0, 2, HB_PERIOD, 0, "heartbeat producer time" },
     { CIA402_OD_MODES_OF_OP, 0, 1, 0, CIA402_MODE_CSP, "modes of operation (8 = CSP)" },
+    { CIA402_OD_QUICK_STOP_OPTION, 0, 2, 0, CIA402_QUICK_STOP_HOLD,
+      "quick stop option code (6 = stop and hold in Quick stop active)" },
     { CIA402_OD_INTERP_PERIOD, 1, 1, INTERP_VALUE, 0, "interpolation time period value" },
     { CIA402_OD_INTERP_PERIOD, 2, 1, INTERP_INDEX, 0, "interpolation time index" },
     { CANOPEN_OD_RPDO1_COMM, 1, 4, ADD_NODE, CANOPEN_PDO_COBID_INVALID | CANOPEN_COB_RPDO1,
@@ -142,6 +144,12 @@ static bool bus_cfg_ok(const struct canopen_master_cfg *cfg, char *err, size_t l
         snprintf(err, len, "BOOT_TIMEOUT must be at least 1 ms");
         return false;
     }
+    if (cfg->feedback_timeout_syncs < 0 ||
+        cfg->feedback_timeout_syncs > CANOPEN_FEEDBACK_SYNCS_MAX) {
+        snprintf(err, len, "FEEDBACK_TIMEOUT_SYNCS %d is outside 1..%d SYNC periods",
+                 cfg->feedback_timeout_syncs, CANOPEN_FEEDBACK_SYNCS_MAX);
+        return false;
+    }
     return true;
 }
 
@@ -161,6 +169,8 @@ int canopen_master_init(struct canopen_master *m, const struct canopen_master_cf
         return CANOPEN_ERR_ARG;
     }
     m->cfg = *cfg;
+    if (m->cfg.feedback_timeout_syncs == 0)
+        m->cfg.feedback_timeout_syncs = CANOPEN_FEEDBACK_SYNCS_DEFAULT;
     for (int i = 0; i < cfg->n_nodes; i++) {
         m->node[i].cfg = cfg->node[i];
         m->node[i].phase = CANOPEN_PHASE_RESET;

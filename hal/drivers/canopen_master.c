@@ -172,9 +172,15 @@ static void check_timeouts(struct canopen_master *m, struct canopen_node *n, int
                         m->cfg.heartbeat_timeout_ms);
         return;
     }
-    if (n->phase == CANOPEN_PHASE_RUN && now_ns - n->last_tpdo_ns > hb_ns)
-        node_comm_fault(n, CANOPEN_ERR_PDO_TIMEOUT, "no position feedback (TPDO1) for more "
-                        "than %ld ms", m->cfg.heartbeat_timeout_ms);
+    /* The TPDO comes once per SYNC: its absence is seen in SYNC periods, long before the
+     * heartbeat, and before the stale feedback turns into a following error. */
+    int64_t fb_ns = (int64_t)m->cfg.feedback_timeout_syncs * m->cfg.sync_period_ns;
+    if (n->phase == CANOPEN_PHASE_RUN && now_ns - n->last_tpdo_ns > fb_ns)
+        node_comm_fault(n, CANOPEN_ERR_PDO_TIMEOUT, "no position feedback (TPDO1) from node "
+                        "%d for %.0f ms (more than %d SYNC periods of %g ms, [CAN]"
+                        "FEEDBACK_TIMEOUT_SYNCS): the drive stopped sending its position",
+                        n->cfg.node_id, (double)(now_ns - n->last_tpdo_ns) / 1e6,
+                        m->cfg.feedback_timeout_syncs, (double)m->cfg.sync_period_ns / 1e6);
 }
 
 /* The non-cyclic part of one node: NMT, configuration writes, fault reset of a lost node. */
@@ -303,6 +309,51 @@ bool canopen_master_all_enabled(const struct canopen_master *m)
         if (m->node[i].phase != CANOPEN_PHASE_RUN || m->node[i].state != CIA402_OP_ENABLED)
             return false;
     return true;
+}
+
+/* Every node loses its bus at once; one message for all. */
+void canopen_master_bus_lost(struct canopen_master *m, const char *why)
+{
+    for (int i = 0; i < m->cfg.n_nodes; i++) {
+        struct canopen_node *n = &m->node[i];
+        node_comm_fault(n, CANOPEN_ERR_BUS_LOST, "%s", why);
+        n->message_new = false;
+    }
+}
+
+/* Failed if any node has a fault latched, ready when all run with a statusword. */
+enum canopen_startup canopen_master_startup(const struct canopen_master *m, int *failed_node)
+{
+    bool all_run = true;
+    *failed_node = -1;
+    for (int i = 0; i < m->cfg.n_nodes; i++) {
+        const struct canopen_node *n = &m->node[i];
+        if (n->fault) {
+            *failed_node = i;
+            return CANOPEN_FAILED;
+        }
+        all_run = all_run && n->phase == CANOPEN_PHASE_RUN && n->actual_valid;
+    }
+    return all_run ? CANOPEN_READY : CANOPEN_STARTING;
+}
+
+/* Nodes start in parallel; each waits for its boot-up, then writes one object per step_ns
+ * (the servo period at least) and may wait SDO_TIMEOUT for each answer; then the NMT start
+ * and the first TPDO (two SYNC periods) and the CiA 402 climb (three transitions, one per
+ * SYNC). */
+int64_t canopen_master_startup_budget_ns(const struct canopen_master *m, long step_ns)
+{
+    int64_t worst = 0;
+    int64_t sync_ns = m->cfg.sync_period_ns;
+    int writes = canopen_config_count();
+    for (int i = 0; i < m->cfg.n_nodes; i++) {
+        const struct canopen_node_cfg *c = &m->node[i].cfg;
+        int64_t t = m->cfg.boot_timeout_ms * MS_NS +
+                    (int64_t)writes * (c->sdo_timeout_ms * MS_NS + step_ns);
+        if (t > worst)
+            worst = t;
+    }
+    return worst + 6 * sync_ns + 2 * (int64_t)step_ns;
 }
 
 /* Looks a node up by its node-ID. */

@@ -29,6 +29,18 @@
 #define CANOPEN_MSG_LEN 240
 /* Frames one step can emit: a SYNC, one RPDO and one NMT or SDO request per node. */
 #define CANOPEN_MASTER_MAX_TX(n) (1 + 2 * (n))
+/* Missed SYNC cycles before lost feedback is a fault, by default (docs/can.md: at 2 ms SYNC
+ * the 6 ms it allows plus the PDO delay stay inside the 10 ms in which a leg at full speed
+ * would reach its following-error limit, and two late or lost frames are forgiven). */
+#define CANOPEN_FEEDBACK_SYNCS_DEFAULT 3
+#define CANOPEN_FEEDBACK_SYNCS_MAX 1000
+
+/* Where the start-up of the whole bus stands (for the runner's wait before motion). */
+enum canopen_startup {
+    CANOPEN_STARTING = 0,   /* some node is still booting or being configured */
+    CANOPEN_READY,          /* every node runs (Operational, its statusword received) */
+    CANOPEN_FAILED,         /* some node has a fault latched (its message says why) */
+};
 
 /* One drive as the INI describes it. */
 struct canopen_node_cfg {
@@ -46,6 +58,8 @@ struct canopen_master_cfg {
     long heartbeat_period_ms;    /* written to each node's 0x1017 (producer time), ms */
     long heartbeat_timeout_ms;   /* consumer: a node silent for longer is a fault, ms */
     long boot_timeout_ms;        /* boot-up expected this soon after reset communication, ms */
+    int feedback_timeout_syncs;  /* a running node whose TPDO1 is missing for more than this
+                                  * many SYNC periods is a fault; 0 = the default */
     struct canopen_node_cfg node[CANOPEN_MASTER_MAX_NODES];
 };
 
@@ -116,6 +130,14 @@ int canopen_master_step(struct canopen_master *m, int64_t now_ns, struct can_fra
                         int max_out);
 /* True when every node is in RUN and Operation enabled. */
 bool canopen_master_all_enabled(const struct canopen_master *m);
+/* The transport is gone: every node gets a communication fault with `why` as its message
+ * (message_new stays false: the caller reports the bus once, not each node). */
+void canopen_master_bus_lost(struct canopen_master *m, const char *why);
+/* The bus's start-up: starting, ready or failed (then *failed_node = its index, else -1). */
+enum canopen_startup canopen_master_startup(const struct canopen_master *m, int *failed_node);
+/* The longest start-up the configuration allows, ns: BOOT_TIMEOUT, every configuration write
+ * at its SDO_TIMEOUT, and the CiA 402 climb (a few SYNC periods); step_ns = servo period. */
+int64_t canopen_master_startup_budget_ns(const struct canopen_master *m, long step_ns);
 /* The node with this node-ID, or NULL. */
 struct canopen_node *canopen_master_node(struct canopen_master *m, int node_id);
 

@@ -12,6 +12,11 @@
 #define CIA402_OD_MODES_DISPLAY    0x6061u  /* i8 */
 #define CIA402_OD_POSITION_ACTUAL  0x6064u  /* i32, counts */
 #define CIA402_OD_TARGET_POSITION  0x607Au  /* i32, counts */
+#define CIA402_OD_QUICK_STOP_OPTION 0x605Au /* i16: what Quick stop does (CiA 402) */
+/* Quick stop option code 6: brake on the quick stop ramp and stay in Quick stop active, under
+ * power and holding position. (The CiA 402 default, 2, brakes and then drops to Switch on
+ * disabled: power stage off, a hexapod's legs would let the platform go.) */
+#define CIA402_QUICK_STOP_HOLD 6
 #define CIA402_OD_INTERP_PERIOD    0x60C2u  /* sub 1 value u8, sub 2 index i8: value * 10^index s */
 #define CIA402_MODE_CSP            8        /* modes of operation: cyclic synchronous position */
 

@@ -7,6 +7,7 @@
 #include "hal/drivers/can_bus.h"
 #include "hal/drivers/can_load.h"
 #include "hal/drivers/canopen_master.h"
+#include "hal/drivers/drive_startup.h"
 
 #define CIA402_RX_MAX 256   /* frames read per period at most; more wait for the next one */
 
@@ -28,6 +29,7 @@ struct cia402_comp {
     struct hal *h;                          /* for messages to the shell (hal_msg_post) */
     struct can_bus bus;                     /* the socket (and the sim's end) */
     struct canopen_master m;                /* the protocol core */
+    struct drive_startup startup;           /* for the runner: starting / ready / failed */
     int64_t now_ns;                         /* sum of the periods this funct has run */
     struct cia402_chan chan[CANOPEN_MASTER_MAX_NODES];
     bool *fault_any;                        /* out: any drive faulted or bus-off */
@@ -45,10 +47,11 @@ static void cia402_update(void *arg, long period_ns)
     struct cia402_comp *c = arg;
     struct canopen_master *m = &c->m;
     uint32_t dropped = c->bus.tx_dropped, rxerr = c->bus.rx_errors;
+    bool closed_before = c->bus.peer_closed;
     int nrx = can_bus_recv_batch(&c->bus, c->rx, CIA402_RX_MAX);
     for (int i = 0; i < nrx; i++)
         canopen_master_rx(m, &c->rx[i], c->now_ns);
-    bool any = c->bus.bus_off;
+    bool any = c->bus.bus_off || c->bus.peer_closed;
     for (int i = 0; i < m->cfg.n_nodes; i++) {
         struct canopen_node *n = &m->node[i];
         struct cia402_chan *ch = &c->chan[i];
@@ -59,6 +62,13 @@ static void cia402_update(void *arg, long period_ns)
     }
     int ntx = canopen_master_step(m, c->now_ns, c->tx, (int)(sizeof c->tx / sizeof c->tx[0]));
     can_bus_send_batch(&c->bus, c->tx, ntx);
+    if (c->bus.peer_closed && !closed_before) {  /* once: every drive is gone with it */
+        char why[CANOPEN_MSG_LEN];
+        snprintf(why, sizeof why, "CAN bus %s: the other end closed the connection (%s): "
+                 "every drive is off the bus", c->bus.ifname, strerror(c->bus.last_errno));
+        canopen_master_bus_lost(m, why);
+        hal_msg_post(c->h, HAL_MSG_FAULT, "cia402", "%s", why);
+    }
     for (int i = 0; i < m->cfg.n_nodes; i++) {
         struct canopen_node *n = &m->node[i];
         struct cia402_chan *ch = &c->chan[i];
@@ -80,11 +90,17 @@ static void cia402_update(void *arg, long period_ns)
     *c->fault_any = any;
     *c->all_enabled = canopen_master_all_enabled(m);
     *c->bus_off = c->bus.bus_off;
-    *c->bus_error = c->bus.bus_off || c->bus.tx_dropped != dropped || c->bus.rx_errors != rxerr;
+    *c->bus_error = c->bus.bus_off || c->bus.peer_closed || c->bus.tx_dropped != dropped || c->bus.rx_errors != rxerr;
     *c->tx_dropped = c->bus.tx_dropped;
     *c->rx_errors = c->bus.rx_errors;
     *c->err_frames = c->bus.err_frames;
     *c->sync_count = m->sync_count;
+    int failed;
+    static const int startup_of[] = { [CANOPEN_STARTING] = DRIVE_STARTUP_STARTING,
+                                      [CANOPEN_READY] = DRIVE_STARTUP_READY,
+                                      [CANOPEN_FAILED] = DRIVE_STARTUP_FAILED };
+    enum canopen_startup su = canopen_master_startup(m, &failed);
+    atomic_store(&c->startup.state, c->bus.bus_off || c->bus.peer_closed ? DRIVE_STARTUP_FAILED : startup_of[su]);
     c->now_ns += period_ns;
 }
 
@@ -125,9 +141,10 @@ static int read_node(struct hal *h, int i, struct canopen_node_cfg *nc)
 }
 
 /* [CAN] and every [CAN_NODE_i] into a master configuration. */
-static int read_cfg(struct hal *h, int count, struct canopen_master_cfg *cfg, long *bitrate)
+static int read_cfg(struct hal *h, int count, struct canopen_master_cfg *cfg, long *bitrate,
+                    long *servo_out_ns)
 {
-    long servo_ns;
+    long servo_ns, fb_syncs = CANOPEN_FEEDBACK_SYNCS_DEFAULT;
     memset(cfg, 0, sizeof *cfg);
     cfg->n_nodes = count;
     int st = ini_long(h, "EMCMOT", "SERVO_PERIOD", 1000000, false, &servo_ns);
@@ -137,6 +154,14 @@ static int read_cfg(struct hal *h, int count, struct canopen_master_cfg *cfg, lo
     st = st ? st : ini_long(h, "CAN", "HEARTBEAT_TIMEOUT", 100, false,
                             &cfg->heartbeat_timeout_ms);
     st = st ? st : ini_long(h, "CAN", "BOOT_TIMEOUT", 1000, false, &cfg->boot_timeout_ms);
+    st = st ? st : ini_long(h, "CAN", "FEEDBACK_TIMEOUT_SYNCS", CANOPEN_FEEDBACK_SYNCS_DEFAULT,
+                            false, &fb_syncs);
+    if (!st && (fb_syncs < 1 || fb_syncs > CANOPEN_FEEDBACK_SYNCS_MAX))
+        return hal_error(h, HAL_ERR_COMPONENT, "cia402: %s: [CAN]FEEDBACK_TIMEOUT_SYNCS = %ld: "
+                         "1 to %d SYNC periods", hal_ini_path(h), fb_syncs,
+                         CANOPEN_FEEDBACK_SYNCS_MAX);
+    cfg->feedback_timeout_syncs = (int)fb_syncs;
+    *servo_out_ns = servo_ns;
     for (int i = 0; i < count && !st; i++)
         st = read_node(h, i, &cfg->node[i]);
     if (!st && servo_ns > 0 && cfg->sync_period_ns % servo_ns != 0)
@@ -228,7 +253,7 @@ static int open_bus(struct hal *h, struct cia402_comp *c)
     char err[300];
     if (!ifname)
         return hal_error(h, HAL_ERR_COMPONENT, "cia402: %s: [CAN]INTERFACE is missing (a "
-                         "SocketCAN interface such as can0, or sim)",
+                         "SocketCAN interface such as can0, sim, or unix:PATH)",
                          hal_ini_path(h) ? hal_ini_path(h) : "(no INI file)");
     if (can_bus_open(&c->bus, ifname, err, sizeof err) != CAN_BUS_OK)
         return hal_error(h, HAL_ERR_COMPONENT, "cia402: %s: [CAN]INTERFACE = %s: %s",
@@ -242,10 +267,11 @@ static int open_bus(struct hal *h, struct cia402_comp *c)
 static int cia402_load(struct hal *h, int argc, char **argv)
 {
     int count = 0, st;
-    long bitrate = 0;
+    long bitrate = 0, servo_ns = 0;
     struct canopen_master_cfg cfg;
     char err[CANOPEN_MSG_LEN];
-    if ((st = parse_count(h, argc, argv, &count)) || (st = read_cfg(h, count, &cfg, &bitrate)) ||
+    if ((st = parse_count(h, argc, argv, &count)) ||
+        (st = read_cfg(h, count, &cfg, &bitrate, &servo_ns)) ||
         (st = check_bus_load(h, &cfg, bitrate)))
         return st;
     struct cia402_comp *c = calloc(1, sizeof *c);
@@ -264,7 +290,10 @@ static int cia402_load(struct hal *h, int argc, char **argv)
     for (int i = 0; i < count; i++)
         if ((st = chan_new(h, &c->chan[i], i)))
             return st;
-    if ((st = hal_set_object(h, CIA402_OBJ_MASTER, &c->m)))
+    c->startup.budget_ns = canopen_master_startup_budget_ns(&c->m, servo_ns);
+    c->startup.what = "CAN drives (cia402)";
+    if ((st = hal_set_object(h, CIA402_OBJ_MASTER, &c->m)) ||
+        (st = hal_set_object(h, DRIVE_STARTUP_OBJ_CIA402, &c->startup)))
         return st;
     return hal_export_functf(h, cia402_update, c, "cia402.update");
 }

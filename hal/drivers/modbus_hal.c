@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "hal/hal.h"
+#include "hal/drivers/drive_startup.h"
 #include "hal/drivers/modbus_cfg.h"
 #include "hal/drivers/modbus_link.h"
 
@@ -14,6 +15,12 @@
  * waits on the network. The exchanges happen in one I/O thread per drive (io=thread, the
  * default on the real-time clock) or, with the simulated clock (io=inline), in modbus.update
  * itself once every set-point period, so simulated runs are deterministic.
+ *
+ * After a fault stop a hexapod's legs must keep carrying the platform: while `hold` is true
+ * (the e-stop latch's fault-out) and `enable` false, a drive that is not itself faulted
+ * keeps ENABLE set with its target frozen at the command of the moment the hold began, so
+ * it holds position under power; enable false without hold clears ENABLE (power stage off,
+ * the drive's brake takes the load).
  *
  *   loadrt modbus [count=N] [section=MODBUS] [io=thread|inline]
  */
@@ -27,6 +34,7 @@ struct modbus_hal_drive {
     double *pos_cmd;          /* in: commanded position, mm */
     bool *enable;             /* in: enable the drive */
     bool *fault_reset;        /* in: rising edge clears the fault and reconnects */
+    bool *hold;               /* in: while true and enable false, stay enabled holding */
     double *pos_fb;           /* out: actual position, mm */
     bool *fault;              /* out: latched communication or drive fault */
     bool *connected;          /* out: a connection is open */
@@ -35,6 +43,8 @@ struct modbus_hal_drive {
     uint32_t *errors;         /* out: failed connects and exchanges */
     uint32_t *status_word;    /* out: the drive's status word */
     bool reset_last;          /* fault-reset in the previous period (edge detection) */
+    bool holding;             /* hold in force: ENABLE kept, target frozen at hold_mm */
+    double hold_mm;           /* the command when the hold began, mm */
     long setpoint_ticks;      /* inline: servo periods per set-point period (0 = not yet) */
     long tick;                /* inline: servo periods since the last exchange */
     bool linked;              /* link initialised (needs fini) */
@@ -46,14 +56,51 @@ struct modbus_hal {
     int count;                /* drives */
     bool inline_io;           /* exchanges in modbus.update instead of I/O threads */
     bool *fault_any;          /* out: any drive faulted (to the e-stop chain) */
+    struct drive_startup startup;  /* for the runner: starting / ready / failed */
     struct modbus_hal_drive d[MODBUS_HAL_MAX_DRIVES];
 };
 
-/* Hands a fault to the shell once, when it is raised (from the I/O side). */
+/* Hands a fault to the shell once, when it is raised (from the I/O side); a fault before
+ * the drive's first exchange is said to be one at start-up, with the drive's unit id. */
 static void modbus_hal_report(void *arg, const char *msg)
 {
     struct modbus_hal_drive *d = arg;
-    hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s", msg);
+    struct modbus_feedback fb;
+    modbus_link_feedback(&d->link, &fb);
+    if (fb.exchanges == 0)
+        hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s (unit %d; at start-up, before its "
+                     "first exchange)", msg, d->link.drive.cfg.unit);
+    else
+        hal_msg_post(d->h, HAL_MSG_FAULT, d->source, "%s", msg);
+}
+
+/* Starting until every drive has exchanged once, failed as soon as one has a fault. */
+static void modbus_hal_startup(struct modbus_hal *c)
+{
+    int st = DRIVE_STARTUP_READY;
+    for (int i = 0; i < c->count && st != DRIVE_STARTUP_FAILED; i++) {
+        struct modbus_feedback fb;
+        modbus_link_feedback(&c->d[i].link, &fb);
+        if (fb.fault)
+            st = DRIVE_STARTUP_FAILED;
+        else if (fb.exchanges == 0)
+            st = DRIVE_STARTUP_STARTING;
+    }
+    atomic_store(&c->startup.state, st);
+}
+
+/* The longest start-up the drives' settings allow: a connect and a first answer, each within
+ * the response time-out, and two set-point periods, ns. */
+static int64_t modbus_hal_startup_budget_ns(const struct modbus_hal *c)
+{
+    int64_t worst = 0;
+    for (int i = 0; i < c->count; i++) {
+        const struct modbus_drive_cfg *cfg = &c->d[i].link.drive.cfg;
+        int64_t t = 2 * (int64_t)cfg->timeout_us * 1000 + 2 * (int64_t)cfg->period_ns;
+        if (t > worst)
+            worst = t;
+    }
+    return worst;
 }
 
 /* Copies drive d's latest feedback to its pins; returns its fault. */
@@ -96,12 +143,17 @@ static void modbus_hal_update(void *arg, long period_ns)
         if (*d->fault_reset && !d->reset_last)
             modbus_link_reset(&d->link);
         d->reset_last = *d->fault_reset;
-        modbus_link_command(&d->link, *d->pos_cmd, *d->enable);
+        bool hold = *d->hold && !*d->enable && !*d->fault;
+        if (hold && !d->holding)
+            d->hold_mm = *d->pos_cmd;
+        d->holding = hold;
+        modbus_link_command(&d->link, hold ? d->hold_mm : *d->pos_cmd, *d->enable || hold);
         if (c->inline_io && modbus_hal_due(d, period_ns))
             modbus_link_cycle(&d->link);
         any = modbus_hal_publish(d) || any;
     }
     *c->fault_any = any;
+    modbus_hal_startup(c);
 }
 
 /* Stops the I/O threads and closes the connections (hal_destroy). */
@@ -121,6 +173,7 @@ static int modbus_hal_pins(struct hal *h, struct modbus_hal_drive *d, int i)
     if ((rc = hal_pin_float_newf(h, HAL_IN, &d->pos_cmd, "modbus.%d.position-cmd", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_IN, &d->enable, "modbus.%d.enable", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_IN, &d->fault_reset, "modbus.%d.fault-reset", i)) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &d->hold, "modbus.%d.hold", i)) ||
         (rc = hal_pin_float_newf(h, HAL_OUT, &d->pos_fb, "modbus.%d.position-fb", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &d->fault, "modbus.%d.fault", i)) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &d->connected, "modbus.%d.connected", i)) ||
@@ -242,7 +295,10 @@ static int modbus_hal_load(struct hal *h, int argc, char **argv)
             return hal_error(h, HAL_ERR_RT, "modbus: drive %d: %s", i,
                              modbus_drive_strerror(MODBUS_DRIVE_ERR_THREAD));
     modbus_hal_first_read(c);
-    return HAL_OK;
+    modbus_hal_startup(c);
+    c->startup.budget_ns = modbus_hal_startup_budget_ns(c);
+    c->startup.what = "Modbus drives (modbus)";
+    return hal_set_object(h, DRIVE_STARTUP_OBJ_MODBUS, &c->startup);
 }
 
 const struct hal_comp_type hal_comp_modbus = { "modbus", modbus_hal_load };

@@ -15,3 +15,4 @@ TESTS += test_can_bus
 TESTS += test_can_hal
 BENCHES += bench_can
 TESTS += test_can_e2e
+SCRIPT_TESTS += tests/can_unix.sh

@@ -6,6 +6,7 @@
  *   lcm_check --run LOG PERIOD_MS       a log of `hexcnc run` on the simulated machine
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,8 @@
 struct check {
     int status, events, estop_events;
     int64_t last_seq;
+    int64_t last_grid_ns;           /* machine time of the last on-grid sample */
+    int stop_state;                 /* state of the stop sample; -1 none yet */
     char error[200];
 };
 
@@ -128,7 +131,9 @@ static int listen_url(const char *url, int count, int ms, struct check *c)
 
 /* A program run on the simulated machine: samples on the PERIOD_MS grid of machine time,
  * numbered 0, 1, 2, ...; running (state 1) on a program line; feedback within 0.01 mm (and
- * deg) of the command, which moves. Returns the number of status messages, or -1. */
+ * deg) of the command, which moves; and last, the stop: one sample off the grid, after the
+ * last one on it, in state done (5, MOTION_DONE), at the end of the program's time. Returns the number of
+ * status messages, or -1. */
 static int check_run(const char *path, int period_ms, struct check *c)
 {
     lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
@@ -165,9 +170,21 @@ static int check_run(const char *path, int period_ms, struct check *c)
             if (isnan(first_x))
                 first_x = m.pose_cmd[0];
             moved = fmax(moved, fabs(m.pose_cmd[0] - first_x));
-            if (m.seq != c->last_seq + 1 || m.machine_time_ns != want_ms * 1000000)
+            bool stop = m.state != 1 && m.seq == c->last_seq + 1 &&
+                        m.machine_time_ns > c->last_grid_ns &&
+                        m.machine_time_ns < want_ms * 1000000;
+            if (c->stop_state >= 0)
+                snprintf(c->error, sizeof c->error, "sample %lld after the stop sample",
+                         (long long)m.seq);
+            else if (stop)
+                c->stop_state = m.state;
+            else if (m.seq != c->last_seq + 1 || m.machine_time_ns != want_ms * 1000000)
                 snprintf(c->error, sizeof c->error, "sample %lld at %lld ns after %lld",
                          (long long)m.seq, (long long)m.machine_time_ns, (long long)c->last_seq);
+            else
+                c->last_grid_ns = m.machine_time_ns;
+            if (c->error[0] || stop)
+                ;
             else if (m.state != 1 || m.line <= 0 || worst > 0.01 || m.fault_flags)
                 snprintf(c->error, sizeof c->error, "sample %lld: state %d line %d, feedback "
                          "%g from command, faults '%s'", (long long)m.seq, (int)m.state,
@@ -182,6 +199,9 @@ static int check_run(const char *path, int period_ms, struct check *c)
     if (!c->error[0] && (c->status < 2 || moved < 1.0))
         snprintf(c->error, sizeof c->error, "%d status messages, X moved %g mm", c->status,
                  moved);
+    if (!c->error[0] && c->stop_state != 5)
+        snprintf(c->error, sizeof c->error, "no stop sample in state done (5) after the last "
+                 "one on the grid (state %d)", c->stop_state);
     if (!c->error[0] && c->events != 2)
         snprintf(c->error, sizeof c->error, "the runner's 'program started' and 'program "
                  "finished' events are missing or out of order (%d of 2 seen)", c->events);
@@ -191,7 +211,7 @@ static int check_run(const char *path, int period_ms, struct check *c)
 int main(int argc, char **argv)
 {
     if (argc == 4 && !strcmp(argv[1], "--run")) {
-        struct check c = { .last_seq = -1 };
+        struct check c = { .last_seq = -1, .stop_state = -1 };
         if (check_run(argv[2], atoi(argv[3]), &c) < 0) {
             printf("FAIL %s: %s\n", argv[2], c.error);
             return 1;
