@@ -1,0 +1,411 @@
+/* comp5_gouge.c: the gouge check of a G141/G142 run: tool axis against the whole programmed contour. */
+#include "interp/comp5_gouge.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interp/comp5.h"
+#include "interp/comp5_join.h"
+
+#define GOUGE_SAMPLES_MIN 16   /* samples along a curved or tilting move, at least */
+#define GOUGE_SAMPLES_MAX 4096 /* ... and at most */
+#define GOUGE_REFINE_ITER 60   /* golden-section steps around the closest sample */
+
+/* One contour segment's extent across the reference plane, for the sweep. */
+struct gouge_box {
+    double lo, hi;            /* along e1, mm */
+    double lo2, hi2;          /* along e2, mm */
+    size_t k;                 /* the segment pts[k - 1] -> pts[k] */
+};
+
+/* The closest approach of one move to one segment. */
+struct gouge_near {
+    double dist_mm;           /* tool axis to contour, in the plane normal to the axis */
+    double t;                 /* where on the move (0..1) */
+    double u;                 /* where on the segment (0..1) */
+};
+
+/* The tolerance for a tool of radius W: 1e-6 relative, never below 1e-6 mm. */
+static double gouge_tol(double radius_mm)
+{
+    return COMP5_GOUGE_REL * fmax(radius_mm, 1.0);
+}
+
+void comp5_gouge_clear(struct comp5_gouge *g)
+{
+    g->npts = 0;
+    g->nmoves = 0;
+}
+
+void comp5_gouge_free(struct comp5_gouge *g)
+{
+    free(g->pts);
+    free(g->moves);
+    memset(g, 0, sizeof *g);
+}
+
+/* Makes room for one more element of size sz in *arr (count n, capacity *cap). */
+static int gouge_grow(void **arr, size_t n, size_t *cap, size_t sz)
+{
+    if (n < *cap)
+        return 0;
+    size_t ncap = *cap ? 2 * *cap : 64;
+    void *p = realloc(*arr, ncap * sz);
+    if (!p)
+        return -1;
+    *arr = p;
+    *cap = ncap;
+    return 0;
+}
+
+int comp5_gouge_add_point(struct comp5_gouge *g, const struct comp5_gpt *pt)
+{
+    if (gouge_grow((void **)&g->pts, g->npts, &g->cap_pts, sizeof *g->pts))
+        return -1;
+    g->pts[g->npts++] = *pt;
+    return 0;
+}
+
+int comp5_gouge_add_move(struct comp5_gouge *g, const struct comp5_gmove *m)
+{
+    if (gouge_grow((void **)&g->moves, g->nmoves, &g->cap_moves, sizeof *g->moves))
+        return -1;
+    g->moves[g->nmoves++] = *m;
+    return 0;
+}
+
+/* True when two poses have the same orientation (A B C within COMP5_EPS_DEG). */
+static int gouge_same_abc(const double a[6], const double b[6])
+{
+    for (int i = 3; i < 6; i++)
+        if (fabs(a[i] - b[i]) >= COMP5_EPS_DEG)
+            return 0;
+    return 1;
+}
+
+/* The angle (rad, in (0, 2 pi]) an arc turns counter-clockwise about its normal. */
+static double gouge_arc_angle(const struct comp5_gmove *m)
+{
+    double r0[3], r1[3], x[3];
+    comp5_sub(m->p0, m->center, r0);
+    comp5_sub(m->p1, m->center, r1);
+    comp5_cross(r0, r1, x);
+    double a = atan2(comp5_dot(x, m->normal), comp5_dot(r0, r1));
+    return a <= 0.0 ? a + 2.0 * M_PI : a;
+}
+
+/* The tool pose at fraction t of a move: straight (linear in all six), or the arc's
+ * rotation about its normal with the along-normal part and A B C linear. */
+static void gouge_pose(const struct comp5_gmove *m, double angle, double t, double out[6])
+{
+    for (int i = 0; i < 6; i++)
+        out[i] = m->p0[i] + t * (m->p1[i] - m->p0[i]);
+    if (!m->arc)
+        return;
+    double r0[3], nxr[3];
+    comp5_sub(m->p0, m->center, r0);
+    double h0 = comp5_dot(r0, m->normal);
+    for (int i = 0; i < 3; i++)
+        r0[i] -= h0 * m->normal[i];
+    comp5_cross(m->normal, r0, nxr);
+    double c = cos(t * angle), s = sin(t * angle), d[3];
+    comp5_sub(m->p1, m->p0, d);
+    double h = h0 + t * comp5_dot(d, m->normal);
+    for (int i = 0; i < 3; i++)
+        out[i] = m->center[i] + c * r0[i] + s * nxr[i] + h * m->normal[i];
+}
+
+/* v without its component along unit n. */
+static void gouge_flat(const double v[3], const double n[3], double out[3])
+{
+    double d = comp5_dot(v, n);
+    for (int i = 0; i < 3; i++)
+        out[i] = v[i] - d * n[i];
+}
+
+/* Distance from the line through x along unit n to segment a..b, measured in the plane
+ * normal to n; *u the closest point's place on a..b. */
+static double gouge_point_seg(const double x[3], const double n[3], const double a[3],
+                              const double b[3], double *u)
+{
+    double d[3], e[3], dp[3], ep[3];
+    comp5_sub(a, x, d);
+    comp5_sub(b, a, e);
+    gouge_flat(d, n, dp);
+    gouge_flat(e, n, ep);
+    double ee = comp5_dot(ep, ep), t = 0.0;
+    if (ee > 0.0)
+        t = -comp5_dot(dp, ep) / ee;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    *u = t;
+    for (int i = 0; i < 3; i++)
+        dp[i] += t * ep[i];
+    return comp5_len(dp);
+}
+
+/* 2-D helpers for the straight case. */
+static double cross2(const double a[2], const double b[2])
+{
+    return a[0] * b[1] - a[1] * b[0];
+}
+
+/* Distance from 2-D point p to segment a..b, and the place s on a..b. */
+static double seg2_point(const double p[2], const double a[2], const double b[2], double *s)
+{
+    double e[2] = {b[0] - a[0], b[1] - a[1]}, d[2] = {p[0] - a[0], p[1] - a[1]};
+    double ee = e[0] * e[0] + e[1] * e[1], t = 0.0;
+    if (ee > 0.0)
+        t = (d[0] * e[0] + d[1] * e[1]) / ee;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    *s = t;
+    return hypot(d[0] - t * e[0], d[1] - t * e[1]);
+}
+
+/* Straight move with a constant tool axis n: the exact distance between two segments in the
+ * plane normal to n (zero where they cross, else the closest of the four end-to-segment
+ * distances). */
+static void gouge_near_line(const struct comp5_gmove *m, const double n[3], const double e1[3],
+                            const double e2[3], const double a[3], const double b[3],
+                            struct gouge_near *r)
+{
+    double p0[2] = {comp5_dot(m->p0, e1), comp5_dot(m->p0, e2)};
+    double p1[2] = {comp5_dot(m->p1, e1), comp5_dot(m->p1, e2)};
+    double q0[2] = {comp5_dot(a, e1), comp5_dot(a, e2)};
+    double q1[2] = {comp5_dot(b, e1), comp5_dot(b, e2)};
+    double rv[2] = {p1[0] - p0[0], p1[1] - p0[1]}, sv[2] = {q1[0] - q0[0], q1[1] - q0[1]};
+    double w[2] = {q0[0] - p0[0], q0[1] - p0[1]}, den = cross2(rv, sv), s;
+    (void)n;
+    if (fabs(den) > 1e-300) {
+        double t = cross2(w, sv) / den, u = cross2(w, rv) / den;
+        if (t >= 0.0 && t <= 1.0 && u >= 0.0 && u <= 1.0) {
+            r->dist_mm = 0.0, r->t = t, r->u = u;
+            return;
+        }
+    }
+    r->dist_mm = seg2_point(p0, q0, q1, &s), r->t = 0.0, r->u = s;
+    double d = seg2_point(p1, q0, q1, &s);
+    if (d < r->dist_mm)
+        r->dist_mm = d, r->t = 1.0, r->u = s;
+    d = seg2_point(q0, p0, p1, &s);
+    if (d < r->dist_mm)
+        r->dist_mm = d, r->t = s, r->u = 0.0;
+    d = seg2_point(q1, p0, p1, &s);
+    if (d < r->dist_mm)
+        r->dist_mm = d, r->t = s, r->u = 1.0;
+}
+
+/* The distance at fraction t of a curved or tilting move (the axis from the pose's A B C). */
+static double gouge_dist_at(const struct comp5_gmove *m, double angle, double t,
+                            const double a[3], const double b[3], double *u)
+{
+    double pose[6], n[3];
+    gouge_pose(m, angle, t, pose);
+    comp5_normal(pose[3], pose[4], pose[5], n);
+    return gouge_point_seg(pose, n, a, b, u);
+}
+
+/* Curved or tilting move: sampled finely (at least every W/4 of travel, every degree of
+ * tilt and every 1/16 rad of arc), then the closest sample refined by golden section. */
+static void gouge_near_sampled(const struct comp5_gmove *m, const double a[3],
+                               const double b[3], struct gouge_near *r)
+{
+    double angle = m->arc ? gouge_arc_angle(m) : 0.0, tilt_deg = 0.0, u;
+    for (int i = 3; i < 6; i++)
+        tilt_deg = fmax(tilt_deg, fabs(m->p1[i] - m->p0[i]));
+    double len_mm = m->arc ? angle * comp5_dist(m->p0, m->center) : comp5_dist(m->p0, m->p1);
+    double ns = GOUGE_SAMPLES_MIN + ceil(4.0 * len_mm / m->radius_mm) + ceil(tilt_deg) +
+                ceil(16.0 * angle);
+    int n = ns > GOUGE_SAMPLES_MAX ? GOUGE_SAMPLES_MAX : (int)ns, best = 0;
+    r->dist_mm = INFINITY;
+    for (int i = 0; i <= n; i++) {
+        double d = gouge_dist_at(m, angle, (double)i / n, a, b, &u);
+        if (d < r->dist_mm)
+            r->dist_mm = d, r->t = (double)i / n, r->u = u, best = i;
+    }
+    double lo = best > 0 ? (double)(best - 1) / n : 0.0;
+    double hi = best < n ? (double)(best + 1) / n : 1.0;
+    const double g = 0.5 * (sqrt(5.0) - 1.0);
+    for (int it = 0; it < GOUGE_REFINE_ITER; it++) {
+        double t1 = hi - g * (hi - lo), t2 = lo + g * (hi - lo), u1, u2;
+        double d1 = gouge_dist_at(m, angle, t1, a, b, &u1);
+        double d2 = gouge_dist_at(m, angle, t2, a, b, &u2);
+        if (d1 < r->dist_mm)
+            r->dist_mm = d1, r->t = t1, r->u = u1;
+        if (d2 < r->dist_mm)
+            r->dist_mm = d2, r->t = t2, r->u = u2;
+        if (d1 < d2)
+            hi = t2;
+        else
+            lo = t1;
+    }
+}
+
+/* The reference frame of a run whose tool axis never changes: e1, e2 span the plane normal
+ * to it. Returns 0 when the orientation changes somewhere (then no sweep: every pair). */
+static int gouge_frame(const struct comp5_gouge *g, double n[3], double e1[3], double e2[3])
+{
+    const double *ref = g->pts[0].p;
+    for (size_t k = 1; k < g->npts; k++)
+        if (!gouge_same_abc(g->pts[k].p, ref))
+            return 0;
+    for (size_t k = 0; k < g->nmoves; k++)
+        if (!gouge_same_abc(g->moves[k].p0, ref) || !gouge_same_abc(g->moves[k].p1, ref))
+            return 0;
+    comp5_normal(ref[3], ref[4], ref[5], n);
+    double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
+    comp5_cross(n, fabs(n[0]) < 0.9 ? x : y, e1);
+    double l = comp5_len(e1);
+    for (int i = 0; i < 3; i++)
+        e1[i] /= l;
+    comp5_cross(n, e1, e2);
+    return 1;
+}
+
+/* Sweep order: by the low end along e1. */
+static int gouge_box_cmp(const void *pa, const void *pb)
+{
+    const struct gouge_box *a = pa, *b = pb;
+    return (a->lo > b->lo) - (a->lo < b->lo);
+}
+
+/* The closest approach of move m to segment k. */
+static void gouge_near_pair(const struct comp5_gouge *g, const struct comp5_gmove *m, size_t k,
+                            int flat, const double n[3], const double e1[3],
+                            const double e2[3], struct gouge_near *r)
+{
+    const double *a = g->pts[k - 1].p, *b = g->pts[k].p;
+    if (!m->arc && (flat || gouge_same_abc(m->p0, m->p1))) {
+        double nn[3], f1[3], f2[3];
+        if (flat) {
+            gouge_near_line(m, n, e1, e2, a, b, r);
+            return;
+        }
+        comp5_normal(m->p0[3], m->p0[4], m->p0[5], nn);
+        double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
+        comp5_cross(nn, fabs(nn[0]) < 0.9 ? x : y, f1);
+        double l = comp5_len(f1);
+        for (int i = 0; i < 3; i++)
+            f1[i] /= l;
+        comp5_cross(nn, f1, f2);
+        gouge_near_line(m, nn, f1, f2, a, b, r);
+        return;
+    }
+    gouge_near_sampled(m, a, b, r);
+}
+
+/* Fills the report for move m cutting into segment k at r. */
+static void gouge_report(const struct comp5_gouge *g, const struct comp5_gmove *m, size_t k,
+                         const struct gouge_near *r, struct comp5_gouge_hit *hit)
+{
+    const struct comp5_gpt *pa = &g->pts[k - 1], *pb = &g->pts[k];
+    double unit = pb->unit_mm > 0.0 ? pb->unit_mm : 1.0, tool[6];
+    gouge_pose(m, m->arc ? gouge_arc_angle(m) : 0.0, r->t, tool);
+    hit->depth_mm = m->radius_mm - r->dist_mm;
+    hit->dist_mm = r->dist_mm;
+    hit->radius_mm = m->radius_mm;
+    hit->move_line = m->line;
+    hit->positioning = m->positioning && r->t < 1.0 - 1e-9;
+    hit->tilt = m->line == pb->line && !gouge_same_abc(m->p0, m->p1);
+    hit->seg_line0 = pa->line;
+    hit->seg_line1 = pb->line;
+    for (int i = 0; i < 3; i++) {
+        double c = pa->p[i] + r->u * (pb->p[i] - pa->p[i]);
+        hit->point_prog[i] = (c - pb->prog_off[i]) / unit;
+        hit->tool_prog[i] = (tool[i] - pb->prog_off[i]) / unit;
+    }
+}
+
+/* The deepest cut of move m into any candidate segment; 1 (and *hit) when beyond the
+ * tolerance. Candidates: every segment, or those the sweep finds near the move. */
+static int gouge_move(const struct comp5_gouge *g, const struct comp5_gmove *m, int flat,
+                      const double n[3], const double e1[3], const double e2[3],
+                      const struct gouge_box *box, size_t nbox, double max_w,
+                      struct comp5_gouge_hit *hit)
+{
+    double reach = m->radius_mm + gouge_tol(m->radius_mm), worst = gouge_tol(m->radius_mm);
+    double lo = 0, hi = 0, lo2 = 0, hi2 = 0;
+    size_t first = 0, best_k = 0;
+    struct gouge_near r, best;
+    if (flat) {
+        double ext = m->arc ? comp5_dist(m->p0, m->center) : 0.0;
+        const double *c0 = m->arc ? m->center : m->p0, *c1 = m->arc ? m->center : m->p1;
+        lo = fmin(comp5_dot(c0, e1), comp5_dot(c1, e1)) - ext - reach;
+        hi = fmax(comp5_dot(c0, e1), comp5_dot(c1, e1)) + ext + reach;
+        lo2 = fmin(comp5_dot(c0, e2), comp5_dot(c1, e2)) - ext - reach;
+        hi2 = fmax(comp5_dot(c0, e2), comp5_dot(c1, e2)) + ext + reach;
+        size_t l = 0, h = nbox; /* first box whose lo may reach: lo >= query lo - max_w */
+        while (l < h) {
+            size_t mid = l + (h - l) / 2;
+            if (box[mid].lo < lo - max_w)
+                l = mid + 1;
+            else
+                h = mid;
+        }
+        first = l;
+    }
+    size_t count = flat ? nbox : g->npts - 1;
+    for (size_t i = first; i < count; i++) {
+        size_t k = i + 1;
+        if (flat) {
+            if (box[i].lo > hi)
+                break;
+            if (box[i].hi < lo || box[i].hi2 < lo2 || box[i].lo2 > hi2)
+                continue;
+            k = box[i].k;
+        }
+        gouge_near_pair(g, m, k, flat, n, e1, e2, &r);
+        double depth = m->radius_mm - r.dist_mm;
+        if (depth > worst)
+            worst = depth, best = r, best_k = k;
+    }
+    if (!best_k)
+        return 0;
+    gouge_report(g, m, best_k, &best, hit);
+    return 1;
+}
+
+/* The positioning move counts only when level: it starts at the cutting depth. */
+static int gouge_counts(const struct comp5_gmove *m)
+{
+    if (!m->positioning)
+        return 1;
+    double n[3], d[3];
+    comp5_normal(m->p1[3], m->p1[4], m->p1[5], n);
+    comp5_sub(m->p0, m->p1, d);
+    return fabs(comp5_dot(d, n)) <= gouge_tol(m->radius_mm);
+}
+
+int comp5_gouge_check(const struct comp5_gouge *g, struct comp5_gouge_hit *hit)
+{
+    double n[3] = {0}, e1[3] = {0}, e2[3] = {0}, max_w = 0.0;
+    struct gouge_box *box = NULL;
+    size_t nbox = 0;
+    int found = 0;
+    memset(hit, 0, sizeof *hit);
+    if (g->npts < 2)
+        return 0;
+    int flat = gouge_frame(g, n, e1, e2);
+    if (flat) {
+        nbox = g->npts - 1;
+        box = malloc(nbox * sizeof *box);
+        if (!box)
+            return -1;
+        for (size_t k = 1; k < g->npts; k++) {
+            const double *a = g->pts[k - 1].p, *b = g->pts[k].p;
+            struct gouge_box *x = &box[k - 1];
+            double a1 = comp5_dot(a, e1), b1 = comp5_dot(b, e1);
+            double a2 = comp5_dot(a, e2), b2 = comp5_dot(b, e2);
+            x->lo = fmin(a1, b1), x->hi = fmax(a1, b1);
+            x->lo2 = fmin(a2, b2), x->hi2 = fmax(a2, b2);
+            x->k = k;
+            max_w = fmax(max_w, x->hi - x->lo);
+        }
+        qsort(box, nbox, sizeof *box, gouge_box_cmp);
+    }
+    for (size_t i = 0; i < g->nmoves && !found; i++)
+        if (gouge_counts(&g->moves[i]))
+            found = gouge_move(g, &g->moves[i], flat, n, e1, e2, box, nbox, max_w, hit);
+    free(box);
+    return found;
+}
