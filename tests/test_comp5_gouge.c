@@ -121,6 +121,42 @@ START_TEST(test_pocket_started_mid_edge)
 }
 END_TEST
 
+/* The pocket, horizontal, on a table tilted B-4 (the paper's tilt): the contour is not
+ * normal to the tool axis, so the offset lines of each corner are skew. The joins are where
+ * they cross seen along the axis: the tool axis is exactly W from both walls there (X35 in
+ * the view along the axis, X35 + depth * tan 4 deg in X), no gouge. The closest approach of
+ * the skew lines (the join before) left the axis 4.9878 mm from the wall X40: 0.0122 mm of
+ * gouge. */
+START_TEST(test_tilted_table_pocket)
+{
+    struct canon_prog p;
+    double n[3];
+    interp_ok("G21 G90 G0 X20 Y15 Z630 A0 B-4\nG142 X20 Y0 W5 F500\nG142 X40 Y0\n"
+              "G142 X40 Y30\nG142 X0 Y30\nG142 X0 Y0\nG142 X20 Y0\nG0 X20 Y15\nM2\n", &p);
+    tu_normal(0, -4, 0, n);
+    int joins = 0;
+    for (size_t i = 0; i < p.count; i++) {
+        const struct canon_cmd *c = &p.cmds[i];
+        if (c->type != CANON_FEED || !c->compensated)
+            continue;
+        /* distance, seen along the axis, from the tool to the nearer of the walls X0, X40 */
+        double wall = c->end[0] > 20 ? 40 : 0;
+        double d[3] = {c->end[0] - wall, 0, c->end[2] - 630}, dn = tu_dot(d, n);
+        for (int k = 0; k < 3; k++)
+            d[k] -= dn * n[k];
+        if (fabs(c->end[1] - 5) < 1e-6 || fabs(c->end[1] - 25) < 1e-6) {
+            if (fabs(c->end[0] - 20) > 1e-6) {
+                ck_assert_msg(fabs(tu_norm(d) - 5.0) < 1e-9, "join %zu: %.9f from the wall", i,
+                              tu_norm(d));
+                joins++;
+            }
+        }
+    }
+    ck_assert_int_eq(joins, 4);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* An island (the same rectangle, cut from outside): counter-clockwise with G141 and
  * clockwise with G142 both put the tool outside. Started at a corner, the run's start and
  * end stay open (no closing arc), but outside they are clear of the contour. */
@@ -297,6 +333,7 @@ static Suite *suite(void)
     TCase *tc = tcase_create("gouge");
     tcase_add_test(tc, test_pocket_started_at_corner);
     tcase_add_test(tc, test_pocket_started_mid_edge);
+    tcase_add_test(tc, test_tilted_table_pocket);
     tcase_add_test(tc, test_island);
     tcase_add_test(tc, test_neck_narrower_than_tool);
     tcase_add_test(tc, test_slot_narrower_than_tool);
