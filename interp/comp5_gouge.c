@@ -16,6 +16,7 @@
 struct gouge_box {
     double lo, hi;            /* along e1, mm */
     double lo2, hi2;          /* along e2, mm */
+    double q0[2], q1[2];      /* its ends in (e1, e2), mm */
     size_t k;                 /* the segment pts[k - 1] -> pts[k] */
 };
 
@@ -150,8 +151,8 @@ static double cross2(const double a[2], const double b[2])
     return a[0] * b[1] - a[1] * b[0];
 }
 
-/* Distance from 2-D point p to segment a..b, and the place s on a..b. */
-static double seg2_point(const double p[2], const double a[2], const double b[2], double *s)
+/* Squared distance from 2-D point p to segment a..b, and the place s on a..b. */
+static double seg2_point2(const double p[2], const double a[2], const double b[2], double *s)
 {
     double e[2] = {b[0] - a[0], b[1] - a[1]}, d[2] = {p[0] - a[0], p[1] - a[1]};
     double ee = e[0] * e[0] + e[1] * e[1], t = 0.0;
@@ -159,23 +160,17 @@ static double seg2_point(const double p[2], const double a[2], const double b[2]
         t = (d[0] * e[0] + d[1] * e[1]) / ee;
     t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
     *s = t;
-    return hypot(d[0] - t * e[0], d[1] - t * e[1]);
+    double x = d[0] - t * e[0], y = d[1] - t * e[1];
+    return x * x + y * y;
 }
 
-/* Straight move with a constant tool axis n: the exact distance between two segments in the
- * plane normal to n (zero where they cross, else the closest of the four end-to-segment
- * distances). */
-static void gouge_near_line(const struct comp5_gmove *m, const double n[3], const double e1[3],
-                            const double e2[3], const double a[3], const double b[3],
-                            struct gouge_near *r)
+/* The exact distance between two 2-D segments p0..p1 (the tool) and q0..q1 (the contour):
+ * zero where they cross, else the closest of the four end-to-segment distances. */
+static void gouge_near_2d(const double p0[2], const double p1[2], const double q0[2],
+                          const double q1[2], struct gouge_near *r)
 {
-    double p0[2] = {comp5_dot(m->p0, e1), comp5_dot(m->p0, e2)};
-    double p1[2] = {comp5_dot(m->p1, e1), comp5_dot(m->p1, e2)};
-    double q0[2] = {comp5_dot(a, e1), comp5_dot(a, e2)};
-    double q1[2] = {comp5_dot(b, e1), comp5_dot(b, e2)};
     double rv[2] = {p1[0] - p0[0], p1[1] - p0[1]}, sv[2] = {q1[0] - q0[0], q1[1] - q0[1]};
     double w[2] = {q0[0] - p0[0], q0[1] - p0[1]}, den = cross2(rv, sv), s;
-    (void)n;
     if (fabs(den) > 1e-300) {
         double t = cross2(w, sv) / den, u = cross2(w, rv) / den;
         if (t >= 0.0 && t <= 1.0 && u >= 0.0 && u <= 1.0) {
@@ -183,16 +178,30 @@ static void gouge_near_line(const struct comp5_gmove *m, const double n[3], cons
             return;
         }
     }
-    r->dist_mm = seg2_point(p0, q0, q1, &s), r->t = 0.0, r->u = s;
-    double d = seg2_point(p1, q0, q1, &s);
-    if (d < r->dist_mm)
-        r->dist_mm = d, r->t = 1.0, r->u = s;
-    d = seg2_point(q0, p0, p1, &s);
-    if (d < r->dist_mm)
-        r->dist_mm = d, r->t = s, r->u = 0.0;
-    d = seg2_point(q1, p0, p1, &s);
-    if (d < r->dist_mm)
-        r->dist_mm = d, r->t = s, r->u = 1.0;
+    double best = seg2_point2(p0, q0, q1, &s);
+    r->t = 0.0, r->u = s;
+    double d = seg2_point2(p1, q0, q1, &s);
+    if (d < best)
+        best = d, r->t = 1.0, r->u = s;
+    d = seg2_point2(q0, p0, p1, &s);
+    if (d < best)
+        best = d, r->t = s, r->u = 0.0;
+    d = seg2_point2(q1, p0, p1, &s);
+    if (d < best)
+        best = d, r->t = s, r->u = 1.0;
+    r->dist_mm = sqrt(best);
+}
+
+/* Straight move with a constant tool axis: both segments seen along the axis (e1, e2 span
+ * the plane normal to it), then the exact 2-D distance. */
+static void gouge_near_line(const struct comp5_gmove *m, const double e1[3], const double e2[3],
+                            const double a[3], const double b[3], struct gouge_near *r)
+{
+    double p0[2] = {comp5_dot(m->p0, e1), comp5_dot(m->p0, e2)};
+    double p1[2] = {comp5_dot(m->p1, e1), comp5_dot(m->p1, e2)};
+    double q0[2] = {comp5_dot(a, e1), comp5_dot(a, e2)};
+    double q1[2] = {comp5_dot(b, e1), comp5_dot(b, e2)};
+    gouge_near_2d(p0, p1, q0, q1, r);
 }
 
 /* The distance at fraction t of a curved or tilting move (the axis from the pose's A B C). */
@@ -241,6 +250,17 @@ static void gouge_near_sampled(const struct comp5_gmove *m, const double a[3],
     }
 }
 
+/* Two unit vectors e1, e2 spanning the plane normal to unit n. */
+static void gouge_plane(const double n[3], double e1[3], double e2[3])
+{
+    double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
+    comp5_cross(n, fabs(n[0]) < 0.9 ? x : y, e1);
+    double l = comp5_len(e1);
+    for (int i = 0; i < 3; i++)
+        e1[i] /= l;
+    comp5_cross(n, e1, e2);
+}
+
 /* The reference frame of a run whose tool axis never changes: e1, e2 span the plane normal
  * to it. Returns 0 when the orientation changes somewhere (then no sweep: every pair). */
 static int gouge_frame(const struct comp5_gouge *g, double n[3], double e1[3], double e2[3])
@@ -253,12 +273,7 @@ static int gouge_frame(const struct comp5_gouge *g, double n[3], double e1[3], d
         if (!gouge_same_abc(g->moves[k].p0, ref) || !gouge_same_abc(g->moves[k].p1, ref))
             return 0;
     comp5_normal(ref[3], ref[4], ref[5], n);
-    double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
-    comp5_cross(n, fabs(n[0]) < 0.9 ? x : y, e1);
-    double l = comp5_len(e1);
-    for (int i = 0; i < 3; i++)
-        e1[i] /= l;
-    comp5_cross(n, e1, e2);
+    gouge_plane(n, e1, e2);
     return 1;
 }
 
@@ -269,26 +284,16 @@ static int gouge_box_cmp(const void *pa, const void *pb)
     return (a->lo > b->lo) - (a->lo < b->lo);
 }
 
-/* The closest approach of move m to segment k. */
+/* The closest approach of move m to segment k (no common frame: a frame per move). */
 static void gouge_near_pair(const struct comp5_gouge *g, const struct comp5_gmove *m, size_t k,
-                            int flat, const double n[3], const double e1[3],
-                            const double e2[3], struct gouge_near *r)
+                            struct gouge_near *r)
 {
     const double *a = g->pts[k - 1].p, *b = g->pts[k].p;
-    if (!m->arc && (flat || gouge_same_abc(m->p0, m->p1))) {
+    if (!m->arc && gouge_same_abc(m->p0, m->p1)) {
         double nn[3], f1[3], f2[3];
-        if (flat) {
-            gouge_near_line(m, n, e1, e2, a, b, r);
-            return;
-        }
         comp5_normal(m->p0[3], m->p0[4], m->p0[5], nn);
-        double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
-        comp5_cross(nn, fabs(nn[0]) < 0.9 ? x : y, f1);
-        double l = comp5_len(f1);
-        for (int i = 0; i < 3; i++)
-            f1[i] /= l;
-        comp5_cross(nn, f1, f2);
-        gouge_near_line(m, nn, f1, f2, a, b, r);
+        gouge_plane(nn, f1, f2);
+        gouge_near_line(m, f1, f2, a, b, r);
         return;
     }
     gouge_near_sampled(m, a, b, r);
@@ -345,6 +350,10 @@ static int gouge_move(const struct comp5_gouge *g, const struct comp5_gmove *m, 
         first = l;
     }
     size_t count = flat ? nbox : g->npts - 1;
+    double p0[2] = {comp5_dot(m->p0, e1), comp5_dot(m->p0, e2)};
+    double p1[2] = {comp5_dot(m->p1, e1), comp5_dot(m->p1, e2)};
+    double mid[2] = {0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])};
+    double half_mm = 0.5 * hypot(p1[0] - p0[0], p1[1] - p0[1]);
     for (size_t i = first; i < count; i++) {
         size_t k = i + 1;
         if (flat) {
@@ -353,8 +362,19 @@ static int gouge_move(const struct comp5_gouge *g, const struct comp5_gmove *m, 
             if (box[i].hi < lo || box[i].hi2 < lo2 || box[i].lo2 > hi2)
                 continue;
             k = box[i].k;
+            if (!m->arc) {
+                /* lower bound first: no move point is nearer than its middle's distance
+                 * less half its length */
+                double us, dm = sqrt(seg2_point2(mid, box[i].q0, box[i].q1, &us));
+                if (dm - half_mm >= reach)
+                    continue;
+                gouge_near_2d(p0, p1, box[i].q0, box[i].q1, &r);
+            }
+            else
+                gouge_near_sampled(m, g->pts[k - 1].p, g->pts[k].p, &r);
+        } else {
+            gouge_near_pair(g, m, k, &r);
         }
-        gouge_near_pair(g, m, k, flat, n, e1, e2, &r);
         double depth = m->radius_mm - r.dist_mm;
         if (depth > worst)
             worst = depth, best = r, best_k = k;
@@ -397,6 +417,7 @@ int comp5_gouge_check(const struct comp5_gouge *g, struct comp5_gouge_hit *hit)
             double a1 = comp5_dot(a, e1), b1 = comp5_dot(b, e1);
             double a2 = comp5_dot(a, e2), b2 = comp5_dot(b, e2);
             x->lo = fmin(a1, b1), x->hi = fmax(a1, b1);
+            x->q0[0] = a1, x->q0[1] = a2, x->q1[0] = b1, x->q1[1] = b2;
             x->lo2 = fmin(a2, b2), x->hi2 = fmax(a2, b2);
             x->k = k;
             max_w = fmax(max_w, x->hi - x->lo);
