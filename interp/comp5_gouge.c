@@ -8,9 +8,9 @@
 #include "interp/comp5.h"
 #include "interp/comp5_join.h"
 
-#define GOUGE_SAMPLES_MIN 16   /* samples along a curved or tilting move, at least */
+#define GOUGE_SAMPLES_MIN 8    /* samples along a curved or tilting move, at least */
 #define GOUGE_SAMPLES_MAX 4096 /* ... and at most */
-#define GOUGE_REFINE_ITER 60   /* golden-section steps around the closest sample */
+#define GOUGE_REFINE_ITER 32   /* golden-section steps around the closest sample */
 
 /* One contour segment's extent across the reference plane, for the sweep. */
 struct gouge_box {
@@ -25,6 +25,21 @@ struct gouge_near {
     double dist_mm;           /* tool axis to contour, in the plane normal to the axis */
     double t;                 /* where on the move (0..1) */
     double u;                 /* where on the segment (0..1) */
+};
+
+/* How moves find the segments near them: sorted along e1 of the plane normal to the run's
+ * first tool axis n. When the axis changes along the run, a contour point whose distance
+ * from some tool axis N is d lies within d + D sin(a) of that tool position seen along n (D
+ * the run's extent, a the largest angle between N and n): the margin widens the search by
+ * that. Past 60 degrees of tilt there is no sweep: every pair is compared. */
+struct gouge_sweep {
+    int sweep;                /* the boxes below are in use */
+    int flat;                 /* the tool axis is n all along the run: exact 2-D pairs */
+    double n[3], e1[3], e2[3];
+    double margin_mm;         /* D sin(a), 0 when flat */
+    struct gouge_box *box;    /* the segments, sorted by lo */
+    size_t nbox;
+    double max_w;             /* the widest box along e1, mm */
 };
 
 /* The tolerance for a tool of radius W: 1e-6 relative, never below 1e-6 mm. */
@@ -261,20 +276,37 @@ static void gouge_plane(const double n[3], double e1[3], double e2[3])
     comp5_cross(n, e1, e2);
 }
 
-/* The reference frame of a run whose tool axis never changes: e1, e2 span the plane normal
- * to it. Returns 0 when the orientation changes somewhere (then no sweep: every pair). */
-static int gouge_frame(const struct comp5_gouge *g, double n[3], double e1[3], double e2[3])
+/* Grows the box lo..hi (3 axes) by the point p with margin r. */
+static void gouge_extend(double lo[3], double hi[3], const double p[3], double r)
+{
+    for (int i = 0; i < 3; i++)
+        lo[i] = fmin(lo[i], p[i] - r), hi[i] = fmax(hi[i], p[i] + r);
+}
+
+/* The run's reference frame (its first tool axis n), whether the axis stays n (flat), and
+ * the sweep's margin D sin(a) for a run whose axis changes; no sweep past 60 degrees. */
+static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
 {
     const double *ref = g->pts[0].p;
-    for (size_t k = 1; k < g->npts; k++)
-        if (!gouge_same_abc(g->pts[k].p, ref))
-            return 0;
-    for (size_t k = 0; k < g->nmoves; k++)
-        if (!gouge_same_abc(g->moves[k].p0, ref) || !gouge_same_abc(g->moves[k].p1, ref))
-            return 0;
-    comp5_normal(ref[3], ref[4], ref[5], n);
-    gouge_plane(n, e1, e2);
-    return 1;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double min_cos = 1.0, nn[3];
+    sw->flat = 1;
+    comp5_normal(ref[3], ref[4], ref[5], sw->n);
+    gouge_plane(sw->n, sw->e1, sw->e2);
+    for (size_t k = 0; k < g->npts + 2 * g->nmoves; k++) {
+        const struct comp5_gmove *m = k < g->npts ? NULL : &g->moves[(k - g->npts) / 2];
+        const double *p = !m ? g->pts[k].p : (k - g->npts) % 2 ? m->p1 : m->p0;
+        gouge_extend(lo, hi, p, m && m->arc ? comp5_dist(m->p0, m->center) : 0.0);
+        if (gouge_same_abc(p, ref))
+            continue;
+        sw->flat = 0;
+        comp5_normal(p[3], p[4], p[5], nn);
+        min_cos = fmin(min_cos, comp5_dot(nn, sw->n));
+    }
+    double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    double sin_a = sqrt(fmax(0.0, 1.0 - min_cos * min_cos));
+    sw->sweep = min_cos > 0.5;
+    sw->margin_mm = sw->flat ? 0.0 : comp5_len(d) * sin_a + COMP5_EPS_MM;
 }
 
 /* Sweep order: by the low end along e1. */
@@ -284,16 +316,77 @@ static int gouge_box_cmp(const void *pa, const void *pb)
     return (a->lo > b->lo) - (a->lo < b->lo);
 }
 
-/* The closest approach of move m to segment k (no common frame: a frame per move). */
+/* What one move needs for its pairs, computed once: the frame of its middle tool axis, how
+ * far the axis turns from it along the move (sin beta), and for an arc its centre and
+ * radius. */
+struct gouge_movectx {
+    double f1[3], f2[3];      /* the plane normal to the axis at the middle of the move */
+    double nm[3];             /* that axis */
+    double beta_rad;          /* the axis never turns further than this from nm */
+    double arc_r_mm;          /* arc: distance of the start from the centre */
+};
+
+/* Fills the move's context. N = Rz(C) Ry(B) Rx(A) z turns no faster than |dA| + |dB| +
+ * s |dC| (rad per unit of t), s = |z x N| <= sqrt(1 - (cos A cos B)^2) the sine of the
+ * axis's tilt from Z (C turns about Z), with the largest |A|, |B| of the move; so within
+ * half of that from the middle. */
+static void gouge_move_ctx(const struct comp5_gmove *m, struct gouge_movectx *x)
+{
+    double mid[6], d2r = M_PI / 180.0;
+    for (int i = 0; i < 6; i++)
+        mid[i] = 0.5 * (m->p0[i] + m->p1[i]);
+    double a_max = fmax(fabs(m->p0[3]), fabs(m->p1[3])) * d2r;
+    double b_max = fmax(fabs(m->p0[4]), fabs(m->p1[4])) * d2r;
+    double cz = a_max < 0.5 * M_PI && b_max < 0.5 * M_PI ? cos(a_max) * cos(b_max) : 0.0;
+    double turn_rad = (fabs(m->p1[3] - m->p0[3]) + fabs(m->p1[4] - m->p0[4]) +
+                       sqrt(fmax(0.0, 1.0 - cz * cz)) * fabs(m->p1[5] - m->p0[5])) * d2r;
+    comp5_normal(mid[3], mid[4], mid[5], x->nm);
+    gouge_plane(x->nm, x->f1, x->f2);
+    x->beta_rad = 0.5 * turn_rad;
+    x->arc_r_mm = m->arc ? comp5_dist(m->p0, m->center) : 0.0;
+}
+
+/* max |q - p| and max |(q - p) . n| over p in {p0, p1}, q in {a, b} (both are largest at
+ * the ends, the first being convex and the second affine in the places on both segments). */
+static void gouge_span(const double p0[3], const double p1[3], const double a[3],
+                       const double b[3], const double n[3], double *v_mm, double *h_mm)
+{
+    const double *ps[2] = {p0, p1}, *qs[2] = {a, b};
+    double d[3];
+    *v_mm = 0.0, *h_mm = 0.0;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++) {
+            comp5_sub(qs[j], ps[i], d);
+            *v_mm = fmax(*v_mm, comp5_len(d));
+            *h_mm = fmax(*h_mm, fabs(comp5_dot(d, n)));
+        }
+}
+
+/* The closest approach of move m to segment k in the move's own frame: exact for a straight
+ * move with a constant axis; otherwise a lower bound first, and sampling only when the bound
+ * does not already show the pair clear (>= `clear_mm`). The bounds: an arc (constant axis)
+ * is no nearer than its centre less its radius; a straight tilting move, seen along its axis
+ * N instead of the middle axis nm: d_N^2 = |v|^2 - (v.N)^2 = d_nm^2 - (v.(N - nm)) (v.(N +
+ * nm)) >= d_nm^2 - |v| beta (2 h + |v| beta), v from tool to contour, h = max |v.nm|. */
 static void gouge_near_pair(const struct comp5_gouge *g, const struct comp5_gmove *m, size_t k,
+                            const struct gouge_movectx *x, double clear_mm,
                             struct gouge_near *r)
 {
     const double *a = g->pts[k - 1].p, *b = g->pts[k].p;
-    if (!m->arc && gouge_same_abc(m->p0, m->p1)) {
-        double nn[3], f1[3], f2[3];
-        comp5_normal(m->p0[3], m->p0[4], m->p0[5], nn);
-        gouge_plane(nn, f1, f2);
-        gouge_near_line(m, f1, f2, a, b, r);
+    double lb, u;
+    if (!m->arc) {
+        gouge_near_line(m, x->f1, x->f2, a, b, r);
+        if (x->beta_rad == 0.0)
+            return;
+        double v, h;
+        gouge_span(m->p0, m->p1, a, b, x->nm, &v, &h);
+        double vb = v * x->beta_rad, d = r->dist_mm;
+        lb = sqrt(fmax(0.0, d * d - vb * (2.0 * h + vb)));
+    } else {
+        lb = gouge_point_seg(m->center, x->nm, a, b, &u) - x->arc_r_mm;
+    }
+    if (lb >= clear_mm) {
+        r->dist_mm = lb, r->t = 0.0, r->u = 0.0;
         return;
     }
     gouge_near_sampled(m, a, b, r);
@@ -323,57 +416,58 @@ static void gouge_report(const struct comp5_gouge *g, const struct comp5_gmove *
 
 /* The deepest cut of move m into any candidate segment; 1 (and *hit) when beyond the
  * tolerance. Candidates: every segment, or those the sweep finds near the move. */
-static int gouge_move(const struct comp5_gouge *g, const struct comp5_gmove *m, int flat,
-                      const double n[3], const double e1[3], const double e2[3],
-                      const struct gouge_box *box, size_t nbox, double max_w,
-                      struct comp5_gouge_hit *hit)
+static int gouge_move(const struct comp5_gouge *g, const struct comp5_gmove *m,
+                      const struct gouge_sweep *sw, struct comp5_gouge_hit *hit)
 {
     double reach = m->radius_mm + gouge_tol(m->radius_mm), worst = gouge_tol(m->radius_mm);
     double lo = 0, hi = 0, lo2 = 0, hi2 = 0;
+    const double *e1 = sw->e1, *e2 = sw->e2;
+    const struct gouge_box *box = sw->box;
     size_t first = 0, best_k = 0;
     struct gouge_near r, best;
-    if (flat) {
-        double ext = m->arc ? comp5_dist(m->p0, m->center) : 0.0;
+    if (sw->sweep) {
+        double ext = (m->arc ? comp5_dist(m->p0, m->center) : 0.0) + reach + sw->margin_mm;
         const double *c0 = m->arc ? m->center : m->p0, *c1 = m->arc ? m->center : m->p1;
-        lo = fmin(comp5_dot(c0, e1), comp5_dot(c1, e1)) - ext - reach;
-        hi = fmax(comp5_dot(c0, e1), comp5_dot(c1, e1)) + ext + reach;
-        lo2 = fmin(comp5_dot(c0, e2), comp5_dot(c1, e2)) - ext - reach;
-        hi2 = fmax(comp5_dot(c0, e2), comp5_dot(c1, e2)) + ext + reach;
-        size_t l = 0, h = nbox; /* first box whose lo may reach: lo >= query lo - max_w */
+        lo = fmin(comp5_dot(c0, e1), comp5_dot(c1, e1)) - ext;
+        hi = fmax(comp5_dot(c0, e1), comp5_dot(c1, e1)) + ext;
+        lo2 = fmin(comp5_dot(c0, e2), comp5_dot(c1, e2)) - ext;
+        hi2 = fmax(comp5_dot(c0, e2), comp5_dot(c1, e2)) + ext;
+        size_t l = 0, h = sw->nbox; /* first box whose lo may reach: lo >= query lo - max_w */
         while (l < h) {
             size_t mid = l + (h - l) / 2;
-            if (box[mid].lo < lo - max_w)
+            if (box[mid].lo < lo - sw->max_w)
                 l = mid + 1;
             else
                 h = mid;
         }
         first = l;
     }
-    size_t count = flat ? nbox : g->npts - 1;
+    size_t count = sw->sweep ? sw->nbox : g->npts - 1;
     double p0[2] = {comp5_dot(m->p0, e1), comp5_dot(m->p0, e2)};
     double p1[2] = {comp5_dot(m->p1, e1), comp5_dot(m->p1, e2)};
     double mid[2] = {0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])};
     double half_mm = 0.5 * hypot(p1[0] - p0[0], p1[1] - p0[1]);
+    struct gouge_movectx x;
+    if (!sw->flat || m->arc)
+        gouge_move_ctx(m, &x);
     for (size_t i = first; i < count; i++) {
         size_t k = i + 1;
-        if (flat) {
+        if (sw->sweep) {
             if (box[i].lo > hi)
                 break;
             if (box[i].hi < lo || box[i].hi2 < lo2 || box[i].lo2 > hi2)
                 continue;
             k = box[i].k;
-            if (!m->arc) {
-                /* lower bound first: no move point is nearer than its middle's distance
-                 * less half its length */
-                double us, dm = sqrt(seg2_point2(mid, box[i].q0, box[i].q1, &us));
-                if (dm - half_mm >= reach)
-                    continue;
-                gouge_near_2d(p0, p1, box[i].q0, box[i].q1, &r);
-            }
-            else
-                gouge_near_sampled(m, g->pts[k - 1].p, g->pts[k].p, &r);
+        }
+        if (sw->flat && !m->arc) {
+            /* lower bound first: no move point is nearer than its middle's distance less
+             * half its length */
+            double us, dm = sqrt(seg2_point2(mid, box[i].q0, box[i].q1, &us));
+            if (dm - half_mm >= reach)
+                continue;
+            gouge_near_2d(p0, p1, box[i].q0, box[i].q1, &r);
         } else {
-            gouge_near_pair(g, m, k, &r);
+            gouge_near_pair(g, m, k, &x, m->radius_mm - gouge_tol(m->radius_mm), &r);
         }
         double depth = m->radius_mm - r.dist_mm;
         if (depth > worst)
@@ -398,35 +492,34 @@ static int gouge_counts(const struct comp5_gmove *m)
 
 int comp5_gouge_check(const struct comp5_gouge *g, struct comp5_gouge_hit *hit)
 {
-    double n[3] = {0}, e1[3] = {0}, e2[3] = {0}, max_w = 0.0;
-    struct gouge_box *box = NULL;
-    size_t nbox = 0;
+    struct gouge_sweep sw;
     int found = 0;
     memset(hit, 0, sizeof *hit);
+    memset(&sw, 0, sizeof sw);
     if (g->npts < 2)
         return 0;
-    int flat = gouge_frame(g, n, e1, e2);
-    if (flat) {
-        nbox = g->npts - 1;
-        box = malloc(nbox * sizeof *box);
-        if (!box)
+    gouge_frame(g, &sw);
+    if (sw.sweep) {
+        sw.nbox = g->npts - 1;
+        sw.box = malloc(sw.nbox * sizeof *sw.box);
+        if (!sw.box)
             return -1;
         for (size_t k = 1; k < g->npts; k++) {
             const double *a = g->pts[k - 1].p, *b = g->pts[k].p;
-            struct gouge_box *x = &box[k - 1];
-            double a1 = comp5_dot(a, e1), b1 = comp5_dot(b, e1);
-            double a2 = comp5_dot(a, e2), b2 = comp5_dot(b, e2);
+            struct gouge_box *x = &sw.box[k - 1];
+            double a1 = comp5_dot(a, sw.e1), b1 = comp5_dot(b, sw.e1);
+            double a2 = comp5_dot(a, sw.e2), b2 = comp5_dot(b, sw.e2);
             x->lo = fmin(a1, b1), x->hi = fmax(a1, b1);
             x->q0[0] = a1, x->q0[1] = a2, x->q1[0] = b1, x->q1[1] = b2;
             x->lo2 = fmin(a2, b2), x->hi2 = fmax(a2, b2);
             x->k = k;
-            max_w = fmax(max_w, x->hi - x->lo);
+            sw.max_w = fmax(sw.max_w, x->hi - x->lo);
         }
-        qsort(box, nbox, sizeof *box, gouge_box_cmp);
+        qsort(sw.box, sw.nbox, sizeof *sw.box, gouge_box_cmp);
     }
     for (size_t i = 0; i < g->nmoves && !found; i++)
         if (gouge_counts(&g->moves[i]))
-            found = gouge_move(g, &g->moves[i], flat, n, e1, e2, box, nbox, max_w, hit);
-    free(box);
+            found = gouge_move(g, &g->moves[i], &sw, hit);
+    free(sw.box);
     return found;
 }

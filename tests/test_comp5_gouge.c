@@ -157,6 +157,24 @@ START_TEST(test_tilted_table_pocket)
 }
 END_TEST
 
+/* The pocket on a table tilted B-4 that also turns (C +0.5 deg a block): the tool axis
+ * changes along the run and along every move. Mid-edge start: clean; corner start: the
+ * closing wall is found through the search that allows for the turning axis. */
+START_TEST(test_turning_table_pocket)
+{
+    struct canon_prog p;
+    interp_ok("G21 G90 G0 X20 Y15 Z630 A0 B-4 C0\nG142 X20 Y0 W5 F500\nG142 X40 Y0 C0.5\n"
+              "G142 X40 Y30 C1\nG142 X0 Y30 C1.5\nG142 X0 Y0 C2\nG142 X20 Y0 C2.5\n"
+              "G0 X20 Y15\nM2\n", &p);
+    canon_prog_free(&p);
+    static const char *const want[] = {"G142 at line 3", "from line 5 to 6", "by 5.0000 mm",
+                                       "X0.0000 Y5.0000 Z630.0000", NULL};
+    expect_gouge("G21 G90 G0 X20 Y15 Z630 A0 B-4 C0\nG142 X0 Y0 W5 F500\nG142 X40 Y0 C0.5\n"
+                 "G142 X40 Y30 C1\nG142 X0 Y30 C1.5\nG142 X0 Y0 C2\nG0 X20 Y15\nM2\n", NULL, 3,
+                 want);
+}
+END_TEST
+
 /* An island (the same rectangle, cut from outside): counter-clockwise with G141 and
  * clockwise with G142 both put the tool outside. Started at a corner, the run's start and
  * end stay open (no closing arc), but outside they are clear of the contour. */
@@ -209,6 +227,18 @@ START_TEST(test_neck_narrower_than_tool)
     static const char *const want[] = {"G142 at line 4", "from line 10 to 11", "by 2.0000 mm",
                                        "X30.0000 Y19.0000", "radius 5 mm", NULL};
     expect_gouge(prog, table, 4, want);
+    /* C turns the table about the tool axis here (A = B = 0): the axis stays +Z, so the
+     * same figures, but the run's orientation changes: the search that allows for it */
+    char turned[1200], *o = turned;
+    snprintf(prog, sizeof prog, DUMBBELL, 2);
+    int blocks = 0;
+    for (const char *q = prog; *q; q++) {
+        *o++ = *q;
+        if (*q == '\n' && q[1] == 'G' && q[2] == '1')
+            o += sprintf(o, "C%d ", 5 * (blocks++ % 3));
+    }
+    *o = 0;
+    expect_gouge(turned, table, 4, want);
 }
 END_TEST
 
@@ -334,6 +364,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pocket_started_at_corner);
     tcase_add_test(tc, test_pocket_started_mid_edge);
     tcase_add_test(tc, test_tilted_table_pocket);
+    tcase_add_test(tc, test_turning_table_pocket);
     tcase_add_test(tc, test_island);
     tcase_add_test(tc, test_neck_narrower_than_tool);
     tcase_add_test(tc, test_slot_narrower_than_tool);
