@@ -283,13 +283,27 @@ static void gouge_extend(double lo[3], double hi[3], const double p[3], double r
         lo[i] = fmin(lo[i], p[i] - r), hi[i] = fmax(hi[i], p[i] + r);
 }
 
+/* How far the tool axis can turn along move m, rad: N = Rz(C) Ry(B) Rx(A) z turns no
+ * faster than |dA| + |dB| + s |dC| (rad per unit of t), s = |z x N| <= sqrt(1 - (cos A
+ * cos B)^2) the sine of the axis's tilt from Z (C turns about Z), with the largest |A|, |B|
+ * of the move; so it stays within half of that from the middle. */
+static double gouge_turn_rad(const struct comp5_gmove *m)
+{
+    double d2r = M_PI / 180.0;
+    double a_max = fmax(fabs(m->p0[3]), fabs(m->p1[3])) * d2r;
+    double b_max = fmax(fabs(m->p0[4]), fabs(m->p1[4])) * d2r;
+    double cz = a_max < 0.5 * M_PI && b_max < 0.5 * M_PI ? cos(a_max) * cos(b_max) : 0.0;
+    return (fabs(m->p1[3] - m->p0[3]) + fabs(m->p1[4] - m->p0[4]) +
+            sqrt(fmax(0.0, 1.0 - cz * cz)) * fabs(m->p1[5] - m->p0[5])) * d2r;
+}
+
 /* The run's reference frame (its first tool axis n), whether the axis stays n (flat), and
  * the sweep's margin D sin(a) for a run whose axis changes; no sweep past 60 degrees. */
 static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
 {
     const double *ref = g->pts[0].p;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double min_cos = 1.0, nn[3];
+    double min_cos = 1.0, nn[3], max_turn = 0.0;
     sw->flat = 1;
     comp5_normal(ref[3], ref[4], ref[5], sw->n);
     gouge_plane(sw->n, sw->e1, sw->e2);
@@ -297,6 +311,8 @@ static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
         const struct comp5_gmove *m = k < g->npts ? NULL : &g->moves[(k - g->npts) / 2];
         const double *p = !m ? g->pts[k].p : (k - g->npts) % 2 ? m->p1 : m->p0;
         gouge_extend(lo, hi, p, m && m->arc ? comp5_dist(m->p0, m->center) : 0.0);
+        if (m && !m->arc && (k - g->npts) % 2 == 0)
+            max_turn = fmax(max_turn, gouge_turn_rad(m));
         if (gouge_same_abc(p, ref))
             continue;
         sw->flat = 0;
@@ -304,8 +320,10 @@ static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
         min_cos = fmin(min_cos, comp5_dot(nn, sw->n));
     }
     double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    double sin_a = sqrt(fmax(0.0, 1.0 - min_cos * min_cos));
-    sw->sweep = min_cos > 0.5;
+    /* a: the largest angle at the ends of the moves, plus half a move's turn between them */
+    double a_rad = acos(fmin(1.0, min_cos)) + 0.5 * max_turn;
+    double sin_a = sin(fmin(a_rad, 0.5 * M_PI));
+    sw->sweep = a_rad < M_PI / 3.0;
     sw->margin_mm = sw->flat ? 0.0 : comp5_len(d) * sin_a + COMP5_EPS_MM;
 }
 
@@ -326,23 +344,15 @@ struct gouge_movectx {
     double arc_r_mm;          /* arc: distance of the start from the centre */
 };
 
-/* Fills the move's context. N = Rz(C) Ry(B) Rx(A) z turns no faster than |dA| + |dB| +
- * s |dC| (rad per unit of t), s = |z x N| <= sqrt(1 - (cos A cos B)^2) the sine of the
- * axis's tilt from Z (C turns about Z), with the largest |A|, |B| of the move; so within
- * half of that from the middle. */
+/* The context of move m. */
 static void gouge_move_ctx(const struct comp5_gmove *m, struct gouge_movectx *x)
 {
-    double mid[6], d2r = M_PI / 180.0;
+    double mid[6];
     for (int i = 0; i < 6; i++)
         mid[i] = 0.5 * (m->p0[i] + m->p1[i]);
-    double a_max = fmax(fabs(m->p0[3]), fabs(m->p1[3])) * d2r;
-    double b_max = fmax(fabs(m->p0[4]), fabs(m->p1[4])) * d2r;
-    double cz = a_max < 0.5 * M_PI && b_max < 0.5 * M_PI ? cos(a_max) * cos(b_max) : 0.0;
-    double turn_rad = (fabs(m->p1[3] - m->p0[3]) + fabs(m->p1[4] - m->p0[4]) +
-                       sqrt(fmax(0.0, 1.0 - cz * cz)) * fabs(m->p1[5] - m->p0[5])) * d2r;
     comp5_normal(mid[3], mid[4], mid[5], x->nm);
     gouge_plane(x->nm, x->f1, x->f2);
-    x->beta_rad = 0.5 * turn_rad;
+    x->beta_rad = 0.5 * gouge_turn_rad(m);
     x->arc_r_mm = m->arc ? comp5_dist(m->p0, m->center) : 0.0;
 }
 
