@@ -357,6 +357,124 @@ START_TEST(test_paper_programs_accepted)
 }
 END_TEST
 
+/* xorshift: the same random runs on every test. */
+static double rnd(unsigned long long *st)
+{
+    *st ^= *st << 13, *st ^= *st >> 7, *st ^= *st << 17;
+    return (double)(*st % 1000000ULL) / 1e6;
+}
+
+/* The deepest cut of the emitted moves (the first, the positioning, left out) into the
+ * contour pts, sampled every 0.01 mm (arcs about their normal by Rodrigues' formula), the
+ * tool axis from each sample's A B C: independent of comp5_gouge.c. */
+static double sampled_depth(const struct canon_prog *p, const struct comp5_block *blk, int n)
+{
+    double worst = -INFINITY, pos[6];
+    memcpy(pos, p->cmds[0].end, sizeof pos);
+    for (size_t i = 1; i < p->count; i++) {
+        const struct canon_cmd *c = &p->cmds[i];
+        double r0[3], r1[3], x[3], ang = 0, len;
+        for (int k = 0; k < 3; k++)
+            r0[k] = pos[k] - c->arc.center[k], r1[k] = c->end[k] - c->arc.center[k];
+        if (c->type == CANON_ARC) {
+            tu_cross(r0, r1, x);
+            ang = atan2(tu_dot(x, c->arc.normal), tu_dot(r0, r1));
+            ang = ang <= 0 ? ang + 2 * M_PI : ang;
+            len = ang * tu_norm(r0);
+        } else {
+            len = tu_dist(pos, c->end);
+        }
+        int steps = 2 + (int)(len / 0.01);
+        for (int s = 0; s <= steps; s++) {
+            double t = (double)s / steps, q[3], nrm[3], abc[3];
+            for (int k = 0; k < 3; k++)
+                abc[k] = pos[3 + k] + t * (c->end[3 + k] - pos[3 + k]);
+            if (c->type == CANON_ARC) {
+                tu_rotate(c->arc.normal, ang * t / TU_DEG, r0, q);
+                for (int k = 0; k < 3; k++)
+                    q[k] += c->arc.center[k];
+            } else {
+                for (int k = 0; k < 3; k++)
+                    q[k] = pos[k] + t * (c->end[k] - pos[k]);
+            }
+            tu_normal(abc[0], abc[1], abc[2], nrm);
+            for (int k = 1; k < n; k++) { /* nearest point of the segment, seen along nrm */
+                double a[3], e[3], ap[3], ep[3];
+                for (int m = 0; m < 3; m++)
+                    a[m] = blk[k - 1].point[m] - q[m], e[m] = blk[k].point[m] - blk[k - 1].point[m];
+                double da = tu_dot(a, nrm), de = tu_dot(e, nrm);
+                for (int m = 0; m < 3; m++)
+                    ap[m] = a[m] - da * nrm[m], ep[m] = e[m] - de * nrm[m];
+                double u = -tu_dot(ap, ep) / tu_dot(ep, ep);
+                u = u < 0 ? 0 : u > 1 ? 1 : u;
+                for (int m = 0; m < 3; m++)
+                    ap[m] += u * ep[m];
+                worst = fmax(worst, blk[k].radius_mm - tu_norm(ap));
+            }
+        }
+        memcpy(pos, c->end, sizeof pos);
+    }
+    return worst;
+}
+
+/* Random runs (6 points on an open convex polygon, or anywhere in a 40 mm square; flat,
+ * tilted or turning table; W 2..8 mm): the
+ * check refuses exactly those whose sampled depth is beyond the tolerance, and its depth
+ * agrees with the sampled one. Runs the corner check refuses first are left out. */
+START_TEST(test_random_runs_against_sampling)
+{
+    unsigned long long st = 0x9e3779b97f4a7c15ULL;
+    int refused = 0, accepted = 0;
+    for (int run = 0; run < 300; run++) {
+        struct comp5 c;
+        struct canon_prog p;
+        struct comp5_block blk[6];
+        int mode = run % 3, side = run % 2 ? 141 : 142, rc = COMP5_OK;
+        double w = 2 + 6 * rnd(&st), b0 = mode ? -10 + 20 * rnd(&st) : 0;
+        comp5_init(&c);
+        canon_prog_init(&p);
+        for (int k = 0; k < 6 && rc == COMP5_OK; k++) {
+            double cdeg = mode == 2 ? 3.0 * k * rnd(&st) : 0, x, y;
+            if (run % 4 < 2) { /* an open convex arc of a polygon, counter-clockwise */
+                double ang = (k * 50.0 + 40.0 * rnd(&st)) * TU_DEG, r = 15 + 5 * rnd(&st);
+                x = 20 + r * cos(ang), y = 20 + r * sin(ang);
+            } else {           /* anything */
+                x = 40 * rnd(&st), y = 40 * rnd(&st);
+            }
+            blk[k] = tu_block(side, x, y, 600, 0, b0, cdeg, w, k + 1);
+            double start[6] = {-100, -100, 500, 0, b0, 0}; /* off the work: not level */
+            rc = comp5_block(&c, &blk[k], start, canon_prog_sink, &p);
+        }
+        if (rc == COMP5_OK)
+            rc = comp5_flush(&c, canon_prog_sink, &p);
+        if (rc != COMP5_OK && rc != COMP5_ERR_GOUGE_CONTOUR) {
+            comp5_free(&c);
+            canon_prog_free(&p);
+            continue;
+        }
+        double depth = sampled_depth(&p, blk, 6), tol = 1e-6 * fmax(w, 1.0);
+        if (rc == COMP5_OK) {
+            ck_assert_msg(depth < tol + 1e-9, "run %d accepted, sampled depth %g", run, depth);
+            accepted++;
+        } else {
+            /* the reported cut is the first gouging move's deepest: no deeper than the
+             * deepest sampled (which, every 0.01 mm, may miss up to 0.01 mm of it), and
+             * beyond the tolerance */
+            double got;
+            const char *q = strstr(comp5_errmsg(&c), " by ");
+            ck_assert_ptr_nonnull(q);
+            got = strtod(q + 4, NULL);
+            ck_assert_msg(got <= depth + 0.01 && depth > tol, "run %d: reported %.4f, "
+                          "sampled %.6f: %s", run, got, depth, comp5_errmsg(&c));
+            refused++;
+        }
+        canon_prog_free(&p);
+    }
+    ck_assert_msg(refused > 20 && accepted > 20, "refused %d, accepted %d", refused, accepted);
+    printf("random runs: %d refused, %d accepted\n", refused, accepted);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("comp5_gouge");
@@ -372,6 +490,8 @@ static Suite *suite(void)
     tcase_add_test(tc, test_point_in_program_coordinates);
     tcase_add_test(tc, test_tilting_move);
     tcase_add_test(tc, test_paper_programs_accepted);
+    tcase_add_test(tc, test_random_runs_against_sampling);
+    tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;
 }
