@@ -1,4 +1,5 @@
-/* bench_interp.c: interpreter speed on a 200,000-block five-axis program, against rs274 -g. */
+/* bench_interp.c: interpreter speed on a 200,000-block five-axis program (against rs274 -g) and on G142 pockets. */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,38 @@ static int generate(const char *path)
         put_value(c, -180, 180, 3, &s);
         put_value(fe, 200, 3000, 0, &s);
         fprintf(f, "G1 X%s Y%s Z%s A%s B%s C%s F%s\n", x, y, z, a, b, c, fe);
+    }
+    fprintf(f, "M2\n");
+    return fclose(f);
+}
+
+#define COMP_SIDES 500   /* sides of each polygonal pocket of the compensated program */
+#define COMP_RUNS 400    /* pockets: 400 x 502 blocks */
+
+/* Writes the compensated benchmark program: COMP_RUNS closed G142 pockets (a 500-gon of
+ * radius 60 mm, sides 0.75 mm, table tilted B-4 as in the paper), each started mid-edge
+ * from the centre at the cutting depth, tool radius 5 mm. Every block is checked against the
+ * pocket's contour near it (docs/compensation.md, gouge check). */
+static int generate_comp(const char *path, long *blocks)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    *blocks = 0;
+    fprintf(f, "(G142 pockets for bench_interp)\nG21 G90 G17 G94\n");
+    for (int r = 0; r < COMP_RUNS; r++) {
+        double cx = (r % 20) * 130.0 - 1300.0, cy = (r / 20) * 130.0 - 1300.0;
+        fprintf(f, "G0 X%.4f Y%.4f Z630 A0 B-4\n", cx, cy);
+        double a0 = 0.0, a1 = 2.0 * M_PI / COMP_SIDES;
+        fprintf(f, "G142 X%.4f Y%.4f W5 F1000\n", cx + 30.0 * (cos(a0) + cos(a1)),
+                cy + 30.0 * (sin(a0) + sin(a1)));
+        for (int k = 1; k <= COMP_SIDES; k++) {
+            double a = 2.0 * M_PI * (k % COMP_SIDES) / COMP_SIDES;
+            fprintf(f, "G142 X%.4f Y%.4f\n", cx + 60.0 * cos(a), cy + 60.0 * sin(a));
+        }
+        fprintf(f, "G142 X%.4f Y%.4f\n", cx + 30.0 * (cos(a0) + cos(a1)),
+                cy + 30.0 * (sin(a0) + sin(a1)));
+        *blocks += COMP_SIDES + 3;
     }
     fprintf(f, "M2\n");
     return fclose(f);
@@ -157,6 +190,18 @@ int main(int argc, char **argv)
            BLOCKS);
     printf("library, null sink:        %.3f s  %10.0f blocks/s\n", t_lib, BLOCKS / t_lib);
     printf("library + rs274 printer:   %.3f s  %10.0f blocks/s\n", t_print, BLOCKS / t_print);
+    long comp_blocks = 0;
+    if (generate_comp(path, &comp_blocks)) {
+        fprintf(stderr, "bench_interp: cannot write %s\n", path);
+        return 1;
+    }
+    double t_comp = time_library(path, 0, &moves);
+    printf("G142 pockets (%ld blocks, %ld moves), library, null sink: %.3f s  %10.0f blocks/s\n",
+           comp_blocks, moves, t_comp, comp_blocks / t_comp);
+    if (generate(path)) {
+        fprintf(stderr, "bench_interp: cannot write %s\n", path);
+        return 1;
+    }
     const char *bin = getenv("HEXCNC_BIN");
     char cmd[1024];
     double t_cmd = -1;

@@ -18,6 +18,8 @@ static const char *const comp5_msgs[COMP5_STATUS_COUNT] = {
     [COMP5_ERR_MIXED_SIDES] = "G141 and G142 mixed in one compensated path",
     [COMP5_ERR_RADIUS] = "G141/G142 tool radius missing, zero or negative",
     [COMP5_ERR_GOUGE] = "G141/G142 inside corner: the tool would gouge (segment too short)",
+    [COMP5_ERR_GOUGE_CONTOUR] = "G141/G142 path would gouge its programmed contour",
+    [COMP5_ERR_NO_MEMORY] = "G141/G142: out of memory for the gouge check of the path",
     [COMP5_ERR_SINK] = "G141/G142 moves were refused by the motion queue",
     [COMP5_ERR_SIDE] = "G141/G142 side must be 141 or 142",
 };
@@ -34,6 +36,14 @@ const char *comp5_strerror(int status)
 void comp5_init(struct comp5 *c)
 {
     memset(c, 0, sizeof *c);
+}
+
+/* Drops the record of a run left open (the interpreter stopped on another error). */
+void comp5_free(struct comp5 *c)
+{
+    comp5_gouge_free(&c->gouge);
+    c->active = 0;
+    c->nblocks = 0;
 }
 
 /* Where the emitted moves have left the tool. */
@@ -63,8 +73,7 @@ static int comp5_fail(struct comp5 *c, int status, int line, const char *fmt, ..
     vsnprintf(c->err_msg, sizeof c->err_msg, fmt, ap);
     va_end(ap);
     c->err_line = line;
-    c->active = 0;
-    c->nblocks = 0;
+    comp5_free(c);
     return status;
 }
 
@@ -166,7 +175,21 @@ static int comp5_emit(struct comp5 *c, enum canon_type type, const double end[6]
         return comp5_fail(c, COMP5_ERR_SINK, b->line,
                           "%s: the compensated move of line %d was refused by the motion "
                           "queue", comp5_code(c->side), b->line);
+    struct comp5_gmove m;
+    memset(&m, 0, sizeof m);
+    m.arc = type == CANON_ARC;
+    m.positioning = c->nblocks == 1;
+    memcpy(m.p0, c->tool_pos, sizeof m.p0);
+    memcpy(m.p1, end, sizeof m.p1);
+    if (arc) {
+        memcpy(m.center, arc->center, sizeof m.center);
+        memcpy(m.normal, arc->normal, sizeof m.normal);
+    }
+    m.radius_mm = b->radius_mm;
+    m.line = b->line;
     memcpy(c->tool_pos, end, sizeof c->tool_pos);
+    if (comp5_gouge_add_move(&c->gouge, &m))
+        return comp5_fail(c, COMP5_ERR_NO_MEMORY, b->line, "%s", comp5_strerror(COMP5_ERR_NO_MEMORY));
     return COMP5_OK;
 }
 
@@ -247,6 +270,43 @@ static int comp5_check_block(struct comp5 *c, const struct comp5_block *b)
     return COMP5_OK;
 }
 
+/* Keeps the block's contour point for the gouge check at the end of the run. */
+static int comp5_record_point(struct comp5 *c, const struct comp5_block *b)
+{
+    struct comp5_gpt pt;
+    memcpy(pt.p, b->point, sizeof pt.p);
+    memcpy(pt.prog_off, b->prog_off_mm, sizeof pt.prog_off);
+    pt.unit_mm = b->unit_mm > 0.0 ? b->unit_mm : 1.0;
+    pt.radius_mm = b->radius_mm;
+    pt.line = b->line;
+    if (comp5_gouge_add_point(&c->gouge, &pt))
+        return comp5_fail(c, COMP5_ERR_NO_MEMORY, b->line, "%s",
+                          comp5_strerror(COMP5_ERR_NO_MEMORY));
+    return COMP5_OK;
+}
+
+/* Refuses the run when its tool path comes closer than W to any of its programmed contour
+ * segments (comp5_gouge.c): names the move's line, the depth and the contour point. */
+static int comp5_check_run(struct comp5 *c)
+{
+    struct comp5_gouge_hit h;
+    int found = comp5_gouge_check(&c->gouge, &h);
+    if (found < 0)
+        return comp5_fail(c, COMP5_ERR_NO_MEMORY, c->prev.line, "%s",
+                          comp5_strerror(COMP5_ERR_NO_MEMORY));
+    if (!found)
+        return COMP5_OK;
+    return comp5_fail(c, COMP5_ERR_GOUGE_CONTOUR, h.move_line,
+                      "%s %s line %d gouges the contour from line %d to %d by %.4f mm at "
+                      "X%.4f Y%.4f Z%.4f (tool radius %.4g mm): %s", comp5_code(c->side),
+                      h.positioning ? "positioning move of" : "at", h.move_line, h.seg_line0,
+                      h.seg_line1, h.depth_mm, h.point_prog[0] + 0.0, h.point_prog[1] + 0.0,
+                      h.point_prog[2] + 0.0, h.radius_mm,
+                      h.positioning ? "approach from the compensation side, clear of the contour"
+                      : h.tilt      ? "A B C change too much along the move: split it"
+                                    : "use a smaller tool, or start a closed contour mid-edge");
+}
+
 /* Adds a compensated block: the first is only stored, the second positions the tool at the
  * compensated start, every later one cuts the segment before it up to their corner. */
 int comp5_block(struct comp5 *c, const struct comp5_block *b, const double start[6],
@@ -262,6 +322,7 @@ int comp5_block(struct comp5 *c, const struct comp5_block *b, const double start
         c->side = b->side;
         memcpy(c->start, start, sizeof c->start);
         memcpy(c->tool_pos, start, sizeof c->tool_pos);
+        comp5_gouge_clear(&c->gouge);
     }
     if (c->nblocks > 0 && comp5_dist(b->point, c->prev.point) < COMP5_EPS_MM)
         return comp5_fail(c, COMP5_ERR_ZERO_LENGTH, b->line,
@@ -281,7 +342,7 @@ int comp5_block(struct comp5 *c, const struct comp5_block *b, const double start
     c->prev2 = c->prev;
     c->prev = *b;
     c->nblocks++;
-    return COMP5_OK;
+    return comp5_record_point(c, b);
 }
 
 /* Ends the run: cuts the last segment to its compensated end. */
@@ -295,7 +356,10 @@ int comp5_flush(struct comp5 *c, canon_sink_fn sink, void *ctx)
                           "consecutive blocks with different points, so program at least two",
                           comp5_code(c->side), c->prev.line);
     int rc = comp5_emit(c, CANON_FEED, c->seg.a1, NULL, &c->prev, sink, ctx);
-    c->active = 0;
-    c->nblocks = 0;
-    return rc;
+    if (rc == COMP5_OK)
+        rc = comp5_check_run(c);
+    if (rc != COMP5_OK)
+        return rc;
+    comp5_free(c); /* the record lives only as long as its run */
+    return COMP5_OK;
 }

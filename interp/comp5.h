@@ -3,6 +3,7 @@
 #define HEXCNC_COMP5_H
 
 #include "interp/canon.h"
+#include "interp/comp5_gouge.h"
 
 /*
  * The interpreter hands every block that carries G141 or G142 to comp5_block(), with the
@@ -48,6 +49,8 @@ enum comp5_status {
     COMP5_ERR_MIXED_SIDES,    /* G141 and G142 in one run */
     COMP5_ERR_RADIUS,         /* radius missing, zero or negative */
     COMP5_ERR_GOUGE,          /* an inside corner the tool cannot reach without gouging */
+    COMP5_ERR_GOUGE_CONTOUR,  /* the tool comes closer than W to the run's contour */
+    COMP5_ERR_NO_MEMORY,      /* the run's record for the gouge check could not grow */
     COMP5_ERR_SINK,           /* the canon sink refused a command */
     COMP5_ERR_SIDE,           /* side is neither 141 nor 142 (a caller's mistake) */
     COMP5_STATUS_COUNT
@@ -63,6 +66,9 @@ struct comp5_block {
     double feed_mm_min;       /* feed in force */
     int line;                 /* source line, for the emitted moves and for errors */
     const char *file;
+    double prog_off_mm[3];    /* machine X Y Z = program X Y Z * unit_mm + prog_off_mm: lets
+                               * errors name points in program coordinates */
+    double unit_mm;           /* mm per program length unit (0 is taken as 1) */
 };
 
 /* The offset line of one programmed segment: its two compensated ends. */
@@ -86,14 +92,19 @@ struct comp5 {
     int err_line;             /* line the last error refers to */
     struct comp5_seg seg;     /* the segment prev2 -> prev, not yet cut (nblocks >= 2) */
     char err_msg[240];        /* the last error in a machinist's words (no file:line prefix) */
+    struct comp5_gouge gouge; /* the run's contour and moves, checked when it ends (heap) */
 };
 
 void comp5_init(struct comp5 *c);
+/* Frees the record of an open run (a run dropped by an error elsewhere); then idle. */
+void comp5_free(struct comp5 *c);
 /* Adds a compensated block; start is the tool pose before it (used when it opens a run).
  * May emit canon commands. On error returns a status and sets c->err_line. */
 int comp5_block(struct comp5 *c, const struct comp5_block *b, const double start[6],
                 canon_sink_fn sink, void *ctx);
-/* Ends the current run (no-op when none is open), emitting the buffered moves. */
+/* Ends the current run (no-op when none is open), emitting the buffered moves, then checks
+ * the whole run for gouges (comp5_gouge.h): COMP5_ERR_GOUGE_CONTOUR names the line, the
+ * depth and the contour point. */
 int comp5_flush(struct comp5 *c, canon_sink_fn sink, void *ctx);
 /* Where the tool is after the emitted moves (valid after comp5_flush or while active). */
 const double *comp5_tool_pos(const struct comp5 *c);

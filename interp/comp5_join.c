@@ -3,18 +3,34 @@
 
 #include <string.h>
 
-/* Inside corner: the point where the two offset lines meet, or, when the orientation change
- * makes them skew, the midpoint of their closest approach (standard closest points of two
- * lines: minimise |w0 + t Da - u Db|^2). Parallel lines cannot meet: a straight join. */
+/* v without its component along unit n. */
+static void comp5_join_flat(const double v[3], const double n[3], double out[3])
+{
+    double d = comp5_dot(v, n);
+    for (int i = 0; i < 3; i++)
+        out[i] = v[i] - d * n[i];
+}
+
+/* Inside corner: the point where the two offset lines meet, seen along the corner's tool
+ * axis N. When they are skew (the orientation changes, or the contour does not lie in a
+ * plane normal to N, e.g. a horizontal contour on a tilted table) they still cross in that
+ * view: pa on line a and pb on line b differ only along N, and the join is their midpoint.
+ * Its tool axis is then exactly W from both walls (what the gouge check measures); the
+ * depth difference |pa - pb| is shared. Closest points of two lines in the metric that
+ * ignores N: minimise |flat(w0 + t Da - u Db)|^2. Parallel in that view: a straight join. */
 static void comp5_join_inside(const struct comp5_seg *a, const struct comp5_seg *b,
                               const double corner[6], struct comp5_join *j)
 {
-    double da[3], db[3], w0[3], pa[3], pb[3];
+    double da[3], db[3], w0[3], pa[3], pb[3], n[3], fa[3], fb[3], fw[3];
     comp5_sub(a->a1, a->a0, da);
     comp5_sub(b->a1, b->a0, db);
     comp5_sub(a->a0, b->a0, w0);
-    double aa = comp5_dot(da, da), ab = comp5_dot(da, db), bb = comp5_dot(db, db);
-    double d = comp5_dot(da, w0), e = comp5_dot(db, w0);
+    comp5_normal(corner[3], corner[4], corner[5], n);
+    comp5_join_flat(da, n, fa);
+    comp5_join_flat(db, n, fb);
+    comp5_join_flat(w0, n, fw);
+    double aa = comp5_dot(fa, fa), ab = comp5_dot(fa, fb), bb = comp5_dot(fb, fb);
+    double d = comp5_dot(fa, fw), e = comp5_dot(fb, fw);
     double denom = aa * bb - ab * ab; /* |Da|^2 |Db|^2 sin^2(angle between the lines) */
     if (!(denom > COMP5_EPS_SIN_PARALLEL * COMP5_EPS_SIN_PARALLEL * aa * bb)) {
         j->kind = COMP5_JOIN_LINE;

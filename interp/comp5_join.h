@@ -9,7 +9,7 @@
 /* How two consecutive offset segments meet at a programmed corner. */
 enum comp5_join_kind {
     COMP5_JOIN_NONE,          /* collinear: the first ends where the second begins */
-    COMP5_JOIN_INSIDE,        /* the offset lines cross (or pass closest) before the corner */
+    COMP5_JOIN_INSIDE,        /* the offset lines cross, seen along the tool axis */
     COMP5_JOIN_OUTSIDE,       /* an arc of radius W about the programmed corner */
     COMP5_JOIN_LINE,          /* degenerate corner: a straight move from a1 to b0 */
 };
@@ -20,7 +20,8 @@ struct comp5_join {
     double t_a;               /* INSIDE: the join's place on a, as a0 + t_a (a1 - a0) */
     double u_b;               /* INSIDE: the join's place on b, as b0 + u_b (b1 - b0) */
     double point[6];          /* INSIDE: the join point; orientation = the corner's */
-    double gap_mm;            /* INSIDE: distance between the two offset lines there (skew) */
+    double gap_mm;            /* INSIDE: skew offset lines: their distance along the corner's
+                               * tool axis there (shared by the join) */
     double normal[3];         /* OUTSIDE: unit normal of the arc's plane (rotation +1) */
 };
 

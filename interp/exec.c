@@ -217,6 +217,9 @@ static int exec_comp5(struct interp *in, int g)
     cb.feed_mm_min = in->feed_mm_min;
     cb.line = in->line;
     cb.file = in->file;
+    cb.unit_mm = interp_len_mm(in, 1.0);
+    for (int i = 0; i < 3; i++)
+        cb.prog_off_mm[i] = in->g5x[i] + in->g92[i] + in->tool[i];
     int rc = comp5_block(&in->comp, &cb, in->pos, in->sink, in->sink_ctx);
     if (rc) {
         int col = rc == COMP5_ERR_RADIUS ? (W('w') ? W('w') : W('d')) : 0;

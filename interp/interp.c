@@ -96,6 +96,7 @@ void interp_destroy(struct interp *in)
     if (!in)
         return;
     interp_named_free(in);
+    comp5_free(&in->comp);
     free(in->param_path);
     free(in);
 }
@@ -193,6 +194,15 @@ double interp_param(const struct interp *in, int n)
     return n >= 1 && n < INTERP_NPARAMS ? in->params[n] : 0.0;
 }
 
+/* A G141/G142 error at the end of the program, on the line the compensation names. */
+static int interp_comp5_fail(struct interp *in)
+{
+    interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_errmsg(&in->comp));
+    if (in->comp.err_line)
+        in->err.line = in->comp.err_line;
+    return INTERP_ERR_COMP5;
+}
+
 /* Handles a lone '%': one on the first line opens the program, the next one ends it. */
 static int percent_line(struct interp *in, int first)
 {
@@ -207,7 +217,7 @@ static int percent_line(struct interp *in, int first)
     in->ended = 1;
     int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
     if (rc)
-        return interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_strerror(rc));
+        return interp_comp5_fail(in);
     return 0;
 }
 
@@ -253,6 +263,7 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     in->pct_open = 0;
     in->sink = sink;
     in->sink_ctx = ctx;
+    comp5_free(&in->comp);
     comp5_init(&in->comp);
     interp_named_clear_locals(in); /* #<name> belongs to one program, #<_name> stays */
     interp_settings_begin(in);     /* settings are reported, never saved, from here */

@@ -164,7 +164,7 @@ START_TEST(test_collinear)
 {
     struct comp5 c;
     struct canon_prog p;
-    double start[6] = {0};
+    double start[6] = {-4, 8, 0, 0, 0, 0}; /* beside the start, on the left: no gouge */
     comp5_init(&c);
     canon_prog_init(&p);
     for (int k = 0; k < 3; k++) {
@@ -276,8 +276,8 @@ START_TEST(test_runs_separate)
     canon_prog_init(&p);
     struct comp5_block b[4] = {tu_block(141, 0, 0, 0, 0, 0, 0, 5, 1),
                                tu_block(141, 30, 0, 0, 0, 0, 0, 5, 2),
-                               tu_block(142, 30, 0, 0, 0, 0, 0, 5, 4),
-                               tu_block(142, 60, 0, 0, 0, 0, 0, 5, 5)};
+                               tu_block(142, 40, -10, 0, 0, 0, 0, 5, 4),
+                               tu_block(142, 70, -10, 0, 0, 0, 0, 5, 5)};
     ck_assert_int_eq(comp5_block(&c, &b[0], start, canon_prog_sink, &p), COMP5_OK);
     ck_assert_int_eq(comp5_block(&c, &b[1], start, canon_prog_sink, &p), COMP5_OK);
     ck_assert_uint_eq(p.count, 0); /* no positioning: the tool is there */
@@ -292,8 +292,9 @@ START_TEST(test_runs_separate)
     ck_assert_int_eq(comp5_block(&c, &b[3], pos, canon_prog_sink, &p), COMP5_OK);
     ck_assert_int_eq(comp5_flush(&c, canon_prog_sink, &p), COMP5_OK);
     ck_assert_uint_eq(p.count, 3);
-    ck_assert_int_eq(p.cmds[1].line, 4); /* positioning from (30,-5) to (30,5) */
-    ck_assert_double_eq_tol(p.cmds[1].end[1], 5.0, 1e-12);
+    ck_assert_int_eq(p.cmds[1].line, 4); /* positioning from (30,-5) to (40,-5) */
+    ck_assert_double_eq_tol(p.cmds[1].end[0], 40.0, 1e-12);
+    ck_assert_double_eq_tol(p.cmds[1].end[1], -5.0, 1e-12);
     ck_assert_int_eq(p.cmds[2].compensated, 142);
     canon_prog_free(&p);
 }

@@ -220,13 +220,16 @@ START_TEST(machine_words)
 }
 END_TEST
 
-/* G141 blocks are resolved like G1 (offsets, units) and handed to the compensation. */
+/* G141 blocks are resolved like G1 (offsets, units) and handed to the compensation. The
+ * tool comes in along the compensated line, 10 mm before its start (from the contour line
+ * itself it would cut the wall's start: the gouge check refuses that). */
 START_TEST(g141_hand_off)
 {
     struct canon_prog p;
     struct interp *in = interp_create();
     interp_set_feed_factor(in, 1000);
-    ck_assert_int_eq(run_on(in, "G0 X50 Y-90 Z630 B-4\nG141 X50 Y-80 Z630 A0 B-4 W10 F2\n"
+    ck_assert_int_eq(run_on(in, "G0 X59.975641 Y-90 Z630.697565 B-4\n"
+                                "G141 X50 Y-80 Z630 A0 B-4 W10 F2\n"
                                 "G141 X50 Y-20 Z630 A0 B-4\nG0 Z700\nM2\n", &p), 0);
     const struct canon_cmd *last = NULL;
     for (size_t i = 0; i < p.count; i++)
