@@ -8,13 +8,14 @@
 #   make test       build and run every test (unit, HAL-graph, G-code, end to end)
 #   make sanitize   the same tests built with ASan + UBSan (in build/san/)
 #   make bench      run the benchmarks
+#   make calibration the simulated kinematic calibration (docs/calibration.md)
 #   make run        run the simulated TMU hexapod on the paper's programs
 #   make install PREFIX=/usr/local
 
 PREFIX ?= /usr/local
 BUILD_MAKE = $(MAKE) --no-print-directory -f mk/build.mk
 
-.PHONY: all deps test sanitize bench run experiment install clean fuzz
+.PHONY: all deps test sanitize bench run experiment calibration install clean fuzz
 all: deps
 	@$(BUILD_MAKE) all
 deps:
@@ -29,6 +30,8 @@ run: deps
 	@$(BUILD_MAKE) run
 experiment: deps
 	@$(BUILD_MAKE) experiment
+calibration: deps
+	@$(BUILD_MAKE) calibration
 fuzz: deps
 	@$(BUILD_MAKE) fuzz
 install: deps
