@@ -292,8 +292,8 @@ enum calib_status calib_fit(const struct calib_geom *nominal, const struct calib
 {
     double x[CALIB_NPARAM], cov[CALIB_NPARAM];
     struct calib_observability ob;
-    enum calib_status st = calib_fit_check(m, n, err, errlen);
     memset(out, 0, sizeof *out);
+    enum calib_status st = calib_fit_check(m, n, err, errlen);
     if (st != CALIB_OK)
         return st;
     out->n = n;

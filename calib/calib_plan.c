@@ -73,18 +73,17 @@ static void calib_rank1(double inv[P * P], const double x[P])
 
 /* Greedy D-optimal choice: each step takes the candidate that raises log det of the
  * information matrices most, sum over legs of log(1 + j' M^-1 j) (determinant lemma). */
-static void calib_plan_greedy(const double *jac, int nc, int n, int *chosen)
+static void calib_plan_greedy(const double *jac, int nc, int n, int *taken, int *chosen)
 {
     double inv[CALIB_LEGS][P * P] = { { 0 } };
     for (int i = 0; i < CALIB_LEGS; i++)
         for (int r = 0; r < P; r++)
             inv[i][r * P + r] = 1e6; /* M starts at 1e-6 I: a weak prior, mm^-2 */
-    int *taken = calloc((size_t)nc, sizeof *taken);
     for (int s = 0; s < n; s++) {
         int best = -1;
         double best_gain = -1.0;
         for (int c = 0; c < nc; c++) {
-            if (taken && taken[c])
+            if (taken[c])
                 continue;
             double g = 0.0;
             for (int i = 0; i < CALIB_LEGS; i++)
@@ -95,12 +94,10 @@ static void calib_plan_greedy(const double *jac, int nc, int n, int *chosen)
             }
         }
         chosen[s] = best;
-        if (taken)
-            taken[best] = 1;
+        taken[best] = 1;
         for (int i = 0; i < CALIB_LEGS; i++)
             calib_rank1(inv[i], &jac[(best * CALIB_LEGS + i) * P]);
     }
-    free(taken);
 }
 
 /* Plans n poses (see calib.h). */
@@ -113,8 +110,9 @@ enum calib_status calib_plan(struct kins *k, const struct calib_geom *g,
     double (*cand)[KINS_POSE_DIM] = calloc((size_t)opts->candidates, sizeof *cand);
     double *jac = calloc((size_t)opts->candidates * CALIB_LEGS * P, sizeof *jac);
     int *chosen = calloc((size_t)(n > 0 ? n : 1), sizeof *chosen);
+    int *taken = calloc((size_t)opts->candidates, sizeof *taken);
     struct calib_meas *m = calloc((size_t)(n > 0 ? n : 1), sizeof *m);
-    if (!cand || !jac || !chosen || !m)
+    if (!cand || !jac || !chosen || !taken || !m)
         goto fail;
     st = CALIB_ERR_TOO_FEW;
     if (n < CALIB_MIN_MEAS) {
@@ -133,7 +131,7 @@ enum calib_status calib_plan(struct kins *k, const struct calib_geom *g,
         for (int i = 0; i < CALIB_LEGS; i++) /* lengths that fit g exactly: r = 0 */
             cm.legs_mm[i] = calib_leg_residual(g, &cm, i, &jac[(c * CALIB_LEGS + i) * P]);
     }
-    calib_plan_greedy(jac, nc, n, chosen);
+    calib_plan_greedy(jac, nc, n, taken, chosen);
     for (int s = 0; s < n; s++) {
         memcpy(pose[s], cand[chosen[s]], sizeof pose[s]);
         memcpy(m[s].pose, cand[chosen[s]], sizeof m[s].pose);
@@ -145,6 +143,7 @@ fail:
     free(cand);
     free(jac);
     free(chosen);
+    free(taken);
     free(m);
     return st;
 }

@@ -157,10 +157,11 @@ static int calibrate_plan(const struct calibrate_args *a, struct kins *k,
     if (po.candidates < 20 * n)
         po.candidates = (int)(20 * n);
     double (*pose)[KINS_POSE_DIM] = calloc((size_t)n, sizeof *pose), cond;
-    struct calib_buf_text { char *s; size_t len; } csv = { NULL, 0 };
+    char *csv = NULL;  /* the CSV text, built in memory, then printed or written */
+    size_t csv_len = 0;
     FILE *mem = NULL;
     int rc = 1;
-    if (!pose || !(mem = open_memstream(&csv.s, &csv.len)))
+    if (!pose || !(mem = open_memstream(&csv, &csv_len)))
         goto done;
     enum calib_status st = calib_plan(k, g, &po, (int)n, pose, &cond, err, sizeof err);
     if (st != CALIB_OK) {
@@ -176,8 +177,8 @@ static int calibrate_plan(const struct calibrate_args *a, struct kins *k,
     fclose(mem);
     mem = NULL;
     if (!a->out)
-        fputs(csv.s, stdout);
-    else if (calibrate_write_atomic(a->out, csv.s, err, sizeof err) != 0) {
+        fputs(csv, stdout);
+    else if (calibrate_write_atomic(a->out, csv, err, sizeof err) != 0) {
         fprintf(stderr, "hexcnc calibrate plan: %s\n", err);
         goto done;
     }
@@ -188,7 +189,7 @@ static int calibrate_plan(const struct calibrate_args *a, struct kins *k,
 done:
     if (mem)
         fclose(mem);
-    free(csv.s);
+    free(csv);
     free(pose);
     return rc;
 }
