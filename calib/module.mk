@@ -13,7 +13,7 @@ $(CAL_BIN): calib/calibration_main.c $(LIBDIR)/libhexcnc.a
 .PHONY: calibration
 calibration: all $(CAL_BIN)
 	@mkdir -p $(BUILD)/calibration
-	@$(RUN_ENV) $(CAL_BIN) configs/sim/tmu-hexapod.ini $(BUILD)/calibration
+	@$(RUN_ENV) $(CAL_BIN) configs/sim/tmu-hexapod.ini $(BUILD)/calibration --paper
 	@rm -f $(BUILD)/calibration/calibrated.ini
 	@$(RUN_ENV) $(HEXCNC) calibrate fit configs/sim/tmu-hexapod.ini \
 	  $(BUILD)/calibration/measurements.csv -o $(BUILD)/calibration/calibrated.ini \
