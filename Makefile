@@ -8,6 +8,7 @@
 #   make test       build and run every test (unit, HAL-graph, G-code, end to end)
 #   make sanitize   the same tests built with ASan + UBSan (in build/san/)
 #   make bench      run the benchmarks
+#   make calibration the simulated kinematic calibration (docs/calibration.md)
 #   make run        run the simulated TMU hexapod on the paper's programs
 #   make ini-doc    write docs/ini.md from the INI key table (common/config_keys.c)
 #   make install PREFIX=/usr/local
@@ -15,7 +16,7 @@
 PREFIX ?= /usr/local
 BUILD_MAKE = $(MAKE) --no-print-directory -f mk/build.mk
 
-.PHONY: all deps test sanitize bench run experiment install clean fuzz ini-doc
+.PHONY: all deps test sanitize bench run experiment calibration install clean fuzz ini-doc
 all: deps
 	@$(BUILD_MAKE) all
 deps:
@@ -30,6 +31,8 @@ run: deps
 	@$(BUILD_MAKE) run
 experiment: deps
 	@$(BUILD_MAKE) experiment
+calibration: deps
+	@$(BUILD_MAKE) calibration
 fuzz: deps
 	@$(BUILD_MAKE) fuzz
 ini-doc: deps

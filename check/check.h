@@ -122,6 +122,10 @@ int check_machine_open(const char *ini_path, struct check_machine **out, char *e
                        size_t errlen);
 void check_machine_close(struct check_machine *mc);
 struct kins *check_machine_kins(struct check_machine *mc);
+/* The machine as built, when its geometry differs from the controller's (calibration
+ * studies): the cutting simulation turns drive feedback into the platform pose through
+ * real's forward kinematics. mc takes ownership (freed by close); NULL = the controller's. */
+void check_machine_set_real(struct check_machine *mc, struct kins *real);
 struct motion *check_machine_motion(struct check_machine *mc);
 const struct motion_config *check_machine_motion_config(const struct check_machine *mc);
 /* Stepgen steps per mm of leg n ([JOINT_n] SCALE), 0 when not given. */

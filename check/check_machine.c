@@ -139,6 +139,7 @@ void check_machine_close(struct check_machine *mc)
         return;
     motion_destroy(mc->motion);
     kins_free(mc->kins);
+    kins_free(mc->real_kins);
     for (size_t i = 0; i < mc->ninterps; i++)
         interp_destroy(mc->interps[i]);
     free(mc->interps);
@@ -150,6 +151,11 @@ void check_machine_close(struct check_machine *mc)
 /* Accessors (borrowed pointers). */
 struct kins *check_machine_kins(struct check_machine *mc) { return mc->kins; }
 struct motion *check_machine_motion(struct check_machine *mc) { return mc->motion; }
+void check_machine_set_real(struct check_machine *mc, struct kins *real)
+{
+    kins_free(mc->real_kins);
+    mc->real_kins = real;
+}
 const struct motion_config *check_machine_motion_config(const struct check_machine *mc)
 {
     return &mc->mcfg;

@@ -13,6 +13,8 @@ struct interp;
 struct check_machine {
     struct hal *hal;                 /* used only for its INI reader (no threads) */
     struct kins *kins;               /* loaded by name from [KINS] KINEMATICS */
+    struct kins *real_kins;          /* the machine as built, if set: the cutting
+                                      * simulation's forward kinematics (owned) */
     struct motion *motion;           /* the planner and interpolator the machine runs */
     struct motion_config mcfg;       /* its limits, from [EMCMOT] [TRAJ] [JOINT_n] */
     struct tooltable *tt;            /* [RS274NGC] TOOL_TABLE (empty when none) */

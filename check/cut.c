@@ -100,7 +100,8 @@ static int machine_period(struct check_machine *mc, struct stepgen_state *sg,
         fb[i] = lim[i].scale > 0 ? (double)counts / lim[i].scale : sg[i].pos_mm;
     }
     motion_feedback(mc->motion, fb);
-    int st = kins_forward(mc->kins, fb, pose, NULL);   /* warm: from the last actual pose */
+    struct kins *built = mc->real_kins ? mc->real_kins : mc->kins; /* the machine as built */
+    int st = kins_forward(built, fb, pose, NULL);   /* warm: from the last actual pose */
     if (st != KINS_OK) {
         snprintf(err, errlen, "forward kinematics of the drive feedback failed at line %d: %s",
                  out->line, kins_strerror(st));

@@ -6,6 +6,9 @@
 
 #include "check/experiment.h"
 #include "check/plot.h"
+#include "common/errbuf.h"
+#include "common/inifile.h"
+#include "kins/kins.h"
 
 #define DIR "examples/paper/experiment"
 
@@ -14,15 +17,15 @@
  * and (11) order them. Paper values in mm; run 2 has no d1 in the paper. */
 static const struct exp_run_def runs[] = {
     { "1", DIR "/run1_g141.ngc", DIR "/tmu-path1.ini", 1, 141, { 3, 1 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.8, 7.7, 7.7 } },
+      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.8, 7.7, 7.7 }, NULL },
     { "2", DIR "/run2_g141.ngc", DIR "/tmu-path1.ini", 1, 141, { 3, 2 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { NAN, 8.1, 8.3, 8.2 } },
+      { { -80, -20 }, { -30, 20 } }, { NAN, 8.1, 8.3, 8.2 }, NULL },
     { "3", DIR "/run3_g141.ngc", DIR "/tmu-path2.ini", 2, 141, { 3, 1 }, 30, 658, -8,
-      { { -100, -20 }, { -30, 50 } }, { NAN, 8.2, 7.9, 7.9 } },
+      { { -100, -20 }, { -30, 50 } }, { NAN, 8.2, 7.9, 7.9 }, NULL },
     { "4", DIR "/run4_g141.ngc", DIR "/tmu-path2.ini", 2, 141, { 3, 2 }, 30, 658, -8,
-      { { -100, -20 }, { -30, 50 } }, { NAN, 8.0, 7.8, 7.9 } },
+      { { -100, -20 }, { -30, 50 } }, { NAN, 8.0, 7.8, 7.9 }, NULL },
     { "G142", DIR "/run1_g142.ngc", DIR "/tmu-path1.ini", 1, 142, { 3, 1 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.7, 7.9, 8.1 } },
+      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.7, 7.9, 8.1 }, NULL },
 };
 
 /* The run table. */
@@ -111,6 +114,25 @@ static char *nocomp_text(const char *path)
 static int run_plots(const char *dir, const struct exp_run_def *d, const struct cut_wall *w,
                      const struct cut_path *a, const struct cut_path *b, const double st[4]);
 
+/* Loads the machine as built from its INI's kinematics into mc. */
+static int exp_set_real(struct check_machine *mc, const char *path, char *err, size_t errlen)
+{
+    struct inifile ini = { 0 };
+    struct kins *real = NULL;
+    char msg[512] = "";
+    if (inifile_load(&ini, path, msg, sizeof msg) != INIFILE_OK)
+        return errbuf_set(err, errlen, CHECK_ERR_CONFIG, "%s", msg);
+    const char *name = inifile_get(&ini, "KINS", "KINEMATICS");
+    struct kins_config kc = { inifile_config_get, &ini };
+    int st = name ? kins_load(name, &kc, &real, msg, sizeof msg) : KINS_ERR_CONFIG;
+    inifile_free(&ini);
+    if (st != KINS_OK)
+        return errbuf_set(err, errlen, CHECK_ERR_KINS, "%s: %s", path,
+                          name ? msg : "[KINS] KINEMATICS is missing");
+    check_machine_set_real(mc, real);
+    return CHECK_OK;
+}
+
 /* Cuts a run with and without compensation and reads the four stations. */
 int exp_run(const char *root, const struct exp_run_def *d, const char *plot_dir,
             struct exp_result *res, char *err, size_t errlen)
@@ -126,6 +148,8 @@ int exp_run(const char *root, const struct exp_run_def *d, const char *plot_dir,
     snprintf(ini, sizeof ini, "%s/%s", root, d->ini);
     snprintf(prog, sizeof prog, "%s/%s", root, d->program);
     int st = check_machine_open(ini, &mc, err, errlen);
+    if (!st && d->real_ini)
+        st = exp_set_real(mc, d->real_ini, err, errlen);
     if (st || (st = exp_wall_frame(mc, d, &w)) || (st = stations(mc, d, &w, res->station_s_mm)) ||
         (st = simulate(mc, prog, NULL, &comp, err, errlen)))
         goto out;

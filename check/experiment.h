@@ -32,6 +32,8 @@ struct exp_run_def {
     double x_mm, z_mm, b_deg; /* the path's program X, Z and table tilt B */
     double part[2][2];       /* program Y from..to of the first and second tool's part */
     double paper_d_mm[4];    /* the paper's d1..d4 (NAN where it gives none) */
+    const char *real_ini;    /* the machine as built, when its geometry differs from the
+                              * controller's (path as given; NULL: the same machine) */
 };
 /* The five runs: Table 1's runs 1..4 and the G142 run. */
 const struct exp_run_def *exp_runs(int *count);

@@ -73,6 +73,8 @@ const struct config_key config_keys[] = {
       "instead of the radius and angle keys" },
     { "KINS", "PLATFORM_#", NUMS, "mm", "", 3, 0, "", "hexapod: platform joint # (0..5) as "
       "x y z in the platform frame" },
+    { "KINS", "LEG_OFFSET", NUMS, "mm", "-1000..1000", 6, 0, "0 0 0 0 0 0", "hexapod: per leg, "
+      "joint-centre distance minus the length the drive reports (calibration)" },
     { "KINS", "HOME", NUMS, "mm, deg", "", 6, 0, "level, legs mid-range", "pose X Y Z A B C "
       "the forward solver starts from" },
     { "KINS", "PLATFORM_CARRIES", ENUM, "", "WORKPIECE|SPINDLE", 0, 0, "WORKPIECE", "what "

@@ -23,21 +23,22 @@ static int hexapod_pose_frame(const double pose[KINS_POSE_DIM], double t_mm[3],
     return KINS_OK;
 }
 
-/* Copies evaluated leg lengths out; KINS_ERR_UNREACHABLE when any is outside its limits
- * (all are written, so callers can say by how much). */
+/* Copies the joint values (joint-centre distance - leg offset) out; KINS_ERR_UNREACHABLE
+ * when any is outside its limits (all are written, so callers can say by how much). */
 static int hexapod_lengths_of(const struct kins *k, const struct hexapod_legs *lg,
                               double *joints)
 {
+    const struct hexapod *h = (const struct hexapod *)k;
     int st = KINS_OK;
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        joints[i] = lg->len_mm[i];
-        if (lg->len_mm[i] < k->joint_min[i] || lg->len_mm[i] > k->joint_max[i])
+        joints[i] = lg->len_mm[i] - h->offset_mm[i];
+        if (joints[i] < k->joint_min[i] || joints[i] > k->joint_max[i])
             st = KINS_ERR_UNREACHABLE;
     }
     return st;
 }
 
-/* Inverse kinematics: leg i length = |t + R·p_i - b_i|. */
+/* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i. */
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
 {
     const struct hexapod *h = (const struct hexapod *)k;
@@ -120,7 +121,8 @@ static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
     out->worst_leg = 0;
     out->leg_margin_mm = INFINITY;
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        double m = fmin(lg.len_mm[i] - k->joint_min[i], k->joint_max[i] - lg.len_mm[i]);
+        double q = lg.len_mm[i] - h->offset_mm[i];
+        double m = fmin(q - k->joint_min[i], k->joint_max[i] - q);
         if (m < 0.0)
             out->reachable = 0;
         if (m < out->leg_margin_mm) {

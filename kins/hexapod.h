@@ -19,6 +19,8 @@ struct hexapod {
     struct kins base;                  /* generic part; must stay first */
     double b_mm[HEXAPOD_LEGS][3];      /* base joint centres in the base frame, mm */
     double p_mm[HEXAPOD_LEGS][3];      /* platform joint centres in the platform frame, mm */
+    double offset_mm[HEXAPOD_LEGS];    /* leg length offsets: joint value (the length the
+                                        * drive reports) + offset = joint-centre distance, mm */
     double pdist_mm[HEXAPOD_LEGS][HEXAPOD_LEGS]; /* platform joint spacing, mm */
     double bdist_mm[HEXAPOD_LEGS][HEXAPOD_LEGS]; /* base joint spacing, mm */
     double char_len_mm;                /* turns angular Jacobian columns (mm/rad) into mm/mm */

@@ -168,13 +168,14 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
     int piv[N] = { 0 }, iter = 0, have_lu = 0, st;
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    double resid = (double)NAN;
+    double resid = (double)NAN, centre_mm[HEXAPOD_LEGS];
 
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
         if (!isfinite(joints[i]) || !isfinite(pose[i]))
             return KINS_ERR_ARG;
         if (joints[i] < k->joint_min[i] || joints[i] > k->joint_max[i])
             return KINS_ERR_LEG_RANGE;
+        centre_mm[i] = joints[i] + h->offset_mm[i]; /* the drives' length + leg offset */
     }
     q[0] = pose[KINS_X];
     q[1] = pose[KINS_Y];
@@ -186,7 +187,7 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
         sincos(q[3 + j], &sn[j], &cs[j]);
 
     for (;;) {
-        resid = hexapod_residual(h, q, sn, cs, joints, &o, &lg, rhs);
+        resid = hexapod_residual(h, q, sn, cs, centre_mm, &o, &lg, rhs);
         if (isnan(resid)) {
             st = KINS_ERR_NO_CONVERGE;
             break;
@@ -221,7 +222,7 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
         info->residual_mm = resid;
     }
     if (st != KINS_OK)
-        return hexapod_lengths_impossible(h, joints) ? KINS_ERR_IMPOSSIBLE : st;
+        return hexapod_lengths_impossible(h, centre_mm) ? KINS_ERR_IMPOSSIBLE : st;
     pose[KINS_X] = q[0];
     pose[KINS_Y] = q[1];
     pose[KINS_Z] = q[2];

@@ -99,12 +99,30 @@ static int hexapod_read_limits(struct hexapod *h, const struct kins_config *cfg,
     return KINS_OK;
 }
 
+/* Reads [KINS] LEG_OFFSET = six numbers (mm, default 0): what each leg's joint-centre
+ * distance exceeds the length its drive reports, as `hexcnc calibrate fit` identifies it. */
+static int hexapod_read_offsets(struct hexapod *h, const struct kins_config *cfg, char *err,
+                                size_t errlen)
+{
+    int found;
+    memset(h->offset_mm, 0, sizeof h->offset_mm);
+    int st = kins_cfg_numbers(cfg, "KINS", "LEG_OFFSET", h->offset_mm, HEXAPOD_LEGS, &found,
+                              err, errlen);
+    if (st != KINS_OK)
+        return st;
+    for (int i = 0; i < HEXAPOD_LEGS; i++)
+        if (fabs(h->offset_mm[i]) > 1e3)
+            return kins_cfg_error(err, errlen, "KINS", "LEG_OFFSET", "leg %d: %g mm is beyond "
+                                  "+-1000 mm", i + 1, h->offset_mm[i]);
+    return KINS_OK;
+}
+
 /* The default home: level and centred, at the height where the legs average mid-range. */
 static int hexapod_default_home(struct hexapod *h, char *err, size_t errlen)
 {
     double z_sum = 0.0;
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        double mid = 0.5 * (h->base.joint_min[i] + h->base.joint_max[i]);
+        double mid = 0.5 * (h->base.joint_min[i] + h->base.joint_max[i]) + h->offset_mm[i];
         double dx = h->p_mm[i][0] - h->b_mm[i][0], dy = h->p_mm[i][1] - h->b_mm[i][1];
         double d2 = dx * dx + dy * dy;
         if (mid * mid <= d2)
@@ -203,6 +221,8 @@ int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *er
                         : hexapod_read_parametric(h, cfg, err, errlen);
     if (st == KINS_OK)
         st = hexapod_read_limits(h, cfg, err, errlen);
+    if (st == KINS_OK)
+        st = hexapod_read_offsets(h, cfg, err, errlen);
     if (st != KINS_OK)
         return st;
     int home_found;

@@ -47,7 +47,10 @@ CFLAGS   := -std=c11 $(OPT) -g -fPIC $(WARN) $(SANFLAGS)
 CXXFLAGS := -std=c++17 $(OPT) -g -fPIC -Wall -Wextra -Wshadow $(if $(CI),-Werror) $(SANFLAGS) \
             $(shell pkg-config --cflags eigen3)
 LDFLAGS  := $(SANFLAGS)
-LDLIBS   := $(shell pkg-config --libs $(PKGS)) -ldl -lpthread -lm -lstdc++
+# Ceres Solver (calib/) ships no .pc file; its CMake config (CeresTargets.cmake) links the
+# shared libceres with glog, gflags and threads.
+CERES_LIBS := -lceres -lglog -lgflags
+LDLIBS   := $(shell pkg-config --libs $(PKGS)) $(CERES_LIBS) -ldl -lpthread -lm -lstdc++
 CHECK_LIBS := $(shell pkg-config --libs check)
 
 # Quiet build: one short line per step; `make V=1` prints the full commands.

@@ -1,12 +1,13 @@
 #!/bin/sh
 # Installs the Debian packages hexcnc needs, only those that are missing.
 # Used by `make deps`; safe to run again.
+# libceres-dev: Ceres Solver, the least squares of `hexcnc calibrate fit` (docs/calibration.md).
 # linuxcnc-uspace is there for tests only: its `rs274` and the programs and tool tables it
 # ships are the reference that hexcnc's G-code and tool-table reading are compared with.
 # mbpoll is there for tests only: a third-party Modbus client for `hexcnc modbus_sim`.
 set -eu
 PKGS="build-essential pkg-config check libmodbus-dev libeigen3-dev liblcm-dev liblcm-bin \
-libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll"
+libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll libceres-dev"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
