@@ -288,6 +288,32 @@ START_TEST(test_nmt_boot)
 }
 END_TEST
 
+/* A boot-up read while a node is being configured (its power-on message arriving after the
+ * master's NMT reset, or a reboot) starts the configuration over instead of faulting. */
+START_TEST(test_bootup_during_config)
+{
+    struct rig r;
+    rig_init(&r, 2, 1000000);
+    rig_run_ms(&r, 3);
+    ck_assert_int_eq(r.m.node[0].phase, CANOPEN_PHASE_CONFIG);
+    ck_assert_uint_gt(r.sim[0].sdo_writes, 0);
+    struct cia402_sim_cfg sc = r.sim[0].cfg;
+    cia402_sim_init(&r.sim[0], &sc);  /* power cycle: its counters restart, a boot-up follows */
+    rig_run_ms(&r, 100);
+    ck_assert_msg(!r.m.node[0].fault, "%s", r.m.node[0].message);
+    ck_assert_int_eq(r.m.node[0].phase, CANOPEN_PHASE_RUN);
+    ck_assert_int_eq(r.sim[0].nmt, CANOPEN_STATE_OPERATIONAL);
+    /* written again from the first entry (one request may have reached the restarted drive
+     * before its boot-up was read): the drive holds the whole configuration */
+    ck_assert_uint_ge(r.sim[0].sdo_writes, (unsigned)canopen_config_count());
+    ck_assert_uint_le(r.sim[0].sdo_writes, (unsigned)canopen_config_count() + 1);
+    ck_assert_int_eq(r.sim[0].mode, 8);
+    ck_assert_uint_eq(r.sim[0].heartbeat_ms, 20);
+    ck_assert_uint_eq(r.sim[0].tpdo_cob, 0x181u);
+    ck_assert_int_eq(r.m.node[1].phase, CANOPEN_PHASE_RUN);
+}
+END_TEST
+
 /* Drive fault with EMCY: fault pin, code and register in the message; fault reset brings
  * the drive back to Operation enabled through the state machine. */
 START_TEST(test_fault_and_reset)
@@ -543,6 +569,7 @@ static Suite *master_suite(void)
     tcase_add_test(tc, test_sdo_abort_from_dictionary);
     tcase_add_test(tc, test_sdo_timeout);
     tcase_add_test(tc, test_nmt_boot);
+    tcase_add_test(tc, test_bootup_during_config);
     tcase_add_test(tc, test_fault_and_reset);
     tcase_add_test(tc, test_heartbeat_loss);
     tcase_add_test(tc, test_feedback_loss);

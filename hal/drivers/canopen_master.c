@@ -73,12 +73,17 @@ static void rx_heartbeat(struct canopen_node *n, const struct can_frame *f, int6
         return;
     uint8_t st = f->data[0] & 0x7Fu;  /* bit 7 is the (unused) toggle bit of node guarding */
     if (st == CANOPEN_STATE_BOOTUP) {
-        if (n->phase == CANOPEN_PHASE_WAIT_BOOT) {
+        /* A boot-up while the node is being configured starts its configuration over: it
+         * may be the node's power-on message read after our NMT reset (the bus was joined
+         * after the node booted, or the other process was slow), or the node rebooted. The
+         * configuration is written again from the first entry; the SDO time-outs and the
+         * runner's start-up wait still bound a node that keeps rebooting. */
+        if (n->phase == CANOPEN_PHASE_WAIT_BOOT || n->phase == CANOPEN_PHASE_CONFIG) {
             n->phase = CANOPEN_PHASE_CONFIG;
             n->sdo_step = 0;
             n->sdo_pending = false;
             n->heartbeat_seen = false;
-        } else if (n->phase == CANOPEN_PHASE_CONFIG || n->phase == CANOPEN_PHASE_RUN) {
+        } else if (n->phase == CANOPEN_PHASE_RUN) {
             node_comm_fault(n, CANOPEN_ERR_BOOT, "the drive restarted by itself (boot-up "
                             "message while running): check its supply and its fault log");
         }
