@@ -225,6 +225,32 @@ START_TEST(command_errors)
 }
 END_TEST
 
+/* addf positions beyond an int are refused as such, not wrapped onto a valid position
+ * (4294967297 used to become 1, 4294967296 to become 0: "append"). */
+START_TEST(addf_position_out_of_range)
+{
+    struct hal *h = new_hal();
+    ck_assert_int_eq(hal_cmd(h, "loadrt threads name1=servo period1=1000000", "t.hal", 1, NULL),
+                     HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "loadrt sum2 count=2", "t.hal", 2, NULL), HAL_OK);
+    static const char *const bad[] = { "4294967297", "4294967296", "-4294967296",
+                                       "2147483648", "-2147483648", "9223372036854775807" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char line[80], msg[200];
+        snprintf(line, sizeof line, "addf sum2.0 servo %s", bad[i]);
+        ck_assert_int_eq(hal_cmd(h, line, "t.hal", 3, NULL), HAL_ERR_ARG);
+        snprintf(msg, sizeof msg, "t.hal:3: addf: position %s is outside thread 'servo', "
+                 "which has 0 functions", bad[i]);
+        ck_assert_str_eq(hal_last_error(h), msg);
+    }
+    /* nothing was added: the function is still free and goes first */
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.0 servo 1", "t.hal", 4, NULL), HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.1 servo -1", "t.hal", 5, NULL), HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.0 servo 3", "t.hal", 6, NULL), HAL_ERR_EXISTS);
+    hal_destroy(h);
+}
+END_TEST
+
 START_TEST(kinematics_by_name_becomes_the_kins_component)
 {
     void *dl = NULL;
@@ -291,6 +317,7 @@ static Suite *hal_cmd_suite(void)
     tcase_add_test(tc, commands_comments_quotes_and_output);
     tcase_add_test(tc, start_runs_the_simulated_clock_and_show_lists);
     tcase_add_test(tc, command_errors);
+    tcase_add_test(tc, addf_position_out_of_range);
     tcase_add_test(tc, kinematics_by_name_becomes_the_kins_component);
     tcase_add_test(tc, kinematics_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);
