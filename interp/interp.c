@@ -184,6 +184,9 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
     v->feed_factor = in->feed_factor;
     v->current_tool = in->current_tool;
+    v->path_mode = in->path_mode;
+    v->path_tol_mm = in->path_tol_mm;
+    v->naive_cam_tol_mm = in->naive_cam_tol_mm;
 }
 
 /* Reads numbered parameter #n. */
@@ -214,6 +217,8 @@ static int run_lines(struct interp *in, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
     int first = 1;
+    if (len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3))
+        p += 3;  /* a UTF-8 byte order mark, as editors on Windows write: not part of line 1 */
     while (p < end && !in->ended) {
         const char *nl = memchr(p, '\n', (size_t)(end - p));
         size_t l = nl ? (size_t)(nl - p) : (size_t)(end - p);

@@ -83,6 +83,9 @@ struct interp_view {
     double tool_mm[6];        /* tool length offset (Z only for G43 H) */
     double feed_factor;       /* see interp_set_feed_factor */
     int current_tool;         /* tool in the spindle */
+    int path_mode;            /* 610 (G61), 611 (G61.1) or 640 (G64) */
+    double path_tol_mm;       /* G64 P: blend tolerance, mm (0: none given) */
+    double naive_cam_tol_mm;  /* G64 Q: naive CAM tolerance, mm (0: none given) */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */

@@ -97,6 +97,8 @@ struct interp {
     int retract_old_z;           /* G98 */
     int path_mode;               /* 610, 611 or 640 */
     double path_tol_mm;          /* G64 P */
+    double naive_cam_tol_mm;     /* G64 Q: LinuxCNC's "naive CAM detector" tolerance; stored
+                                  * and reported, not used by the planner (docs/gcode.md) */
     double g5x[6];               /* active work offset, mm/deg */
     double g92[6];               /* active G92 offset */
     double tool[6];              /* active tool length offset */

@@ -61,6 +61,61 @@ START_TEST(lexer_comments_n_percent)
 }
 END_TEST
 
+/* A UTF-8 byte order mark before line 1 is skipped: the same moves, columns counted after
+ * it; a BOM anywhere else is an error that names the byte. */
+START_TEST(lexer_utf8_bom)
+{
+    static const char plain[] = "G21 G90\nG0 X1 Y2 Z3\nG1 X4 F100\nM2\n";
+    char bom[sizeof plain + 3] = "\xEF\xBB\xBF";
+    memcpy(bom + 3, plain, sizeof plain);
+    struct canon_prog p, q;
+    ck_assert_int_eq(run_text(plain, &p, NULL), 0);
+    ck_assert_int_eq(run_text(bom, &q, NULL), 0);
+    ck_assert_uint_eq(p.count, q.count);
+    ck_assert_pose(nth(&q, CANON_TRAVERSE, 0)->end, 1, 2, 3, 0, 0, 0, 1e-12);
+    ck_assert_pose(nth(&q, CANON_FEED, 0)->end, 4, 2, 3, 0, 0, 0, 1e-12);
+    ck_assert_int_eq(nth(&q, CANON_FEED, 0)->line, 3);
+    canon_prog_free(&p);
+    canon_prog_free(&q);
+    struct interp_error e;
+    ck_assert_int_ne(run_text("\xEF\xBB\xBFG21 Q1\nM2\n", &p, &e), 0);
+    ck_assert_int_eq(e.line, 1);
+    ck_assert_int_eq(e.column, 5);  /* Q is the fifth character after the mark */
+    canon_prog_free(&p);
+    ck_assert_int_ne(run_text("G21\n\xEF\xBB\xBFG0 X1\nM2\n", &p, &e), 0);
+    ck_assert_int_eq(e.line, 2);
+    ck_assert_int_eq(e.column, 1);
+    ck_assert_str_eq(e.message, "byte 0xEF is not G-code text (G-code is ASCII)");
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* G64 Q (LinuxCNC's naive CAM tolerance, written by Fusion 360's post) is accepted and kept
+ * beside P; a G64 without Q, or G61, clears it. */
+START_TEST(g64_q_is_stored)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    struct canon_prog p;
+    struct interp_view v;
+    ck_assert_int_eq(run_on(in, "G21 G64 P0.02 Q0.005\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_int_eq(v.path_mode, 640);
+    ck_assert_double_eq_tol(v.path_tol_mm, 0.02, 1e-15);
+    ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.005, 1e-15);
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G20 G64 P0.001 Q0.0005\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.0127, 1e-12);  /* inch to mm */
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G21 G64 P0.02\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_double_eq(v.naive_cam_tol_mm, 0.0);
+    canon_prog_free(&p);
+    interp_destroy(in);
+}
+END_TEST
+
 START_TEST(lexer_block_delete)
 {
     const char *prog = "G0 X1\n/G0 X2\n  / G0 X3\nM2\n";
@@ -299,6 +354,8 @@ static Suite *interp_suite(void)
     TCase *tc = tcase_create("core");
     tcase_add_test(tc, lexer_case_spaces_numbers);
     tcase_add_test(tc, lexer_comments_n_percent);
+    tcase_add_test(tc, lexer_utf8_bom);
+    tcase_add_test(tc, g64_q_is_stored);
     tcase_add_test(tc, lexer_block_delete);
     tcase_add_test(tc, expr_precedence);
     tcase_add_test(tc, expr_functions);
