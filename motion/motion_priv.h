@@ -40,6 +40,9 @@ struct motion_seg {
     double blend_tol_mm;     /* G64 tolerance in force (blend into the next move), 0 = stop */
     size_t k0;               /* first knot */
     size_t nk;               /* knots (>= 2) */
+    double fine_h;           /* spacing the checks need, mm (deg when rotary); knots are this
+                              * close but on very long moves (MAX_INTERVALS), where the checks
+                              * sample between them at this spacing */
     int arc;                 /* index into arcs for SEG_ARC, else -1 */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
