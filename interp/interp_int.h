@@ -70,6 +70,7 @@ struct interp {
     struct tooltable *tt;        /* tool table or NULL (not owned) */
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
+    const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
 
     /* where we are in the program */
     char file[256];

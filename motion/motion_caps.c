@@ -269,6 +269,16 @@ static void machine_caps(const struct motion *m, const struct motion_seg *sg,
     }
 }
 
+bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,
+                      size_t errlen)
+{
+    if (!m->cancel || !*m->cancel)
+        return false;
+    snprintf(err, errlen, "%s:%d: planning stopped by the operator", file ? file : "program",
+             line);
+    return true;
+}
+
 /* Knots of a very long move (a helix of many turns) lie further apart (hs) than the checks
  * are made for (sg->fine_h): the error terms grow with the square of the spacing and once
  * refused a 20000-turn helix with a leg "1231.725 mm long". The interval from s to the next
@@ -281,6 +291,8 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
     for (double j = 1; j < n && s + j * h < sg->len; j++) {
         struct motion_sample T;
         double v = HUGE_VAL;
+        if (motion_cancelled(m, sg->file, sg->line, err, errlen))
+            return MOTION_ERR_CANCELLED;
         int st = reach_check(m, sg, &T, h, sample_at(m, sg, s + j * h, &T), err, errlen);
         if (st)
             return st;

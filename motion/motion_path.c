@@ -341,6 +341,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     for (size_t i = 0; i < prog->count; i++) {
         const struct canon_cmd *c = &prog->cmds[i];
         size_t nseg0 = p->nseg;
+        if (motion_cancelled(m, c->file, c->line, err, errlen))
+            return MOTION_ERR_CANCELLED;
         int rc = 0;
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;

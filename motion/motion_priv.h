@@ -2,6 +2,7 @@
 #ifndef HEXCNC_MOTION_PRIV_H
 #define HEXCNC_MOTION_PRIV_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "motion/motion.h"
@@ -84,6 +85,7 @@ struct motion {
     enum motion_state state;
     int fault_status;
     char msg[320];           /* last error / fault text */
+    const volatile sig_atomic_t *cancel; /* the operator's stop request while planning, or NULL */
     double start_pose[KINS_POSE_DIM];
     /* planning scratch: the inverse Jacobian dpose/dL near jc_pose, reused while the path
      * stays within 2 mm and 1 deg of it */
@@ -159,6 +161,10 @@ struct motion_sample {
     double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
     double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
 };
+
+/* Whether the operator asked to stop planning; if so err says where (motion_caps.c). */
+bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,
+                      size_t errlen);
 
 /* Sampling and caps (motion_caps.c). Speed caps of the knot at s of sg (knot spacing hs):
  * hard (machine, legs, kinematic error), with the feed (cap), path acceleration (acc); the

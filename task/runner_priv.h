@@ -21,6 +21,7 @@ struct runner {
     bool loaded;                        /* a program is planned */
     bool started;                       /* runner_start succeeded */
     bool aborting;                      /* runner_abort was called */
+    const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
     runner_message_fn msg_fn;           /* gets every component message (may be NULL) */
     void *msg_ctx;
     char first_fault[300];              /* "source: text" of the first fault message: the cause */

@@ -116,6 +116,49 @@ START_TEST(g64_q_is_stored)
 }
 END_TEST
 
+/* A sink that stands for Ctrl-C: it sets the cancel flag when the command of line `at`
+ * arrives, as a signal handler would between two lines. */
+struct cancel_at {
+    volatile sig_atomic_t flag;
+    int at;
+    struct canon_prog prog;
+};
+static int cancel_sink(void *ctx, const struct canon_cmd *c)
+{
+    struct cancel_at *k = ctx;
+    if (c->line == k->at)
+        k->flag = 1;
+    return canon_prog_sink(&k->prog, c);
+}
+
+/* The cancel flag stops the line loop before the next line: nothing of it or after it is
+ * emitted, and the error says where and why. */
+START_TEST(cancel_flag_stops_before_the_next_line)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    struct cancel_at k = { .flag = 0, .at = 3 };
+    canon_prog_init(&k.prog);
+    interp_set_cancel(in, &k.flag);
+    static const char prog[] = "G21 G90\nG0 X1\nG0 X2\nG0 X3\nG0 X4\nM2\n";
+    ck_assert_int_eq(interp_run_text(in, "c.ngc", prog, strlen(prog), cancel_sink, &k),
+                     INTERP_ERR_CANCELLED);
+    const struct interp_error *e = interp_last_error(in);
+    ck_assert_int_eq(e->line, 4);
+    ck_assert_str_eq(e->message, "stopped by the operator while reading the program");
+    ck_assert_int_eq(count_type(&k.prog, CANON_TRAVERSE), 2);  /* X1 and X2 only */
+    canon_prog_free(&k.prog);
+    /* the flag cleared, the same interpreter runs the program to its end */
+    k.flag = 0;
+    k.at = -1;
+    canon_prog_init(&k.prog);
+    ck_assert_int_eq(interp_run_text(in, "c.ngc", prog, strlen(prog), cancel_sink, &k), 0);
+    ck_assert_int_eq(count_type(&k.prog, CANON_TRAVERSE), 4);
+    canon_prog_free(&k.prog);
+    interp_destroy(in);
+}
+END_TEST
+
 START_TEST(lexer_block_delete)
 {
     const char *prog = "G0 X1\n/G0 X2\n  / G0 X3\nM2\n";
@@ -356,6 +399,7 @@ static Suite *interp_suite(void)
     tcase_add_test(tc, lexer_comments_n_percent);
     tcase_add_test(tc, lexer_utf8_bom);
     tcase_add_test(tc, g64_q_is_stored);
+    tcase_add_test(tc, cancel_flag_stops_before_the_next_line);
     tcase_add_test(tc, lexer_block_delete);
     tcase_add_test(tc, expr_precedence);
     tcase_add_test(tc, expr_functions);

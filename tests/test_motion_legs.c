@@ -254,6 +254,26 @@ START_TEST(test_long_helix_out_of_reach_between_knots)
 }
 END_TEST
 
+/* The cancel flag (Ctrl-C) stops planning at once: the 20000-turn helix, 2.5 million
+ * samples, is dropped with MOTION_ERR_CANCELLED and the file:line; nothing stays loaded. */
+START_TEST(test_cancel_stops_planning)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    volatile sig_atomic_t stop = 1;
+    motion_set_cancel(mc.m, &stop);
+    const double start[6] = {10, 0, 640, 0, 0, 0};
+    char err[512] = "";
+    ck_assert_int_eq(load_helix(&mc, start, 10, 20000, err, sizeof err), MOTION_ERR_CANCELLED);
+    ck_assert_str_eq(err, "helix.ngc:3: planning stopped by the operator");
+    struct motion_plan_info info;
+    ck_assert_int_ne(motion_plan_info(mc.m, &info), MOTION_OK);
+    stop = 0;
+    ck_assert_int_eq(load_helix(&mc, start, 10, 2, err, sizeof err), MOTION_OK);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *legs_suite(void)
 {
     Suite *s = suite_create("motion_legs");
@@ -264,6 +284,7 @@ static Suite *legs_suite(void)
     tcase_add_test(tc, test_kinematic_deviation_helix);
     tcase_add_test(tc, test_long_helix_is_reachable);
     tcase_add_test(tc, test_long_helix_out_of_reach_between_knots);
+    tcase_add_test(tc, test_cancel_stops_planning);
     suite_add_tcase(s, tc);
     return s;
 }

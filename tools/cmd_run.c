@@ -184,12 +184,17 @@ static void run_on_message(void *ctx, const struct hal_msg *m)
 static int run_machine(struct runner *r, const char *program, int quiet)
 {
     char err[1024];
-    if (!quiet)
+    if (!quiet) {
         printf("program %s\n", program);
-    if (runner_load_program(r, program, err, sizeof err) != RUNNER_OK) {
-        fprintf(stderr, "hexcnc run: %s\nhexcnc run: the program was not started; "
-                "the machine did not move\n", err);
-        return RUN_EXIT_REFUSED;
+        fflush(stdout);  /* shown before a long load, also when stdout is a file */
+    }
+    runner_set_cancel(r, &run_stop_requested);  /* Ctrl-C while reading or planning */
+    int st = runner_load_program(r, program, err, sizeof err);
+    if (st != RUNNER_OK) {
+        fprintf(stderr, "hexcnc run: %s%s\nhexcnc run: the program was not started; "
+                "the machine did not move\n", st == RUNNER_ERR_ABORTED ? "interrupted: " : "",
+                err);
+        return st == RUNNER_ERR_ABORTED ? RUN_EXIT_INTERRUPT : RUN_EXIT_REFUSED;
     }
     if (!quiet)
         run_print_plan(r);
@@ -207,7 +212,7 @@ static int run_machine(struct runner *r, const char *program, int quiet)
         fprintf(stderr, "hexcnc run: %s\n", err);
         return RUN_EXIT_REFUSED;
     }
-    int st = runner_run(r, &run_stop_requested, run_progress, &d, err, sizeof err);
+    st = runner_run(r, &run_stop_requested, run_progress, &d, err, sizeof err);
     double wall_s = run_wall_s() - t0;
     if (d.shown)
         printf("\n");
