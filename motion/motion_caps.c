@@ -269,6 +269,7 @@ static void machine_caps(const struct motion *m, const struct motion_seg *sg,
     }
 }
 
+/* The cancel flag's check; on a stop request err names the move being planned. */
 bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,
                       size_t errlen)
 {
