@@ -162,8 +162,10 @@ const struct config_key config_keys[] = {
     { "HAL", "POSTGUI_HALFILE", PATH, "", "", 0, IGN, "", "LinuxCNC GUIs' HAL file" },
     { "TASK", "HALFILE", PATH, "", "", 0, REP, "", "HAL file `hexcnc run` runs after [HAL]'s "
       "(its task.* pins)" },
-    { "TASK", "PROGRESS_INTERVAL", INT, "s", ">= 0", 0, 0, "5", "machine time between "
-      "progress lines when the output is not a terminal (0: none)" },
+    { "TASK", "PROGRESS_INTERVAL", INT, "s", "> 0", 0, 0, "5", "longest machine time "
+      "between progress lines (they also come at every 10 % and every wall second)" },
+    { "TASK", "MAX_PROGRAM_MB", INT, "MB", "> 0", 0, 0, "64", "largest program file "
+      "`hexcnc run` loads (10^6 bytes); a larger one is refused before it is read" },
     { "TASK", "TASK", STR, "", "", 0, IGN, "", "LinuxCNC's task program" },
     { "TASK", "CYCLE_TIME", NUM, "s", "", 0, IGN, "", "LinuxCNC's task period" },
     { "DISPLAY", "OPEN_FILE", PATH, "", "", 0, 0, "", "program `hexcnc run` runs when none "

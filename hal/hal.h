@@ -144,7 +144,7 @@ int hal_export_functf(struct hal *h, hal_funct_fn fn, void *arg, const char *fmt
  * stay 0 (a measured CPU time would make runs differ). */
 int hal_thread_new(struct hal *h, const char *name, long period_ns);
 /* `addf funct thread [position]`: position 1-based, negative from the end, 0 = append. */
-int hal_addf(struct hal *h, const char *funct, const char *thread, int position);
+int hal_addf(struct hal *h, const char *funct, const char *thread, long position);
 
 /* Time: the simulated clock (default off) runs every thread in exact simulated time, as
  * fast as the CPU allows, deterministically; tests and offline checks use it. */

@@ -177,7 +177,7 @@ static int hal_cmd_graph(struct hal *h, int n, char **w)
         v = 0;
         if (n == 4 && hal_word_long(h, "addf", "position", w[3], &v) != HAL_OK)
             return HAL_ERR_SYNTAX;
-        return hal_addf(h, w[1], w[2], (int)v);
+        return hal_addf(h, w[1], w[2], v);
     }
     if (!strcmp(c, "delf"))
         return n < 2 || n > 3 ? hal_error(h, HAL_ERR_SYNTAX, "delf: needs a function name")

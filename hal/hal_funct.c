@@ -124,7 +124,7 @@ void hal_threads_free(struct hal *h)
 }
 
 /* `addf FUNCT THREAD [POSITION]`: 1-based position, negative from the end, 0 appends. */
-int hal_addf(struct hal *h, const char *funct, const char *thread, int position)
+int hal_addf(struct hal *h, const char *funct, const char *thread, long position)
 {
     struct hal_funct *f = hal_map_get(&h->functs, funct);
     struct hal_thread *t = hal_map_get(&h->threads, thread);
@@ -135,10 +135,11 @@ int hal_addf(struct hal *h, const char *funct, const char *thread, int position)
     if (f->thread)
         return hal_error(h, HAL_ERR_EXISTS, "addf: function '%s' is already on thread '%s'",
                          funct, f->thread->name);
-    int idx = position > 0 ? position - 1 : t->nfuncts + position + (position < 0);
-    if (idx < 0 || idx > t->nfuncts)
-        return hal_error(h, HAL_ERR_ARG, "addf: position %d is outside thread '%s', which "
+    /* The range is checked on the long the command gave: no wrap onto a valid position. */
+    if (position > (long)t->nfuncts + 1 || position < -((long)t->nfuncts + 1))
+        return hal_error(h, HAL_ERR_ARG, "addf: position %ld is outside thread '%s', which "
                          "has %d functions", position, thread, t->nfuncts);
+    int idx = position > 0 ? (int)position - 1 : t->nfuncts + (int)position + (position < 0);
     if (t->nfuncts == t->cap) {
         int cap = t->cap ? t->cap * 2 : 8;
         struct hal_funct **v = realloc(t->functs, (size_t)cap * sizeof *v);

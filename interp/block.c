@@ -170,7 +170,7 @@ static int word_used(const struct interp *in, char w)
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 ||
                      (cycle && (m == 820 || m == 890));
-    case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100;
+    case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640;
     case 'l': return cycle || g0 == 100;
     case 'h': return b->g[8] == 430;
     case 'd': case 'w': return comp;
@@ -188,7 +188,7 @@ static int check_unused(struct interp *in)
         "I, J and K are arc centre words: use them with G2 or G3",
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
         "P is used by G4 (dwell), G10, G64, G2/G3 (turns) and G82/G89 (dwell)",
-        "Q is used by the peck cycles G73 and G83",
+        "Q is used by the peck cycles G73 and G83, G10 and G64",
         "L is used by G10 and canned cycles (repeats)",
         "H is used by G43 (tool length offset)",
         "D (tool for the radius) is only used with G141/G142",

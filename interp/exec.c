@@ -178,6 +178,10 @@ static int exec_modes(struct interp *in)
         if (in->path_tol_mm < 0)
             return interp_fail(in, INTERP_ERR_WORD, W('p'), "G64 P (blend tolerance) must not "
                                "be negative");
+        in->naive_cam_tol_mm = b->g[13] == 640 && W('q') ? interp_len_mm(in, V('q')) : 0.0;
+        if (in->naive_cam_tol_mm < 0)
+            return interp_fail(in, INTERP_ERR_WORD, W('q'), "G64 Q (naive CAM tolerance) must "
+                               "not be negative");
         CHP(emit_simple(in, CANON_PATH_MODE, b->g[13] == 640 ? in->path_tol_mm : 0.0,
                         b->g[13]));
     }
@@ -263,8 +267,8 @@ static int exec_motion(struct interp *in)
     int axis = W('x') || W('y') || W('z') || W('a') || W('b') || W('c');
     double t[6];
     if (m == 0 || m == 10) {
-        if (!axis)
-            return 0;
+        if (!axis && b->g[1] < 0)
+            return 0;  /* a G0/G1 word without axis words is a move where the tool is (rs274) */
         if (m == 10)
             CHP(interp_need_feed(in, "G1"));
         interp_target(in, g0 == 530, t);
@@ -321,6 +325,16 @@ static int block_empty(const struct interp_block *b)
     return b->nassign == 0;
 }
 
+/* After a tool change, rs274 takes the position it last commanded as the current one, in
+ * the coordinates of that command: a tool length offset changed in the M6 block itself (`T1
+ * M6 G43 H1`, as CAM posts write it) then does not shift the current point, and the next
+ * move without Z keeps the commanded Z. The same here, so that programs run as in LinuxCNC. */
+static void tool_change_reread(struct interp *in, const double tool_before[6])
+{
+    for (int i = 0; i < 6; i++)
+        in->pos[i] += in->tool[i] - tool_before[i];
+}
+
 /* Runs the block read last: checks, #settings, then LinuxCNC's order of execution. */
 int interp_execute(struct interp *in)
 {
@@ -342,6 +356,8 @@ int interp_execute(struct interp *in)
         c.text = b->comment;
         CHP(interp_emit(in, &c));
     }
+    double tool_before[6], pos_before[6];
+    memcpy(tool_before, in->tool, sizeof tool_before);
     CHP(exec_machine_words(in));
     CHP(exec_modes(in));
     if (g0 == 100)
@@ -354,8 +370,12 @@ int interp_execute(struct interp *in)
         in->motion = b->g[1]; /* G1 beside G141/G142 is modal as usual */
     if (comp)
         CHP(exec_comp5(in, g0));
-    else
+    else {
+        memcpy(pos_before, in->pos, sizeof pos_before);
         CHP(exec_motion(in));
+        if (b->m[6] == 6 && !memcmp(pos_before, in->pos, sizeof pos_before))
+            tool_change_reread(in, tool_before);
+    }
     CHP(exec_stop(in));
     /* Only these blocks can change a persistent parameter: #n=, G10/G28.1/G30.1/G92.x
      * (group 0), G54..G59.3 (group 12), M2/M30 (back to G54, reported above). */

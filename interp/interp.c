@@ -25,6 +25,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_COMP5] = "G141/G142 compensation error",
     [INTERP_ERR_SINK] = "stopped by the command consumer",
     [INTERP_ERR_CONFIG] = "bad interpreter setting in the INI file",
+    [INTERP_ERR_CANCELLED] = "stopped by the operator",
 };
 
 /* The fixed text of a status (the message of a run is in struct interp_error). */
@@ -157,6 +158,12 @@ void interp_set_block_delete(struct interp *in, int on)
     in->block_delete = on != 0;
 }
 
+/* The operator's stop request, checked before every line. */
+void interp_set_cancel(struct interp *in, const volatile sig_atomic_t *flag)
+{
+    in->cancel = flag;
+}
+
 /* FEED_UNITS text to the F multiplier (any case, as every enum key of docs/ini.md). */
 int interp_feed_units_parse(const char *name, double *factor)
 {
@@ -186,6 +193,9 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
     v->feed_factor = in->feed_factor;
     v->current_tool = in->current_tool;
+    v->path_mode = in->path_mode;
+    v->path_tol_mm = in->path_tol_mm;
+    v->naive_cam_tol_mm = in->naive_cam_tol_mm;
 }
 
 /* Reads numbered parameter #n. */
@@ -226,10 +236,15 @@ static int run_lines(struct interp *in, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
     int first = 1;
+    if (len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3))
+        p += 3;  /* a UTF-8 byte order mark, as editors on Windows write: not part of line 1 */
     while (p < end && !in->ended) {
         const char *nl = memchr(p, '\n', (size_t)(end - p));
         size_t l = nl ? (size_t)(nl - p) : (size_t)(end - p);
         in->line++;
+        if (in->cancel && *in->cancel)
+            return interp_fail(in, INTERP_ERR_CANCELLED, 0, "stopped by the operator while "
+                               "reading the program");
         in->depth = 0;
         int kind;
         CHP(interp_read_line(in, p, l, &kind));

@@ -2,6 +2,7 @@
 #ifndef HEXCNC_INTERP_H
 #define HEXCNC_INTERP_H
 
+#include <signal.h>
 #include <stddef.h>
 
 #include "interp/canon.h"
@@ -26,6 +27,7 @@ enum interp_status {
     INTERP_ERR_COMP5,         /* G141/G142 compensation refused the path */
     INTERP_ERR_SINK,          /* the canon sink asked to stop */
     INTERP_ERR_CONFIG,        /* a bad interpreter setting in the machine's INI file */
+    INTERP_ERR_CANCELLED,     /* the cancel flag was set (Ctrl-C) while the program was read */
     INTERP_STATUS_COUNT
 };
 const char *interp_strerror(int status);
@@ -62,6 +64,10 @@ void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit);
 /* Block delete switch: 1 skips lines that start with '/'; 0 (the default, as rs274) runs
  * them. */
 void interp_set_block_delete(struct interp *in, int on);
+/* A flag (set by the caller's SIGINT handler; NULL: none) that the line loop checks before
+ * every line: once it is non-zero the run stops with INTERP_ERR_CANCELLED at that line.
+ * Not owned; it must outlive the runs. */
+void interp_set_cancel(struct interp *in, const volatile sig_atomic_t *flag);
 /* Parses an [RS274NGC] FEED_UNITS value ("mm/min" or "m/min"); -1 if unknown, else 0. */
 int interp_feed_units_parse(const char *name, double *factor);
 
@@ -101,6 +107,9 @@ struct interp_view {
     double tool_mm[6];        /* tool length offset (Z only for G43 H) */
     double feed_factor;       /* see interp_set_feed_factor */
     int current_tool;         /* tool in the spindle */
+    int path_mode;            /* 610 (G61), 611 (G61.1) or 640 (G64) */
+    double path_tol_mm;       /* G64 P: blend tolerance, mm (0: none given) */
+    double naive_cam_tol_mm;  /* G64 Q: naive CAM tolerance, mm (0: none given) */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */

@@ -70,6 +70,7 @@ struct interp {
     struct tooltable *tt;        /* tool table or NULL (not owned) */
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
+    const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
 
     /* where we are in the program */
     char file[256];
@@ -100,6 +101,8 @@ struct interp {
     int retract_old_z;           /* G98 */
     int path_mode;               /* 610, 611 or 640 */
     double path_tol_mm;          /* G64 P */
+    double naive_cam_tol_mm;     /* G64 Q: LinuxCNC's "naive CAM detector" tolerance; stored
+                                  * and reported, not used by the planner (docs/gcode.md) */
     double g5x[6];               /* active work offset, mm/deg */
     double g92[6];               /* active G92 offset */
     double tool[6];              /* active tool length offset */

@@ -54,6 +54,9 @@ static int normalise(struct interp *in, const char *raw, size_t len, size_t i, i
         }
         if (c == ';')
             break;
+        if (c == '\0')
+            return interp_fail(in, INTERP_ERR_SYNTAX, (int)i + 1, "a NUL byte: the file holds "
+                               "binary data here, not G-code text");
         if (n >= INTERP_LINE_MAX - 1)
             return interp_fail(in, INTERP_ERR_SYNTAX, (int)i + 1,
                                "line too long (more than %d characters)", INTERP_LINE_MAX - 1);
@@ -127,6 +130,9 @@ static int read_word(struct interp *in, int *pos)
     if (c == 'u' || c == 'v')
         return interp_fail(in, INTERP_ERR_WORD, col,
                            "this machine has no %c axis (axes are X Y Z A B C)", c - 32);
+    if ((c < ' ' || c > '~') && c != 0)  /* control or non-ASCII byte: shown as a code */
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "byte 0x%02X is not G-code text (G-code "
+                           "is ASCII)", (unsigned)(unsigned char)c);
     if (c == 'e' || (c < 'a' || c > 'z'))
         return interp_fail(in, INTERP_ERR_SYNTAX, col,
                            c >= '0' && c <= '9' ? "a number without a word letter before it"

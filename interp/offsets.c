@@ -45,9 +45,9 @@ static int g10_coord(struct interp *in, int l, int p)
     if (p < 0 || p > 9)
         return interp_fail(in, INTERP_ERR_WORD, W('p'), "G10 L%d P%d: P selects the coordinate "
                            "system, 1 (G54) to 9 (G59.3), or 0 for the active one", l, p);
-    if (W('r'))
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('r'), "G10 L%d R (rotation of the "
-                           "coordinate system) is not supported yet", l);
+    if (W('r') && V('r') != 0.0)  /* R0: no rotation, as CAM posts write it */
+        return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('r'), "G10 L%d R%g (rotation of the "
+                           "coordinate system) is not supported yet (only R0)", l, V('r'));
     int sys = p == 0 ? in->coord_system : p, base = PARAM_G54 + 20 * (sys - 1);
     for (int i = 0; i < 6; i++) {
         if (!W(axis_letter[i]))

@@ -139,6 +139,12 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     return MOTION_OK;
 }
 
+/* The operator's stop request while planning. */
+void motion_set_cancel(struct motion *m, const volatile sig_atomic_t *flag)
+{
+    m->cancel = flag;
+}
+
 /* Starts the loaded program. */
 int motion_start(struct motion *m)
 {

@@ -2,6 +2,7 @@
 #ifndef HEXCNC_MOTION_H
 #define HEXCNC_MOTION_H
 
+#include <signal.h>
 #include <stddef.h>
 
 #include "interp/canon.h"
@@ -34,6 +35,7 @@ enum motion_status {
     MOTION_ERR_KINS,         /* the kinematics failed otherwise (singular, ...) */
     MOTION_ERR_FERROR,       /* following error beyond its limit: fault */
     MOTION_ERR_ESTOP,        /* emergency stop: fault */
+    MOTION_ERR_CANCELLED,    /* the cancel flag was set (Ctrl-C) while planning */
     MOTION_STATUS_COUNT
 };
 const char *motion_strerror(int status);
@@ -105,6 +107,10 @@ void motion_destroy(struct motion *m);
  * DONE and FAULT (clears the fault); the pose jumps to prog->start. On failure the message
  * names file:line and what is wrong; the previous program is dropped. */
 int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size_t errlen);
+/* A flag (set by the caller's SIGINT handler; NULL: none) that motion_load checks as it goes
+ * (every command and every knot): once it is non-zero planning stops with
+ * MOTION_ERR_CANCELLED and nothing is loaded. Not owned. */
+void motion_set_cancel(struct motion *m, const volatile sig_atomic_t *flag);
 /* Starts the loaded program (IDLE with a program -> RUNNING). */
 int motion_start(struct motion *m);
 

@@ -269,13 +269,48 @@ static void machine_caps(const struct motion *m, const struct motion_seg *sg,
     }
 }
 
+/* The cancel flag's check; on a stop request err names the move being planned. */
+bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,
+                      size_t errlen)
+{
+    if (!m->cancel || !*m->cancel)
+        return false;
+    snprintf(err, errlen, "%s:%d: planning stopped by the operator", file ? file : "program",
+             line);
+    return true;
+}
+
+/* Knots of a very long move (a helix of many turns) lie further apart (hs) than the checks
+ * are made for (sg->fine_h): the error terms grow with the square of the spacing and once
+ * refused a 20000-turn helix with a leg "1231.725 mm long". The interval from s to the next
+ * knot is then sampled at no more than fine_h: every sample is checked for reach and
+ * lowers the knot's leg caps, each with the error term of the fine spacing. */
+static int between_knots(struct motion *m, const struct motion_seg *sg, double s, double hs,
+                         double *vl, double *am, char *err, size_t errlen)
+{
+    double n = ceil(hs / sg->fine_h), h = hs / n;
+    for (double j = 1; j < n && s + j * h < sg->len; j++) {
+        struct motion_sample T;
+        double v = HUGE_VAL;
+        if (motion_cancelled(m, sg->file, sg->line, err, errlen))
+            return MOTION_ERR_CANCELLED;
+        int st = reach_check(m, sg, &T, h, sample_at(m, sg, s + j * h, &T), err, errlen);
+        if (st)
+            return st;
+        leg_caps(m, &T, h, &v, am);
+        *vl = fmin(*vl, v);
+    }
+    return MOTION_OK;
+}
+
 /* Speed caps of one knot: hard (machine, legs, kinematic error) into *hard, with the feed
  * into *cap, and the path acceleration limit into *acc. */
 int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
                      struct motion_sample *S, double *hard, double *cap, double *acc, char *err,
                      size_t errlen)
 {
-    int st = reach_check(m, sg, S, hs, sample_at(m, sg, s, S), err, errlen);
+    double h = sg->fine_h > 0 ? fmin(hs, sg->fine_h) : hs;  /* the error terms' spacing */
+    int st = reach_check(m, sg, S, h, sample_at(m, sg, s, S), err, errlen);
     if (st)
         return st;
     double vm, am, vl, kabc = motion_seg_abc_curvature(&m->plan, sg, s);
@@ -289,7 +324,9 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
         if (w > 1e-12)
             am = fmin(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
     }
-    leg_caps(m, S, hs, &vl, &am);
+    leg_caps(m, S, h, &vl, &am);
+    if (h < hs && (st = between_knots(m, sg, s, hs, &vl, &am, err, errlen)))
+        return st;
     double vk = kin_tol_cap(m, sg, S);
     if (vk < 0) {
         snprintf(err, errlen, "%s:%d: the move passes through a singular pose of the machine "

@@ -20,6 +20,7 @@ static const struct { int code; const char *text; } motion_errors[] = {
     {MOTION_ERR_KINS, "the kinematics cannot follow a move"},
     {MOTION_ERR_FERROR, "following error too large"},
     {MOTION_ERR_ESTOP, "emergency stop"},
+    {MOTION_ERR_CANCELLED, "planning stopped by the operator"},
 };
 
 /* Text of a motion status. */

@@ -152,20 +152,29 @@ static struct motion_seg *add_seg(struct motion_plan *p, const struct canon_cmd 
     return sg;
 }
 
-/* Intervals for a move: fine enough for the reachability and limit checks. */
-static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
+/* Intervals a move needs for the reachability and limit checks to hold between samples
+ * (SAMPLE_MM, SAMPLE_DEG, SAMPLE_RAD), at least 1; not capped. */
+static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_rad)
 {
     double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_rad / SAMPLE_RAD);
-    n = ceil(n);
-    return n < 1 ? 1 : n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
+    return fmax(1.0, ceil(n));
 }
 
-/* Spreads the knots of sg evenly over [0, len]. */
-static void place_knots(struct motion_plan *p, struct motion_seg *sg)
+/* Knot intervals for a move: the fine ones, capped at MAX_INTERVALS (the checks then sample
+ * between the knots, motion_caps.c). */
+static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
+{
+    double n = fine_intervals(xyz_mm, abc_max_deg, arc_rad);
+    return n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
+}
+
+/* Spreads the knots of sg evenly over [0, len]; fine_n is what fine_intervals gave. */
+static void place_knots(struct motion_plan *p, struct motion_seg *sg, double fine_n)
 {
     size_t n = sg->nk - 1;
     for (size_t i = 0; i <= n; i++)
         p->ks[sg->k0 + i] = sg->len * (double)i / (double)n;
+    sg->fine_h = sg->len / fine_n;
 }
 
 /* Largest |change| of A B C between two poses, deg. */
@@ -186,7 +195,8 @@ static int add_line(struct motion_plan *p, const struct canon_cmd *c, const doub
     double abc = sqrt(da * da + db * db + dc * dc);
     if (xyz < EPS_LEN && abc < EPS_LEN)
         return 0;              /* no motion: nothing to plan */
-    struct motion_seg *sg = add_seg(p, c, SEG_LINE, intervals_for(xyz, abc_max(from, c->end), 0));
+    double abc_deg = abc_max(from, c->end);
+    struct motion_seg *sg = add_seg(p, c, SEG_LINE, intervals_for(xyz, abc_deg, 0));
     if (!sg)
         return -1;
     memcpy(sg->start, from, sizeof sg->start);
@@ -194,7 +204,7 @@ static int add_line(struct motion_plan *p, const struct canon_cmd *c, const doub
     sg->rotary = xyz < EPS_LEN;
     sg->len = sg->rotary ? abc : xyz;
     sg->xyz_len_mm = sg->rotary ? 0 : xyz;
-    place_knots(p, sg);
+    place_knots(p, sg, fine_intervals(xyz, abc_deg, 0));
     return 0;
 }
 
@@ -264,8 +274,8 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     double rm = a.r0_mm + 0.5 * a.dr_mm;
     double planar = fabs(a.sweep_rad) * rm;
     double xyz = sqrt(planar * planar + a.dh_mm * a.dh_mm + a.dr_mm * a.dr_mm);
-    struct motion_seg *sg = add_seg(p, c, SEG_ARC,
-                                    intervals_for(xyz, abc_max(from, c->end), fabs(a.sweep_rad)));
+    double abc_deg = abc_max(from, c->end);
+    struct motion_seg *sg = add_seg(p, c, SEG_ARC, intervals_for(xyz, abc_deg, fabs(a.sweep_rad)));
     if (!sg)
         return -1;
     p->arcs[p->narc] = a;
@@ -274,7 +284,7 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     memcpy(sg->end, c->end, sizeof sg->end);
     sg->len = xyz;
     sg->xyz_len_mm = xyz;
-    place_knots(p, sg);
+    place_knots(p, sg, fine_intervals(xyz, abc_deg, fabs(a.sweep_rad)));
     return 0;
 }
 
@@ -346,6 +356,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     for (size_t i = 0; i < prog->count; i++) {
         const struct canon_cmd *c = &prog->cmds[i];
         size_t nseg0 = p->nseg;
+        if (motion_cancelled(m, c->file, c->line, err, errlen))
+            return MOTION_ERR_CANCELLED;
         int rc = 0;
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;

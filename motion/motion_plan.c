@@ -61,6 +61,8 @@ static int segment_caps(struct motion *m, const struct motion_seg *sg, double *g
         size_t k = sg->k0 + i;
         double hard = 0, cap = 0, acc = HUGE_VAL;
         zcap[k] = HUGE_VAL;
+        if (motion_cancelled(m, sg->file, sg->line, err, errlen))
+            return MOTION_ERR_CANCELLED;
         if (sg->kind <= SEG_ARC) {
             struct motion_sample S;
             int st = motion_knot_caps(m, sg, p->ks[k], hs, &S, &hard, &cap, &acc, err, errlen);

@@ -2,6 +2,7 @@
 #ifndef HEXCNC_MOTION_PRIV_H
 #define HEXCNC_MOTION_PRIV_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "motion/motion.h"
@@ -40,6 +41,9 @@ struct motion_seg {
     double blend_tol_mm;     /* G64 tolerance in force (blend into the next move), 0 = stop */
     size_t k0;               /* first knot */
     size_t nk;               /* knots (>= 2) */
+    double fine_h;           /* spacing the checks need, mm (deg when rotary); knots are this
+                              * close but on very long moves (MAX_INTERVALS), where the checks
+                              * sample between them at this spacing */
     int arc;                 /* index into arcs for SEG_ARC, else -1 */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
@@ -84,6 +88,7 @@ struct motion {
     enum motion_state state;
     int fault_status;
     char msg[320];           /* last error / fault text */
+    const volatile sig_atomic_t *cancel; /* the operator's stop request while planning, or NULL */
     double start_pose[KINS_POSE_DIM];
     /* planning scratch: the inverse Jacobian dpose/dL near jc_pose, reused while the path
      * stays within 2 mm and 1 deg of it */
@@ -160,6 +165,10 @@ struct motion_sample {
     double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
     double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
 };
+
+/* Whether the operator asked to stop planning; if so err says where (motion_caps.c). */
+bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,
+                      size_t errlen);
 
 /* Sampling and caps (motion_caps.c). Speed caps of the knot at s of sg (knot spacing hs):
  * hard (machine, legs, kinematic error), with the feed (cap), path acceleration (acc); the

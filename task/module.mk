@@ -4,3 +4,4 @@ LIB_SRCS += task/runner.c task/runner_exec.c task/runner_settings.c
 TESTS += test_e2e test_run_faults test_run_settings test_run_startup
 BENCHES += bench_servo
 SCRIPT_TESTS += tests/e2e/run_cli.sh
+SCRIPT_TESTS += tests/e2e/run_large.sh

@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "common/errbuf.h"
 #include "common/inifile.h"
@@ -190,6 +192,55 @@ int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *t
                        : msg);
 }
 
+void runner_set_cancel(struct runner *r, const volatile sig_atomic_t *flag)
+{
+    r->cancel = flag;
+}
+
+/* Memory the system can give now, bytes (MemAvailable; free pages when unknown). */
+static double runner_mem_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    char line[128];
+    double kb = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    if (kb >= 0)
+        return kb * 1024.0;
+    return (double)sysconf(_SC_AVPHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+}
+
+/* Refuses, before reading it, a program too large to hold in memory: larger than [TASK]
+ * MAX_PROGRAM_MB, or needing (RUNNER_BYTES_PER_PROGRAM_BYTE per byte) more memory than the
+ * system has available. A missing file is left to the interpreter's message. */
+static int runner_check_size(struct runner *r, const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    long max_mb = RUNNER_MAX_PROGRAM_MB;
+    if (hal_ini_int(r->hal, "TASK", "MAX_PROGRAM_MB", RUNNER_MAX_PROGRAM_MB, &max_mb) ==
+        HAL_ERR_SYNTAX || max_mb <= 0)
+        return errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "[TASK] MAX_PROGRAM_MB must be a "
+                          "positive whole number of MB");
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+        return RUNNER_OK;
+    double mb = (double)st.st_size / 1e6, need_mb = mb * RUNNER_BYTES_PER_PROGRAM_BYTE;
+    double avail_mb = runner_mem_available() / 1e6;
+    if (mb > (double)max_mb)
+        return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s: the program is %.1f MB "
+                          "(%lld bytes), more than [TASK] MAX_PROGRAM_MB = %ld MB: hexcnc holds "
+                          "a whole program in memory while it plans it (about %.0f MB for this "
+                          "one; %.0f MB available now)", path, mb, (long long)st.st_size, max_mb,
+                          need_mb, avail_mb);
+    if (avail_mb > 0 && need_mb > avail_mb)
+        return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s: the program is %.1f MB "
+                          "(%lld bytes): planning it needs about %.0f MB of memory, only %.0f MB "
+                          "are available", path, mb, (long long)st.st_size, need_mb, avail_mb);
+    return RUNNER_OK;
+}
+
 /* Interprets the whole program into prog, starting from the machine's present pose. */
 static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
                             char *err, size_t errlen)
@@ -209,10 +260,12 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     memcpy(prog->start, start, sizeof start);
     if ((st = runner_setup_interp(r, in, tt, err, errlen)))
         goto out;
+    interp_set_cancel(in, r->cancel);
     if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {
         char msg[600];
-        st = errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s",
-                         interp_error_format(interp_last_error(in), msg, sizeof msg));
+        const struct interp_error *e = interp_last_error(in);
+        st = errbuf_set(err, errlen, e->status == INTERP_ERR_CANCELLED ? RUNNER_ERR_ABORTED
+                        : RUNNER_ERR_PROGRAM, "%s", interp_error_format(e, msg, sizeof msg));
         goto out;
     }
     st = RUNNER_OK;
@@ -231,13 +284,19 @@ int runner_load_program(struct runner *r, const char *path, char *err, size_t er
     struct canon_prog prog;
     canon_prog_init(&prog);
     r->loaded = false;
-    int st = runner_interpret(r, path, &prog, err, errlen);
+    int st = runner_check_size(r, path, err, errlen);
+    if (st == RUNNER_OK)
+        st = runner_interpret(r, path, &prog, err, errlen);
     if (st == RUNNER_OK)
         st = runner_settings_load(r, &prog, err, errlen);
     if (st == RUNNER_OK) {
         char msg[512];
-        if (motion_hal_load(r->hal, &prog, msg, sizeof msg) != MOTION_OK)
-            st = errbuf_set(err, errlen, RUNNER_ERR_PLAN, "%s", msg);
+        motion_set_cancel(r->motion, r->cancel);
+        int ms = motion_hal_load(r->hal, &prog, msg, sizeof msg);
+        motion_set_cancel(r->motion, NULL);
+        if (ms != MOTION_OK)
+            st = errbuf_set(err, errlen, ms == MOTION_ERR_CANCELLED ? RUNNER_ERR_ABORTED
+                            : RUNNER_ERR_PLAN, "%s", msg);
         else if (motion_plan_info(r->motion, &r->plan) != MOTION_OK)
             st = errbuf_set(err, errlen, RUNNER_ERR_PLAN, "%s", motion_hal_fault(r->hal));
     }

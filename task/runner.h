@@ -117,6 +117,18 @@ const char *runner_default_program(const struct runner *r);
 /* Interprets the whole program (with [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE)
  * and plans it. Nothing moves; on failure err holds "file:line: what". */
 int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen);
+/* The operator's stop request (Ctrl-C) for runner_load_program: a flag the caller's signal
+ * handler sets (NULL: none). The interpreter checks it before every line and the planner at
+ * every command and knot; once set, loading ends with RUNNER_ERR_ABORTED and nothing moves.
+ * Not owned. */
+void runner_set_cancel(struct runner *r, const volatile sig_atomic_t *flag);
+
+/* Programs are held whole in memory until they stream: about this many bytes of memory
+ * per byte of G-code (a 25-byte block becomes a 216-byte command, a 248-byte segment and
+ * at least two knots of 112 bytes while it is planned). */
+#define RUNNER_BYTES_PER_PROGRAM_BYTE 30
+/* [TASK] MAX_PROGRAM_MB when the INI has none: the largest program file loaded, MB. */
+#define RUNNER_MAX_PROGRAM_MB 64
 /* The plan of the loaded program. */
 int runner_plan_info(const struct runner *r, struct motion_plan_info *out);
 

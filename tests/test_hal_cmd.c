@@ -2,8 +2,10 @@
  * tests/hal/errors, word for word, and the commands' effects and output. */
 #include <check.h>
 #include <dlfcn.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "hal/hal.h"
@@ -225,6 +227,60 @@ START_TEST(command_errors)
 }
 END_TEST
 
+/* addf positions beyond an int are refused as such, not wrapped onto a valid position
+ * (4294967297 used to become 1, 4294967296 to become 0: "append"). */
+START_TEST(addf_position_out_of_range)
+{
+    struct hal *h = new_hal();
+    ck_assert_int_eq(hal_cmd(h, "loadrt threads name1=servo period1=1000000", "t.hal", 1, NULL),
+                     HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "loadrt sum2 count=2", "t.hal", 2, NULL), HAL_OK);
+    static const char *const bad[] = { "4294967297", "4294967296", "-4294967296",
+                                       "2147483648", "-2147483648", "9223372036854775807" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char line[80], msg[200];
+        snprintf(line, sizeof line, "addf sum2.0 servo %s", bad[i]);
+        ck_assert_int_eq(hal_cmd(h, line, "t.hal", 3, NULL), HAL_ERR_ARG);
+        snprintf(msg, sizeof msg, "t.hal:3: addf: position %s is outside thread 'servo', "
+                 "which has 0 functions", bad[i]);
+        ck_assert_str_eq(hal_last_error(h), msg);
+    }
+    /* nothing was added: the function is still free and goes first */
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.0 servo 1", "t.hal", 4, NULL), HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.1 servo -1", "t.hal", 5, NULL), HAL_OK);
+    ck_assert_int_eq(hal_cmd(h, "addf sum2.0 servo 3", "t.hal", 6, NULL), HAL_ERR_EXISTS);
+    hal_destroy(h);
+}
+END_TEST
+
+/* streamer file= reads the whole file at load time: a FIFO without a writer, /dev/zero or a
+ * folder is refused at once with what it is, instead of holding start-up forever. */
+START_TEST(streamer_refuses_files_that_never_end)
+{
+    struct hal *h = new_hal();
+    char dir[] = "/tmp/hexcnc-streamer.XXXXXX", fifo[64], line[128];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(fifo, sizeof fifo, "%s/fifo", dir);
+    ck_assert_int_eq(mkfifo(fifo, 0600), 0);
+    static const struct { const char *file, *kind; } cases[] = {
+        { "/dev/zero", "a character device" }, { NULL, "a FIFO" }, { "/tmp", "a folder" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *file = cases[i].file ? cases[i].file : fifo;
+        char msg[300];
+        snprintf(line, sizeof line, "loadrt streamer cfg=f file=%s", file);
+        ck_assert_int_eq(hal_cmd(h, line, "t.hal", 7, NULL), HAL_ERR_IO);
+        snprintf(msg, sizeof msg, "t.hal:7: streamer: '%s' is %s, not a regular file: file= "
+                 "is read whole when the streamer is loaded", file, cases[i].kind);
+        ck_assert_str_eq(hal_last_error(h), msg);
+        ck_assert_ptr_null(hal_data_ptr(h, "streamer.0.pin.0", NULL));
+    }
+    unlink(fifo);
+    rmdir(dir);
+    hal_destroy(h);
+}
+END_TEST
+
 START_TEST(kinematics_by_name_becomes_the_kins_component)
 {
     void *dl = NULL;
@@ -291,6 +347,8 @@ static Suite *hal_cmd_suite(void)
     tcase_add_test(tc, commands_comments_quotes_and_output);
     tcase_add_test(tc, start_runs_the_simulated_clock_and_show_lists);
     tcase_add_test(tc, command_errors);
+    tcase_add_test(tc, addf_position_out_of_range);
+    tcase_add_test(tc, streamer_refuses_files_that_never_end);
     tcase_add_test(tc, kinematics_by_name_becomes_the_kins_component);
     tcase_add_test(tc, kinematics_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);

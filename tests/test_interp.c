@@ -61,6 +61,104 @@ START_TEST(lexer_comments_n_percent)
 }
 END_TEST
 
+/* A UTF-8 byte order mark before line 1 is skipped: the same moves, columns counted after
+ * it; a BOM anywhere else is an error that names the byte. */
+START_TEST(lexer_utf8_bom)
+{
+    static const char plain[] = "G21 G90\nG0 X1 Y2 Z3\nG1 X4 F100\nM2\n";
+    char bom[sizeof plain + 3] = "\xEF\xBB\xBF";
+    memcpy(bom + 3, plain, sizeof plain);
+    struct canon_prog p, q;
+    ck_assert_int_eq(run_text(plain, &p, NULL), 0);
+    ck_assert_int_eq(run_text(bom, &q, NULL), 0);
+    ck_assert_uint_eq(p.count, q.count);
+    ck_assert_pose(nth(&q, CANON_TRAVERSE, 0)->end, 1, 2, 3, 0, 0, 0, 1e-12);
+    ck_assert_pose(nth(&q, CANON_FEED, 0)->end, 4, 2, 3, 0, 0, 0, 1e-12);
+    ck_assert_int_eq(nth(&q, CANON_FEED, 0)->line, 3);
+    canon_prog_free(&p);
+    canon_prog_free(&q);
+    struct interp_error e;
+    ck_assert_int_ne(run_text("\xEF\xBB\xBFG21 Q1\nM2\n", &p, &e), 0);
+    ck_assert_int_eq(e.line, 1);
+    ck_assert_int_eq(e.column, 5);  /* Q is the fifth character after the mark */
+    canon_prog_free(&p);
+    ck_assert_int_ne(run_text("G21\n\xEF\xBB\xBFG0 X1\nM2\n", &p, &e), 0);
+    ck_assert_int_eq(e.line, 2);
+    ck_assert_int_eq(e.column, 1);
+    ck_assert_str_eq(e.message, "byte 0xEF is not G-code text (G-code is ASCII)");
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* G64 Q (LinuxCNC's naive CAM tolerance, written by Fusion 360's post) is accepted and kept
+ * beside P; a G64 without Q, or G61, clears it. */
+START_TEST(g64_q_is_stored)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    struct canon_prog p;
+    struct interp_view v;
+    ck_assert_int_eq(run_on(in, "G21 G64 P0.02 Q0.005\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_int_eq(v.path_mode, 640);
+    ck_assert_double_eq_tol(v.path_tol_mm, 0.02, 1e-15);
+    ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.005, 1e-15);
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G20 G64 P0.001 Q0.0005\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.0127, 1e-12);  /* inch to mm */
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G21 G64 P0.02\nM2\n", &p), 0);
+    interp_get_view(in, &v);
+    ck_assert_double_eq(v.naive_cam_tol_mm, 0.0);
+    canon_prog_free(&p);
+    interp_destroy(in);
+}
+END_TEST
+
+/* A sink that stands for Ctrl-C: it sets the cancel flag when the command of line `at`
+ * arrives, as a signal handler would between two lines. */
+struct cancel_at {
+    volatile sig_atomic_t flag;
+    int at;
+    struct canon_prog prog;
+};
+static int cancel_sink(void *ctx, const struct canon_cmd *c)
+{
+    struct cancel_at *k = ctx;
+    if (c->line == k->at)
+        k->flag = 1;
+    return canon_prog_sink(&k->prog, c);
+}
+
+/* The cancel flag stops the line loop before the next line: nothing of it or after it is
+ * emitted, and the error says where and why. */
+START_TEST(cancel_flag_stops_before_the_next_line)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    struct cancel_at k = { .flag = 0, .at = 3 };
+    canon_prog_init(&k.prog);
+    interp_set_cancel(in, &k.flag);
+    static const char prog[] = "G21 G90\nG0 X1\nG0 X2\nG0 X3\nG0 X4\nM2\n";
+    ck_assert_int_eq(interp_run_text(in, "c.ngc", prog, strlen(prog), cancel_sink, &k),
+                     INTERP_ERR_CANCELLED);
+    const struct interp_error *e = interp_last_error(in);
+    ck_assert_int_eq(e->line, 4);
+    ck_assert_str_eq(e->message, "stopped by the operator while reading the program");
+    ck_assert_int_eq(count_type(&k.prog, CANON_TRAVERSE), 2);  /* X1 and X2 only */
+    canon_prog_free(&k.prog);
+    /* the flag cleared, the same interpreter runs the program to its end */
+    k.flag = 0;
+    k.at = -1;
+    canon_prog_init(&k.prog);
+    ck_assert_int_eq(interp_run_text(in, "c.ngc", prog, strlen(prog), cancel_sink, &k), 0);
+    ck_assert_int_eq(count_type(&k.prog, CANON_TRAVERSE), 4);
+    canon_prog_free(&k.prog);
+    interp_destroy(in);
+}
+END_TEST
+
 START_TEST(lexer_block_delete)
 {
     const char *prog = "G0 X1\n/G0 X2\n  / G0 X3\nM2\n";
@@ -369,6 +467,9 @@ static Suite *interp_suite(void)
     TCase *tc = tcase_create("core");
     tcase_add_test(tc, lexer_case_spaces_numbers);
     tcase_add_test(tc, lexer_comments_n_percent);
+    tcase_add_test(tc, lexer_utf8_bom);
+    tcase_add_test(tc, g64_q_is_stored);
+    tcase_add_test(tc, cancel_flag_stops_before_the_next_line);
     tcase_add_test(tc, lexer_block_delete);
     tcase_add_test(tc, expr_precedence);
     tcase_add_test(tc, expr_functions);

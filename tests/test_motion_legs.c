@@ -186,6 +186,94 @@ START_TEST(test_kinematic_deviation_helix)
 }
 END_TEST
 
+/* Plans a helix of `turns` turns about a centre `r_mm` to -X of start (XY plane, 1 mm of Z
+ * over all turns); returns motion_load's status with its message in err. */
+static int load_helix(struct tm_machine *mc, const double *start, double r_mm, int turns,
+                      char *err, size_t errlen)
+{
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, start, 6 * sizeof *start);
+    struct canon_cmd c;
+    memset(&c, 0, sizeof c);
+    c.type = CANON_ARC;
+    c.line = 3;
+    c.file = "helix.ngc";
+    memcpy(c.end, start, sizeof c.end);
+    c.end[2] -= 1.0;
+    c.arc.center[0] = start[0] - r_mm;
+    c.arc.center[1] = start[1];
+    c.arc.center[2] = start[2];
+    c.arc.normal[2] = 1;
+    c.arc.rotation = -turns;   /* G2 ... P<turns> */
+    c.feed_mm_min = 1000;
+    ck_assert_int_eq(canon_prog_sink(&p, &c), 0);
+    int st = motion_load(mc->m, &p, err, errlen);
+    canon_prog_free(&p);
+    return st;
+}
+
+/* A helix of 20000 turns (G2 I-10 P20000, 1257 m of path) is within reach all along: it is
+ * planned, not refused with an impossible leg length. Its knots are capped (4000 per move),
+ * so they lie 314 mm apart; the reach check's error term used that spacing and refused the
+ * move with leg 1 "1231.725 mm long". */
+START_TEST(test_long_helix_is_reachable)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    const double start[6] = {10, 0, 640, 0, 0, 0};
+    char err[512] = "";
+    ck_assert_msg(load_helix(&mc, start, 10, 20000, err, sizeof err) == MOTION_OK, "%s", err);
+    struct motion_plan_info info;
+    ck_assert_int_eq(motion_plan_info(mc.m, &info), MOTION_OK);
+    ck_assert_double_eq_tol(info.length_mm, 20000 * 2 * M_PI * 10, 1.0);
+    tm_close(&mc);
+}
+END_TEST
+
+/* The other way round: 4000 turns in 4000 intervals put every knot on the same side of the
+ * circle, near X-400 where every leg is in range; the far side (X-500) is out of reach.
+ * The samples between the knots find it, with a true leg length. */
+START_TEST(test_long_helix_out_of_reach_between_knots)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    const double start[6] = {-400, 0, 640, 0, 0, 0};
+    double L[6];
+    ck_assert_int_eq(kins_inverse(mc.kins, start, L), KINS_OK);
+    char err[512] = "";
+    ck_assert_int_eq(load_helix(&mc, start, 50, 4000, err, sizeof err), MOTION_ERR_UNREACHABLE);
+    ck_assert_msg(strstr(err, "helix.ngc:3: the move leaves the machine's reach: leg ") != NULL,
+                  "%s", err);
+    double len = 0;
+    const char *at = strstr(err, "would be ");
+    ck_assert_ptr_nonnull(at);
+    ck_assert_int_eq(sscanf(at, "would be %lf", &len), 1);
+    ck_assert_msg(len > 980 && len < 1000, "a leg length the machine could have: %s", err);
+    tm_close(&mc);
+}
+END_TEST
+
+/* The cancel flag (Ctrl-C) stops planning at once: the 20000-turn helix, 2.5 million
+ * samples, is dropped with MOTION_ERR_CANCELLED and the file:line; nothing stays loaded. */
+START_TEST(test_cancel_stops_planning)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    volatile sig_atomic_t stop = 1;
+    motion_set_cancel(mc.m, &stop);
+    const double start[6] = {10, 0, 640, 0, 0, 0};
+    char err[512] = "";
+    ck_assert_int_eq(load_helix(&mc, start, 10, 20000, err, sizeof err), MOTION_ERR_CANCELLED);
+    ck_assert_str_eq(err, "helix.ngc:3: planning stopped by the operator");
+    struct motion_plan_info info;
+    ck_assert_int_ne(motion_plan_info(mc.m, &info), MOTION_OK);
+    stop = 0;
+    ck_assert_int_eq(load_helix(&mc, start, 10, 2, err, sizeof err), MOTION_OK);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *legs_suite(void)
 {
     Suite *s = suite_create("motion_legs");
@@ -194,6 +282,9 @@ static Suite *legs_suite(void)
     tcase_add_test(tc, test_leg_limits_not_needless);
     tcase_add_test(tc, test_kinematic_deviation);
     tcase_add_test(tc, test_kinematic_deviation_helix);
+    tcase_add_test(tc, test_long_helix_is_reachable);
+    tcase_add_test(tc, test_long_helix_out_of_reach_between_knots);
+    tcase_add_test(tc, test_cancel_stops_planning);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -38,13 +38,19 @@ struct run_args {
     const char *program;
 };
 
-/* The progress display's state. */
+/* The progress display's state. A line (or, on a terminal, an update of the one line) is
+ * due at each further 10 % of the program, after every `every_s` of machine time and after
+ * every second of wall time (a terminal: a tenth of a second), whichever comes first, and
+ * whenever the machine's state changes (running, paused, done, ...). */
 struct run_display {
     int tty;                  /* stdout is a terminal: one updating line */
     int quiet;                /* no progress at all */
-    double every_s;           /* not a terminal: a line every this much machine time */
+    double every_s;           /* a line at least every this much machine time */
     double next_s;            /* machine time of the next line */
-    double last_wall_s;       /* terminal: wall time of the last update */
+    double next_percent;      /* the next 10 % mark */
+    double wall_every_s;      /* a line at least every this much wall time */
+    double last_wall_s;       /* wall time of the last line */
+    int last_state;           /* enum motion_state of the last line, -1 before the first */
     int shown;                /* a terminal line is on screen (needs a newline) */
 };
 
@@ -56,27 +62,34 @@ static double run_wall_s(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-/* Prints progress: an updating line on a terminal (10 times a second of wall time), else a
- * line every few seconds of machine time. */
+/* Whether a progress line is due now (see struct run_display). */
+static int run_progress_due(const struct run_display *d, const struct runner_progress *p,
+                            double now_wall_s)
+{
+    return (int)p->state != d->last_state || p->percent >= d->next_percent ||
+           p->elapsed_s >= d->next_s || now_wall_s - d->last_wall_s >= d->wall_every_s;
+}
+
+/* Prints progress: an updating line on a terminal, else one line each time one is due. */
 static void run_progress(void *ctx, const struct runner_progress *p)
 {
     struct run_display *d = ctx;
-    if (d->quiet)
+    double now = run_wall_s();
+    if (d->quiet || !run_progress_due(d, p, now))
         return;
+    d->last_wall_s = now;
+    d->last_state = (int)p->state;
+    d->next_s = p->elapsed_s + d->every_s;
+    while (d->next_percent <= p->percent)
+        d->next_percent += 10.0;
     if (d->tty) {
-        double now = run_wall_s();
-        if (now - d->last_wall_s < 0.1 && p->state == MOTION_RUNNING)
-            return;
-        d->last_wall_s = now;
         printf("\r  line %-5d %5.1f %%  elapsed %8.3f s  remaining %8.3f s  %-9s", p->line,
                p->percent, p->elapsed_s, p->remaining_s, motion_state_name(p->state));
-        fflush(stdout);
         d->shown = 1;
-    } else if (p->elapsed_s >= d->next_s) {
+    } else
         printf("  line %d: %.1f %%, elapsed %.3f s, remaining %.3f s\n", p->line, p->percent,
                p->elapsed_s, p->remaining_s);
-        d->next_s = p->elapsed_s + d->every_s;
-    }
+    fflush(stdout);
 }
 
 /* Parses the command line; returns 0 or prints usage and returns RUN_EXIT_USAGE. */
@@ -159,7 +172,9 @@ static void run_catch_signals(void)
 /* A component's message as it arrives: faults and warnings on stderr, the rest on stdout. */
 static void run_on_message(void *ctx, const struct hal_msg *m)
 {
-    (void)ctx;
+    const int *quiet = ctx;
+    if (*quiet && m->severity == HAL_MSG_INFO)
+        return;
     FILE *f = m->severity == HAL_MSG_INFO ? stdout : stderr;
     fprintf(f, "hexcnc run: %s: %s: %s\n", hal_msg_severity_name(m->severity), m->source,
             m->text);
@@ -169,25 +184,35 @@ static void run_on_message(void *ctx, const struct hal_msg *m)
 static int run_machine(struct runner *r, const char *program, int quiet)
 {
     char err[1024];
-    printf("program %s\n", program);
-    if (runner_load_program(r, program, err, sizeof err) != RUNNER_OK) {
-        fprintf(stderr, "hexcnc run: %s\nhexcnc run: the program was not started; "
-                "the machine did not move\n", err);
-        return RUN_EXIT_REFUSED;
+    if (!quiet) {
+        printf("program %s\n", program);
+        fflush(stdout);  /* shown before a long load, also when stdout is a file */
     }
-    run_print_plan(r);
-    struct run_display d = { .tty = isatty(STDOUT_FILENO), .quiet = quiet, .every_s = 5.0 };
+    runner_set_cancel(r, &run_stop_requested);  /* Ctrl-C while reading or planning */
+    int st = runner_load_program(r, program, err, sizeof err);
+    if (st != RUNNER_OK) {
+        fprintf(stderr, "hexcnc run: %s%s\nhexcnc run: the program was not started; "
+                "the machine did not move\n", st == RUNNER_ERR_ABORTED ? "interrupted: " : "",
+                err);
+        return st == RUNNER_ERR_ABORTED ? RUN_EXIT_INTERRUPT : RUN_EXIT_REFUSED;
+    }
+    if (!quiet)
+        run_print_plan(r);
+    int tty = isatty(STDOUT_FILENO);
+    struct run_display d = { .tty = tty, .quiet = quiet, .every_s = 5.0, .next_s = 5.0,
+                             .next_percent = 10.0, .wall_every_s = tty ? 0.1 : 1.0,
+                             .last_wall_s = run_wall_s(), .last_state = -1 };
     long every = 5;
     if (hal_ini_int(runner_hal(r), "TASK", "PROGRESS_INTERVAL", 5, &every) == HAL_OK &&
         every > 0)
-        d.every_s = (double)every;
-    runner_set_message_fn(r, run_on_message, NULL);
+        d.every_s = d.next_s = (double)every;
+    runner_set_message_fn(r, run_on_message, &quiet);
     double t0 = run_wall_s();
     if (runner_start(r, err, sizeof err) != RUNNER_OK) {
         fprintf(stderr, "hexcnc run: %s\n", err);
         return RUN_EXIT_REFUSED;
     }
-    int st = runner_run(r, &run_stop_requested, run_progress, &d, err, sizeof err);
+    st = runner_run(r, &run_stop_requested, run_progress, &d, err, sizeof err);
     double wall_s = run_wall_s() - t0;
     if (d.shown)
         printf("\n");
@@ -200,7 +225,8 @@ static int run_machine(struct runner *r, const char *program, int quiet)
         fprintf(stderr, "hexcnc run: %s: %s\n", runner_strerror(st), err);
         return RUN_EXIT_FAULT;
     }
-    printf("program finished\n");
+    if (!quiet)
+        printf("program finished\n");
     return RUN_EXIT_OK;
 }
 
@@ -226,8 +252,9 @@ int cmd_run(int argc, char **argv)
         runner_destroy(r);
         return RUN_EXIT_USAGE;
     }
-    printf("hexcnc run: machine %s, %s clock\n", a.ini,
-           runner_sim_clock(r) ? "simulated" : "real-time");
+    if (!a.quiet)
+        printf("hexcnc run: machine %s, %s clock\n", a.ini,
+               runner_sim_clock(r) ? "simulated" : "real-time");
     rc = run_machine(r, program, a.quiet);
     runner_destroy(r);
     return rc;

@@ -24,6 +24,16 @@ static void hexcnc_usage(FILE *f)
         fprintf(f, "  %s\n", c->usage);
 }
 
+/* Whether the arguments ask for help: -h or --help anywhere before a "--", as GNU tools
+ * take it (a subcommand then prints its usage on stdout and exits 0 without doing anything). */
+static int hexcnc_wants_help(int argc, char **argv)
+{
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
+        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help"))
+            return 1;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
@@ -31,8 +41,13 @@ int main(int argc, char **argv)
         return argc < 2 ? 2 : 0;
     }
     for (const struct hexcnc_cmd *c = hexcnc_cmds; c->name; c++)
-        if (!strcmp(argv[1], c->name))
+        if (!strcmp(argv[1], c->name)) {
+            if (hexcnc_wants_help(argc - 1, argv + 1)) {
+                printf("usage: hexcnc %s\n", c->usage);
+                return 0;
+            }
             return c->fn(argc - 1, argv + 1);
+        }
     fprintf(stderr, "hexcnc: unknown command '%s'\n", argv[1]);
     hexcnc_usage(stderr);
     return 2;

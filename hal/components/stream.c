@@ -1,10 +1,13 @@
 /* stream.c: `streamer` (rows of values from a file or the loadrt line onto out pins, one row
  * per period) and `sampler` (in-pin values to a file, one line per period), for graph tests. */
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "common/config.h"
 #include "hal/hal.h"
@@ -179,6 +182,40 @@ static int streamer_row(struct hal *h, struct streamer *s, char *text, const cha
     return HAL_OK;
 }
 
+/* What a file that is not a regular one is, for the message. */
+static const char *stream_file_kind(mode_t m)
+{
+    return S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device" : S_ISBLK(m) ?
+           "a block device" : S_ISDIR(m) ? "a folder" : S_ISSOCK(m) ? "a socket" : "not a file";
+}
+
+/* Opens file= for reading. The rows are all read at load time, so only a regular file will
+ * do: a FIFO without a writer, /dev/zero or a terminal would hold start-up forever. The
+ * open itself does not wait (O_NONBLOCK: a FIFO's open would block until a writer came). */
+static FILE *streamer_open(struct hal *h, const char *path)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+        hal_error(h, HAL_ERR_IO, "streamer: cannot open '%s': %s", path, strerror(errno));
+        return NULL;
+    }
+    struct stat st;
+    int stat_failed = fstat(fd, &st) != 0;
+    if (stat_failed || !S_ISREG(st.st_mode)) {
+        hal_error(h, HAL_ERR_IO, "streamer: '%s' is %s, not a regular file: file= is read "
+                  "whole when the streamer is loaded", path,
+                  stat_failed ? "unreadable" : stream_file_kind(st.st_mode));
+        close(fd);
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "r");
+    if (!f) {
+        hal_error(h, HAL_ERR_NOMEM, "streamer: cannot read '%s': %s", path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 /* Reads the rows: file= (one row a line, `#` comments) or data= (rows split by `;`). */
 static int streamer_read(struct hal *h, struct streamer *s, const char *file, const char *data)
 {
@@ -196,10 +233,9 @@ static int streamer_read(struct hal *h, struct streamer *s, const char *file, co
     char path[PATH_MAX];
     if (hal_path_resolve(h, file, path, sizeof path) != HAL_OK)
         return hal_error(h, HAL_ERR_ARG, "streamer: file name '%s' is too long", file);
-    FILE *f = fopen(path, "r");
+    FILE *f = streamer_open(h, path);
     if (!f)
-        return hal_error(h, HAL_ERR_IO, "streamer: cannot open '%s': %s", path,
-                         strerror(errno));
+        return HAL_ERR_IO;
     char line[4096];
     while (st == HAL_OK && fgets(line, sizeof line, f)) {
         lineno++;
