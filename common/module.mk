@@ -2,3 +2,6 @@
 LIB_SRCS += common/errbuf.c common/plugin_dirs.c common/inifile.c
 $(BUILD)/common/plugin_dirs.o: CPPFLAGS += -DHEXCNC_PREFIX='"$(PREFIX)"'
 TESTS += test_inifile
+# Replacing a file atomically (tool table, parameter file, plots, sampler output).
+LIB_SRCS += common/atomicfile.c
+TESTS += test_atomicfile
