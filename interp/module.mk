@@ -8,6 +8,7 @@ LIB_SRCS += interp/comp5.c interp/comp5_join.c interp/tooltable.c interp/tooltab
 TESTS += test_comp5 test_comp5_join test_tooltable test_tooltable_file
 SCRIPT_TESTS += tests/paper_programs.sh
 TESTS += test_interp test_interp_number test_interp_motion test_interp_setup test_interp_cycles test_interp_named
+TESTS += test_interp_params
 BENCHES += bench_interp
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh tests/linuxcnc_tooltables.sh
 LIB_SRCS += interp/interp_setup.c
