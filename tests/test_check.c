@@ -1,10 +1,10 @@
 /* test_check.c: hexcnc check on good and faulty programs: problems, lines, figures, JSON, plots, exit status. */
 #include <check.h>
-#include <sys/stat.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
