@@ -1,5 +1,6 @@
 /* check_plot.c: the check's sample trace, the no-compensation variant of a program, and its SVG plots. */
 #include <ctype.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,6 +8,7 @@
 
 #include "check/check_priv.h"
 #include "check/plot.h"
+#include "common/errbuf.h"
 
 static const char *const leg_colors[KINS_MAX_JOINTS] = {
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
@@ -197,9 +199,21 @@ static void isometric(double *xyz, size_t n)
     }
 }
 
+/* "DIR/BASE" into file; a name that does not fit is an error naming the limit, never cut. */
+static int plot_name(char *file, size_t flen, const char *dir, const char *base, char *err,
+                     size_t errlen)
+{
+    int n = snprintf(file, flen, "%s/%s", dir, base);
+    if (n < 0 || (size_t)n >= flen)
+        return errbuf_set(err, errlen, -1, "%.200s...: plot folder name too long (the limit "
+                          "is %zu characters with the file name)", dir, flen - 1);
+    return 0;
+}
+
 /* The two tool path views: programmed contour (dashed) against compensated tool path. */
 static int path_plots(const char *dir, const struct canon_prog *path,
-                      const struct canon_prog *contour, char *file, size_t flen)
+                      const struct canon_prog *contour, char *file, size_t flen, char *err,
+                      size_t errlen)
 {
     size_t cap = 2 + 33 * (path->count + (contour ? contour->count : 0));
     double *a = malloc(3 * cap * sizeof *a), *b = malloc(3 * cap * sizeof *b);
@@ -215,21 +229,22 @@ static int path_plots(const char *dir, const struct canon_prog *path,
     };
     struct svg_chart top = { "Tool path, top view (program X Y: platform pose)", "X (mm)",
                              "Y (mm)", 1 };
-    snprintf(file, flen, "%s/toolpath_top.svg", dir);
-    if (svg_write_chart(file, &top, s, nb ? 2 : 1))
+    if (plot_name(file, flen, dir, "toolpath_top.svg", err, errlen) ||
+        svg_write_chart(file, &top, s, nb ? 2 : 1, err, errlen))
         goto out;
     isometric(a, na), isometric(b, nb);
     struct svg_chart iso = { "Tool path, isometric view", "(X - Y) cos 30 deg (mm)",
                              "Z + (X + Y) sin 30 deg (mm)", 1 };
-    snprintf(file, flen, "%s/toolpath_3d.svg", dir);
-    st = svg_write_chart(file, &iso, s, nb ? 2 : 1);
+    st = plot_name(file, flen, dir, "toolpath_3d.svg", err, errlen);
+    st = st ? st : svg_write_chart(file, &iso, s, nb ? 2 : 1, err, errlen);
 out:
     free(a), free(b), free(comp);
     return st;
 }
 
 /* Leg lengths and leg rates against time, one series per leg. */
-static int leg_plots(const char *dir, const struct check_trace *t, char *file, size_t flen)
+static int leg_plots(const char *dir, const struct check_trace *t, char *file, size_t flen,
+                     char *err, size_t errlen)
 {
     struct svg_series s[KINS_MAX_JOINTS];
     char names[KINS_MAX_JOINTS][16];
@@ -247,21 +262,22 @@ static int leg_plots(const char *dir, const struct check_trace *t, char *file, s
     for (int i = 0; i < t->njoints; i++)
         s[i].y = y + i * t->n;
     struct svg_chart c1 = { "Leg lengths", "machine time (s)", "leg length (mm)", 0 };
-    snprintf(file, flen, "%s/legs.svg", dir);
-    int st = svg_write_chart(file, &c1, s, t->njoints);
+    int st = plot_name(file, flen, dir, "legs.svg", err, errlen);
+    st = st ? st : svg_write_chart(file, &c1, s, t->njoints, err, errlen);
     for (size_t k = 0; k < t->n; k++)
         for (int i = 0; i < t->njoints; i++)
             y[i * t->n + k] = t->rates_mm_s[k * KINS_MAX_JOINTS + i];
     struct svg_chart c2 = { "Leg rates", "machine time (s)", "leg rate (mm/s)", 0 };
-    snprintf(file, flen, "%s/leg_rates.svg", dir);
-    st = st ? st : svg_write_chart(file, &c2, s, t->njoints);
+    st = st ? st : plot_name(file, flen, dir, "leg_rates.svg", err, errlen);
+    st = st ? st : svg_write_chart(file, &c2, s, t->njoints, err, errlen);
     free(y);
     return st;
 }
 
 /* Kinematic deviation along the path, with the tolerance. */
 static int deviation_plot(const char *dir, const struct check_trace *t,
-                          const struct check_result *r, char *file, size_t flen)
+                          const struct check_result *r, char *file, size_t flen, char *err,
+                          size_t errlen)
 {
     double *um = malloc((t->ndev ? t->ndev : 1) * sizeof *um);
     if (!um)
@@ -275,26 +291,29 @@ static int deviation_plot(const char *dir, const struct check_trace *t,
     };
     struct svg_chart c = { "Kinematic deviation from the programmed path",
                            "distance along the path (mm)", "deviation (um)", 0 };
-    snprintf(file, flen, "%s/deviation.svg", dir);
-    int st = svg_write_chart(file, &c, s, r->kin_tol_mm > 0 ? 2 : 1);
+    int st = plot_name(file, flen, dir, "deviation.svg", err, errlen);
+    st = st ? st : svg_write_chart(file, &c, s, r->kin_tol_mm > 0 ? 2 : 1, err, errlen);
     free(um);
     return st;
 }
 
-/* All the check's plots into dir. */
+/* All the check's plots into dir, each replaced atomically (common/atomicfile). */
 int check_write_plots(const char *dir, const struct canon_prog *path,
                       const struct canon_prog *contour, const struct check_trace *trace,
                       const struct check_result *r, char *err, size_t errlen)
 {
-    char file[1200];
+    char file[PATH_MAX];
     if (trace->failed) {
         snprintf(err, errlen, "out of memory while keeping the plot samples");
         return CHECK_ERR_NOMEM;
     }
-    if (path_plots(dir, path, contour, file, sizeof file) ||
-        leg_plots(dir, trace, file, sizeof file) ||
-        deviation_plot(dir, trace, r, file, sizeof file)) {
-        snprintf(err, errlen, "%s: cannot write the plot (does the folder exist?)", file);
+    if (errlen)
+        err[0] = '\0';
+    if (path_plots(dir, path, contour, file, sizeof file, err, errlen) ||
+        leg_plots(dir, trace, file, sizeof file, err, errlen) ||
+        deviation_plot(dir, trace, r, file, sizeof file, err, errlen)) {
+        if (errlen && !err[0])
+            snprintf(err, errlen, "out of memory while writing the plots");
         return CHECK_ERR_IO;
     }
     return CHECK_OK;

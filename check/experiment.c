@@ -232,7 +232,7 @@ static int iso_plot(const char *dir, const struct exp_run_def *d, const struct c
     struct svg_chart c = { title, "(x - y) cos 30 deg, workpiece frame (mm)",
                            "z + (x + y) sin 30 deg (mm)", 1 };
     snprintf(file, sizeof file, "%s/exp_run%s_3d.svg", dir, d->name);
-    int rc = svg_write_chart(file, &c, s, 2);
+    int rc = svg_write_chart(file, &c, s, 2, NULL, 0);
     free(uv);
     return rc;
 }
@@ -274,7 +274,7 @@ static int run_plots(const char *dir, const struct exp_run_def *d, const struct 
     snprintf(title, sizeof title, "Run %s: wall seen from above (workpiece frame)", d->name);
     struct svg_chart top = { title, "along the wall, s (mm)", "into the material, u (mm)", 1 };
     snprintf(file, sizeof file, "%s/exp_run%s_top.svg", dir, d->name);
-    rc = rc ? rc : svg_write_chart(file, &top, s, 6);
+    rc = rc ? rc : svg_write_chart(file, &top, s, 6, NULL, 0);
     /* the wall in um beyond the contour, where it is fully formed (away from the ends) */
     double len = fabs(d->part[1][1] - d->part[0][0]), s0 = 0.5 * st[0], s1 = 0.5 * (st[3] + len);
     for (int i = 0; i < NW; i++) {
@@ -298,7 +298,7 @@ static int run_plots(const char *dir, const struct exp_run_def *d, const struct 
     snprintf(title, sizeof title, "Run %s: compensated wall beyond the contour", d->name);
     struct svg_chart wall = { title, "along the wall, s (mm)", "wall - contour (um)", 0 };
     snprintf(file, sizeof file, "%s/exp_run%s_wall.svg", dir, d->name);
-    rc = rc ? rc : svg_write_chart(file, &wall, s2, 3);
+    rc = rc ? rc : svg_write_chart(file, &wall, s2, 3, NULL, 0);
     free(xy);
     return rc;
 }

@@ -18,14 +18,15 @@ struct svg_series {
 };
 
 /* A chart: title, axis labels with units, and the series; equal_aspect keeps 1 mm = 1 mm on
- * both axes (paths seen from above). Returns 0, or -1 when the file cannot be written. */
+ * both axes (paths seen from above). The file is replaced atomically (common/atomicfile).
+ * Returns 0, or -1 with "PATH: what" in err when it cannot be written. */
 struct svg_chart {
     const char *title;
     const char *xlabel, *ylabel;
     int equal_aspect;
 };
 int svg_write_chart(const char *path, const struct svg_chart *c, const struct svg_series *s,
-                    int ns);
+                    int ns, char *err, size_t errlen);
 
 /* Samples the check keeps for its plots: time series decimated to about CHECK_TRACE_POINTS
  * points, and every deviation measure (decimated the same way). */

@@ -3,6 +3,7 @@
 #include <stdio.h>
 
 #include "check/plot.h"
+#include "common/atomicfile.h"
 
 #define W_PX 900.0           /* drawing size, px */
 #define H_PX 560.0
@@ -165,17 +166,18 @@ static void legend(FILE *f, const struct frame *fr, const struct svg_series *s, 
     }
 }
 
-/* Writes one chart: frame, grid, ticks, labels, series, legend. */
+/* Writes one chart: frame, grid, ticks, labels, series, legend; atomically. */
 int svg_write_chart(const char *path, const struct svg_chart *c, const struct svg_series *s,
-                    int ns)
+                    int ns, char *err, size_t errlen)
 {
     struct frame fr;
+    struct atomicfile a;
     if (!data_range(s, ns, &fr))
         fr.x0 = fr.y0 = 0, fr.x1 = fr.y1 = 1;
     fit_frame(&fr, c->equal_aspect);
-    FILE *f = fopen(path, "w");
-    if (!f)
+    if (atomicfile_open(&a, path, err, errlen) != ATOMICFILE_OK)
         return -1;
+    FILE *f = a.f;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
             "width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" "
             "font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
@@ -187,5 +189,5 @@ int svg_write_chart(const char *path, const struct svg_chart *c, const struct sv
         series(f, &fr, &s[k]);
     legend(f, &fr, s, ns);
     fputs("</svg>\n", f);
-    return fclose(f) == 0 ? 0 : -1;
+    return atomicfile_commit(&a, err, errlen) == ATOMICFILE_OK ? 0 : -1;
 }

@@ -1,14 +1,61 @@
 /* params.c: the parameter file (LinuxCNC's format) and the work offsets kept in parameters. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "common/atomicfile.h"
+#include "common/errbuf.h"
 #include "interp/interp_int.h"
 
-/* Reads "number value" lines into in->params. A missing file is not an error: it will be
- * created when the run ends, as LinuxCNC does with a new parameter file. */
+/* Column (1-based) of p in line. */
+static int params_col(const char *line, const char *p)
+{
+    return (int)(p - line) + 1;
+}
+
+/* Parses one "number value" line (blank and comment lines leave *n at 0). Plain decimals
+ * only: nan, inf, hex, out-of-range numbers and anything after the value are refused. */
+static int params_parse_line(struct interp *in, const char *line, long *n, double *v)
+{
+    const char *p = line + strspn(line, " \t");
+    char *end;
+    *n = 0;
+    if (*p == '\n' || *p == '\r' || *p == 0 || *p == '#' || *p == ';')
+        return 0;
+    size_t span = strspn(p, "0123456789");
+    errno = 0;
+    *n = strtol(p, &end, 10);
+    if (span == 0 || end != p + span)
+        return interp_fail(in, INTERP_ERR_PARAM, params_col(line, p), "a parameter number "
+                           "is expected at the start of the line");
+    if (errno == ERANGE || *n < 1 || *n >= INTERP_NPARAMS)
+        return interp_fail(in, INTERP_ERR_PARAM, params_col(line, p), "parameter number %.*s "
+                           "is out of range (1 to %d)", (int)span, p, INTERP_NPARAMS - 1);
+    if (*end != ' ' && *end != '\t')
+        return interp_fail(in, INTERP_ERR_PARAM, params_col(line, end), "expected 'number "
+                           "value': a blank after the parameter number");
+    p = end + strspn(end, " \t");
+    span = strspn(p, "+-.0123456789eE");
+    errno = 0;
+    *v = strtod(p, &end);
+    if (span == 0 || end != p + span || !isfinite(*v) || (errno == ERANGE && *v != 0.0))
+        return interp_fail(in, INTERP_ERR_PARAM, params_col(line, p), "parameter %ld: the "
+                           "value '%.*s' is not a finite decimal number", *n,
+                           (int)(strcspn(p, " \t\r\n") ? strcspn(p, " \t\r\n") : 1), p);
+    end += strspn(end, " \t\r\n");
+    if (*end)
+        return interp_fail(in, INTERP_ERR_PARAM, params_col(line, end), "parameter %ld: "
+                           "unexpected '%.*s' after the value", *n,
+                           (int)strcspn(end, "\r\n"), end);
+    return 0;
+}
+
+/* Reads "number value" lines into in->params, all or nothing: a bad line is an error naming
+ * the file, line and column, and no parameter is changed. A missing file is not an error:
+ * it will be created when the run ends, as LinuxCNC does with a new parameter file. */
 int interp_params_load(struct interp *in, const char *path)
 {
     FILE *f = fopen(path, "r");
@@ -18,32 +65,29 @@ int interp_params_load(struct interp *in, const char *path)
         return interp_fail(in, INTERP_ERR_IO, 0, "cannot read parameter file %s: %s", path,
                            strerror(errno));
     }
+    atomicfile_clean_stale(path);
+    double *vals = calloc(INTERP_NPARAMS, sizeof *vals);
+    unsigned char *set = calloc(INTERP_NPARAMS, 1);
     char line[256];
-    int lineno = 0, rc = 0;
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        char *p = line;
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (*p == '\n' || *p == '\r' || *p == 0 || *p == '#' || *p == ';')
-            continue;
-        char *end;
-        long n = strtol(p, &end, 10);
-        in->line = lineno;
-        if (end == p) {
-            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "a parameter number is expected at the "
-                             "start of the line");
-            break;
-        }
-        p = end;
-        double v = strtod(p, &end);
-        if (end == p || n < 1 || n >= INTERP_NPARAMS) {
-            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "expected 'number value' with a number "
-                             "from 1 to %d", INTERP_NPARAMS - 1);
-            break;
-        }
-        in->params[n] = v;
+    int rc = vals && set ? 0 : interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory");
+    in->line = 0;
+    while (rc == 0 && fgets(line, sizeof line, f)) {
+        long n;
+        double v = 0.0;
+        in->line++;
+        if (!strchr(line, '\n') && !feof(f))
+            rc = interp_fail(in, INTERP_ERR_PARAM, 0, "line longer than %d characters",
+                             (int)sizeof line - 2);
+        else if ((rc = params_parse_line(in, line, &n, &v)) == 0 && n > 0)
+            vals[n] = v, set[n] = 1;
     }
+    if (rc == 0 && ferror(f))
+        rc = interp_fail(in, INTERP_ERR_IO, 0, "cannot read parameter file %s", path);
+    for (int i = 0; rc == 0 && i < INTERP_NPARAMS; i++)
+        if (set[i])
+            in->params[i] = vals[i];
+    free(vals);
+    free(set);
     fclose(f);
     return rc;
 }
@@ -68,39 +112,27 @@ int interp_param_persistent(int n)
     return persistent(n);
 }
 
-/* Writes the persistent parameters to a temporary file, syncs it and renames it over the
- * parameter file, so a crash leaves either the old file or the new one, never half. */
+/* Writes the persistent parameters through common/atomicfile: a private temporary next to
+ * the file, fsync, rename; a crash leaves the old file or the new one, never half, and two
+ * processes saving the same file never share a temporary. */
 int interp_params_save(struct interp *in)
 {
     if (!in->param_path)
         return 0;
-    size_t n = strlen(in->param_path);
-    char *tmp = malloc(n + 8);
-    if (!tmp)
-        return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory saving parameters");
-    memcpy(tmp, in->param_path, n);
-    memcpy(tmp + n, ".tmp", 5);
-    FILE *f = fopen(tmp, "w");
-    int ok = f != NULL;
-    for (int i = PARAM_PERSIST_LO; ok && i <= PARAM_PERSIST_HI; i++)
-        if (persistent(i) && fprintf(f, "%d\t%.6f\n", i, in->params[i]) < 0)
-            ok = 0;
-    if (f) {
-        if (fflush(f) != 0 || fsync(fileno(f)) != 0)
-            ok = 0;
-        if (fclose(f) != 0)
-            ok = 0;
-    }
-    if (ok && rename(tmp, in->param_path) != 0)
-        ok = 0;
-    int rc = 0;
-    if (!ok) {
-        rc = interp_fail(in, INTERP_ERR_IO, 0, "cannot write parameter file %s: %s",
-                         in->param_path, strerror(errno));
-        unlink(tmp);
-    }
-    free(tmp);
-    return rc;
+    struct atomicfile a;
+    char err[512];
+    int st = atomicfile_open(&a, in->param_path, err, sizeof err);
+    for (int i = PARAM_PERSIST_LO; st == ATOMICFILE_OK && i <= PARAM_PERSIST_HI; i++)
+        if (persistent(i) && fprintf(a.f, "%d\t%.6f\n", i, in->params[i]) < 0) {
+            atomicfile_abort(&a);
+            st = errbuf_set(err, sizeof err, ATOMICFILE_ERR_IO, "%s: cannot write the file: "
+                            "%s (left as it was)", in->param_path, strerror(errno));
+        }
+    if (st == ATOMICFILE_OK)
+        st = atomicfile_commit(&a, err, sizeof err);
+    if (st != ATOMICFILE_OK)
+        return interp_fail(in, INTERP_ERR_IO, 0, "cannot save the parameter file: %s", err);
+    return 0;
 }
 
 /* Makes coordinate system 1..9 (G54..G59.3) active, reading its offsets from parameters. */

@@ -1,5 +1,6 @@
 /* tooltable.c: LinuxCNC-format tool table: parse, look up, wear, G10 L1 (file I/O: tooltable_file.c). */
 #include "interp/tooltable.h"
+#include "interp/tooltable_priv.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -50,15 +51,23 @@ struct tool_entry *tooltable_find(struct tooltable *t, int tool)
     return i < 0 ? NULL : &t->tools[i];
 }
 
-/* Adds or replaces an entry (tool numbers 1 .. TOOLTABLE_WEAR_BASE - 1). */
+/* Adds or replaces an entry. A number that would read back as something else is refused:
+ * T(WEAR_BASE + n) while tool n exists (that is n's wear entry), and a new tool n while
+ * T(WEAR_BASE + n) exists as a tool (it would turn into n's wear entry). */
 int tooltable_set(struct tooltable *t, const struct tool_entry *e)
 {
-    if (e->tool <= 0 || e->tool >= TOOLTABLE_WEAR_BASE)
+    if (e->tool < 0)
         return TOOLTABLE_ERR_NO_TOOL;
     if (!(e->diameter_mm >= 0.0))
         return TOOLTABLE_ERR_VALUE;
     int i = tooltable_index(t, e->tool);
     if (i < 0) {
+        if (tooltable_is_wear_number(e->tool) &&
+            tooltable_index(t, e->tool - TOOLTABLE_WEAR_BASE) >= 0)
+            return TOOLTABLE_ERR_DUPLICATE;
+        if (e->tool > 0 && e->tool < TOOLTABLE_WEAR_BASE &&
+            tooltable_index(t, e->tool + TOOLTABLE_WEAR_BASE) >= 0)
+            return TOOLTABLE_ERR_DUPLICATE;
         if (t->count >= TOOLTABLE_MAX)
             return TOOLTABLE_ERR_FULL;
         i = t->count++;
@@ -83,13 +92,15 @@ int tooltable_set_wear(struct tooltable *t, int tool, double wear_mm)
 int tooltable_g10_l1(struct tooltable *t, int p, int has_r, double r_mm, int has_z,
                      double z_mm)
 {
-    if (p > TOOLTABLE_WEAR_BASE) {
+    if (tooltable_is_wear_number(p) && tooltable_index(t, p) < 0) {
+        if (tooltable_index(t, p - TOOLTABLE_WEAR_BASE) < 0)
+            return TOOLTABLE_ERR_NO_TOOL;  /* neither a wear entry nor a tool: ambiguous */
         if (has_z)
             return TOOLTABLE_ERR_VALUE; /* only diameter wear is kept */
         return has_r ? tooltable_set_wear(t, p - TOOLTABLE_WEAR_BASE, 2.0 * r_mm)
                      : TOOLTABLE_OK;
     }
-    if (p <= 0 || p >= TOOLTABLE_WEAR_BASE)
+    if (p <= 0)
         return TOOLTABLE_ERR_NO_TOOL;
     struct tool_entry e;
     struct tool_entry *old = tooltable_find(t, p);
@@ -118,214 +129,11 @@ int tooltable_radius(const struct tooltable *t, int tool, double *radius_mm)
     int i = tooltable_index(t, tool);
     if (i < 0)
         return TOOLTABLE_ERR_NO_TOOL;
+    if (t->tools[i].duplicate_line)
+        return TOOLTABLE_ERR_DUPLICATE; /* two diameters for one number: which one is meant? */
     double d_mm = t->tools[i].diameter_mm + t->tools[i].wear_mm;
     if (!(d_mm > 0.0))
         return TOOLTABLE_ERR_VALUE;
     *radius_mm = 0.5 * d_mm;
     return TOOLTABLE_OK;
-}
-
-/* ---- parsing ---- */
-
-/* The letters LinuxCNC's tool table knows, in the order a save writes the optional ones. */
-static const char tooltable_offset_letters[] = "XYZABCUVW";
-
-/* One parsed line: a tool or a wear entry, with the line it came from. */
-struct tooltable_line {
-    struct tool_entry e;
-    int lineno;
-};
-
-/* Copies the comment after ';' without the leading blanks and the line end. */
-static void tooltable_copy_comment(char *dst, size_t dstlen, const char *src)
-{
-    while (*src == ' ' || *src == '\t')
-        src++;
-    size_t n = strcspn(src, "\r\n");
-    if (n >= dstlen)
-        n = dstlen - 1;
-    memcpy(dst, src, n);
-    dst[n] = '\0';
-}
-
-/* Reads one word's number; integers for T P Q. Returns 0 on success. */
-static int tooltable_number(const char **s, int want_int, double *v)
-{
-    char *end;
-    size_t span = strspn(*s, "+-.0123456789eE"); /* plain decimals only: no hex, inf, nan */
-    errno = 0;
-    *v = strtod(*s, &end);
-    if (span == 0 || end != *s + span || errno || !isfinite(*v))
-        return -1;
-    if (want_int && (*v != floor(*v) || fabs(*v) > 1e9))
-        return -1;
-    *s = end;
-    return 0;
-}
-
-/* Stores a field value; `bit` marks it present. Returns 0, or -1 if the letter repeats. */
-static int tooltable_store(struct tool_entry *e, unsigned *seen, char letter, double v)
-{
-    const char *all = "TPXYZABCUVWDIJQ";
-    unsigned bit = 1u << (strchr(all, letter) - all);
-    if (*seen & bit)
-        return -1;
-    *seen |= bit;
-    const char *off = strchr(tooltable_offset_letters, letter);
-    if (letter == 'T')
-        e->tool = (int)v;
-    else if (letter == 'P')
-        e->pocket = (int)v;
-    else if (letter == 'D')
-        e->diameter_mm = v;
-    else if (letter == 'I')
-        e->front_angle_deg = v, e->present |= TOOLTABLE_F_I;
-    else if (letter == 'J')
-        e->back_angle_deg = v, e->present |= TOOLTABLE_F_J;
-    else if (letter == 'Q')
-        e->orientation = (int)v, e->present |= TOOLTABLE_F_Q;
-    else if (letter == 'Z')
-        e->z_offset_mm = v, e->present |= TOOLTABLE_F_Z;
-    else if (off) {
-        e->offset[off - tooltable_offset_letters] = v;
-        e->present |= 1u << (off - tooltable_offset_letters);
-    }
-    return 0;
-}
-
-/* Parses one line into l->e; *is_tool says whether it held a tool (else blank/comment). */
-static int tooltable_parse_line(const char *s, struct tooltable_line *l, int *is_tool,
-                                const char *name, char *err, size_t errlen)
-{
-    unsigned seen = 0;
-    memset(&l->e, 0, sizeof l->e);
-    *is_tool = 0;
-    for (;;) {
-        while (*s == ' ' || *s == '\t' || *s == '\r')
-            s++;
-        if (*s == '\0' || *s == '\n')
-            break;
-        if (*s == ';') {
-            tooltable_copy_comment(l->e.comment, sizeof l->e.comment, s + 1);
-            break;
-        }
-        char letter = (char)toupper((unsigned char)*s);
-        if (!isalpha((unsigned char)*s) || !strchr("TPXYZABCUVWDIJQ", letter))
-            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                                  "%s:%d: unknown field '%c' (a tool table knows T P X Y Z A "
-                                  "B C U V W D I J Q)", name, l->lineno, *s);
-        s++;
-        double v;
-        if (tooltable_number(&s, letter == 'T' || letter == 'P' || letter == 'Q', &v))
-            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                                  "%s:%d: field %c needs a %snumber", name, l->lineno,
-                                  letter, strchr("TPQ", letter) ? "whole " : "");
-        if (*s && !strchr(" \t\r\n;", *s))
-            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                                  "%s:%d: field %c is followed by '%c' (put a space between "
-                                  "fields)", name, l->lineno, letter, *s);
-        if (tooltable_store(&l->e, &seen, letter, v))
-            return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                                  "%s:%d: field %c appears twice", name, l->lineno, letter);
-    }
-    if (!seen)
-        return TOOLTABLE_OK;
-    if (!(seen & 1u))
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                              "%s:%d: the line has no tool number (T)", name, l->lineno);
-    if (l->e.tool <= 0 || l->e.tool == TOOLTABLE_WEAR_BASE)
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                              "%s:%d: tool number T%d is not allowed (use 1..%d, or %d+n for "
-                              "the wear of tool n)", name, l->lineno, l->e.tool,
-                              TOOLTABLE_WEAR_BASE - 1, TOOLTABLE_WEAR_BASE);
-    if (!(seen & 2u))
-        l->e.pocket = l->e.tool;
-    if (l->e.tool > TOOLTABLE_WEAR_BASE && (seen & ~(1u | 2u | (1u << 11))))
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_SYNTAX,
-                              "%s:%d: wear entry T%d may only carry P and D (diameter wear)",
-                              name, l->lineno, l->e.tool);
-    if (l->e.tool < TOOLTABLE_WEAR_BASE && l->e.diameter_mm < 0.0)
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_VALUE,
-                              "%s:%d: tool T%d has a negative diameter D%g", name,
-                              l->lineno, l->e.tool, l->e.diameter_mm);
-    *is_tool = 1;
-    return TOOLTABLE_OK;
-}
-
-/* A wear entry read from the file, applied once every tool is known. */
-struct tooltable_wear {
-    int tool;                 /* the worn tool's number (entry number - WEAR_BASE) */
-    double wear_mm;           /* diameter wear delta */
-    int lineno;               /* line of the wear entry */
-};
-
-/* Folds a wear entry (T WEAR_BASE + n) into tool n, which must be in the table. */
-static int tooltable_apply_wear(struct tooltable *t, const struct tooltable_wear *l,
-                                int *wear_line, const char *name, char *err, size_t errlen)
-{
-    int tool = l->tool;
-    int i = tooltable_index(t, tool);
-    if (i < 0)
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_NO_TOOL,
-                              "%s:%d: wear entry T%d is for tool T%d, which is not in the "
-                              "table", name, l->lineno, tool + TOOLTABLE_WEAR_BASE, tool);
-    if (wear_line[i])
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_DUPLICATE,
-                              "%s:%d: a second wear entry for tool T%d (the first is on line "
-                              "%d)", name, l->lineno, tool, wear_line[i]);
-    t->tools[i].wear_mm = l->wear_mm;
-    wear_line[i] = l->lineno;
-    return TOOLTABLE_OK;
-}
-
-/* Adds one tool line to t, refusing duplicates. line_of[i] remembers where tool i was. */
-static int tooltable_add_line(struct tooltable *t, const struct tooltable_line *l,
-                              int *line_of, const char *name, char *err, size_t errlen)
-{
-    int i = tooltable_index(t, l->e.tool);
-    if (i >= 0)
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_DUPLICATE,
-                              "%s:%d: tool T%d appears twice (first on line %d)", name,
-                              l->lineno, l->e.tool, line_of[i]);
-    if (t->count >= TOOLTABLE_MAX)
-        return errbuf_set(err, errlen, TOOLTABLE_ERR_FULL,
-                              "%s:%d: more than %d tools", name, l->lineno, TOOLTABLE_MAX);
-    line_of[t->count] = l->lineno;
-    t->tools[t->count++] = l->e;
-    return TOOLTABLE_OK;
-}
-
-/* Parses a whole table from text: tools first, then the wear entries folded into them. */
-int tooltable_parse(struct tooltable *t, const char *text, const char *name, char *err,
-                    size_t errlen)
-{
-    int line_of[TOOLTABLE_MAX] = {0}, wear_line[TOOLTABLE_MAX] = {0};
-    struct tooltable_wear wear[TOOLTABLE_MAX];
-    int nwear = 0, rc = TOOLTABLE_OK;
-    struct tooltable_line l;
-    tooltable_init(t);
-    l.lineno = 0;
-    for (const char *s = text; s && *s && rc == TOOLTABLE_OK;) {
-        const char *eol = strchr(s, '\n');
-        l.lineno++;
-        int is_tool;
-        rc = tooltable_parse_line(s, &l, &is_tool, name, err, errlen);
-        if (rc == TOOLTABLE_OK && is_tool && l.e.tool > TOOLTABLE_WEAR_BASE) {
-            if (nwear >= TOOLTABLE_MAX)
-                rc = errbuf_set(err, errlen, TOOLTABLE_ERR_FULL,
-                                    "%s:%d: more than %d wear entries", name, l.lineno,
-                                    TOOLTABLE_MAX);
-            else
-                wear[nwear++] = (struct tooltable_wear){
-                    l.e.tool - TOOLTABLE_WEAR_BASE, l.e.diameter_mm, l.lineno};
-        } else if (rc == TOOLTABLE_OK && is_tool) {
-            rc = tooltable_add_line(t, &l, line_of, name, err, errlen);
-        }
-        s = eol ? eol + 1 : NULL;
-    }
-    for (int k = 0; k < nwear && rc == TOOLTABLE_OK; k++)
-        rc = tooltable_apply_wear(t, &wear[k], wear_line, name, err, errlen);
-    if (rc != TOOLTABLE_OK)
-        tooltable_init(t);
-    return rc;
 }

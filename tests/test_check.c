@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -305,6 +306,38 @@ START_TEST(test_plots_written)
 }
 END_TEST
 
+/* A plot replaces its file atomically: the mode is kept, a read-only plot is refused with
+ * a message naming it and left as it was. */
+START_TEST(test_plot_file_replaced_atomically)
+{
+    char dir[] = "/tmp/hexcnc_check_svgXXXXXX", path[128], err[512] = "";
+    ck_assert(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/legs.svg", dir);
+    FILE *f = fopen(path, "w");
+    fputs("old plot\n", f);
+    fclose(f);
+    ck_assert_int_eq(chmod(path, 0600), 0);
+    double x[3] = { 0, 1, 2 }, y[3] = { 1, 3, 2 };
+    struct svg_series s = { "leg 1", x, y, 3, 0, "#000", 0, 0 };
+    struct svg_chart c = { "Leg lengths", "machine time (s)", "leg length (mm)", 0 };
+    ck_assert_msg(svg_write_chart(path, &c, &s, 1, err, sizeof err) == 0, "%s", err);
+    struct stat st;
+    ck_assert_int_eq(stat(path, &st), 0);
+    ck_assert_uint_eq(st.st_mode & 07777, 0600);
+    char *text = tc_read(path);
+    ck_assert(text && tx_balanced(text) && strstr(text, "leg 1"));
+    free(text);
+    ck_assert_int_eq(chmod(path, 0444), 0);
+    ck_assert_int_eq(svg_write_chart(path, &c, &s, 1, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, path) && strstr(err, "read-only"), "%s", err);
+    text = tc_read(path);
+    ck_assert(text && strstr(text, "leg 1"));        /* the earlier plot, unchanged */
+    free(text);
+    unlink(path);
+    ck_assert_int_eq(rmdir(dir), 0);                  /* nothing else was left there */
+}
+END_TEST
+
 /* A bad value in the INI: the check at load names the file and the key's line. */
 START_TEST(test_config_error_names_the_ini_line)
 {
@@ -354,6 +387,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_json_and_exit_status);
     tcase_add_test(tc, test_json_reader_rejects_bad_text);
     tcase_add_test(tc, test_plots_written);
+    tcase_add_test(tc, test_plot_file_replaced_atomically);
     tcase_add_test(tc, test_strip_compensation);
     tcase_add_test(tc, test_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);

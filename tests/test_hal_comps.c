@@ -1,7 +1,10 @@
 /* test_hal_comps.c: the small generic components (and2, not, sum2, estop-latch watchdog,
  * streamer loop/enable, sampler enable) driven by halcmd lines on the simulated clock. */
 #include <check.h>
+#include <dirent.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -164,6 +167,78 @@ START_TEST(sampler_writes_only_while_enabled)
 }
 END_TEST
 
+/* The sampler replaces its file atomically: the old text stays until the runtime closes,
+ * then the new one is there, with no temporary left; a read-only file is refused. */
+START_TEST(sampler_file_replaced_atomically)
+{
+    char dir[] = "/tmp/test_hal_comps.XXXXXX", line[4300], path[4100], text[256];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/s.out", dir);
+    FILE *f = fopen(path, "w");
+    fputs("old\n", f);
+    fclose(f);
+    struct hal *h = new_hal();
+    cmd(h, "loadrt streamer cfg=f data=1;2;3 names=src");
+    snprintf(line, sizeof line, "loadrt sampler cfg=f file=%s names=log", path);
+    cmd(h, line);
+    cmd(h, "net v src.pin.0 log.pin.0");
+    cmd(h, "addf src th");
+    cmd(h, "addf log th");
+    cmd(h, "start");
+    periods(h, 3);
+    f = fopen(path, "r");
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    ck_assert_str_eq(text, "old\n");                  /* not replaced while running */
+    hal_destroy(h);
+    f = fopen(path, "r");
+    n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    ck_assert_str_eq(text, "1\n2\n3\n");
+    DIR *d = opendir(dir);                             /* no temporary left */
+    struct dirent *e;
+    int files = 0;
+    while (d && (e = readdir(d)))
+        files += e->d_name[0] != '.' || strstr(e->d_name, ".hexcnc-") != NULL;
+    closedir(d);
+    ck_assert_int_eq(files, 1);
+    ck_assert_int_eq(chmod(path, 0444), 0);
+    h = new_hal();
+    snprintf(line, sizeof line, "loadrt sampler cfg=f file=%s names=log", path);
+    ck_assert_int_ne(hal_cmd(h, line, "test", 1, NULL), HAL_OK);
+    ck_assert_msg(strstr(hal_last_error(h), path) && strstr(hal_last_error(h), "read-only"),
+                  "%s", hal_last_error(h));
+    hal_destroy(h);
+    unlink(path);
+    rmdir(dir);
+}
+END_TEST
+
+/* A write error (/dev/full: no space left) stops the sampler with one fault message naming
+ * the file, instead of dropping lines silently. */
+START_TEST(sampler_write_error_is_a_fault)
+{
+    struct hal *h = new_hal();
+    struct hal_msg m;
+    cmd(h, "loadrt streamer cfg=f data=1;2;3;4 names=src");
+    cmd(h, "loadrt sampler cfg=f file=/dev/full names=log");
+    cmd(h, "net v src.pin.0 log.pin.0");
+    cmd(h, "addf src th");
+    cmd(h, "addf log th");
+    cmd(h, "start");
+    periods(h, 4);
+    ck_assert(hal_msg_take(h, &m));
+    ck_assert_int_eq(m.severity, HAL_MSG_FAULT);
+    ck_assert_str_eq(m.source, "log");
+    ck_assert_msg(strstr(m.text, "/dev/full") && strstr(m.text, "No space"), "%s", m.text);
+    ck_assert(!hal_msg_take(h, &m));                   /* once, then silence */
+    ck_assert_str_eq(get(h, "log.sample-num"), "0");
+    hal_destroy(h);
+}
+END_TEST
+
 static Suite *hal_comps_suite(void)
 {
     Suite *s = suite_create("hal_comps");
@@ -173,6 +248,8 @@ static Suite *hal_comps_suite(void)
     tcase_add_test(tc, estop_watchdog_toggles_only_while_ok);
     tcase_add_test(tc, streamer_loop_enable_and_types);
     tcase_add_test(tc, sampler_writes_only_while_enabled);
+    tcase_add_test(tc, sampler_file_replaced_atomically);
+    tcase_add_test(tc, sampler_write_error_is_a_fault);
     suite_add_tcase(s, tc);
     return s;
 }

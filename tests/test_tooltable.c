@@ -183,19 +183,73 @@ START_TEST(test_syntax_errors)
     expect_parse_error("T1 P1 D10Z0\n", TOOLTABLE_ERR_SYNTAX, 1, "space");
     expect_parse_error("T1 P1 D0x10\n", TOOLTABLE_ERR_SYNTAX, 1, "field D");
     expect_parse_error("T1 P1 Dinf\n", TOOLTABLE_ERR_SYNTAX, 1, "field D");
-    expect_parse_error("T0 P1 D10\n", TOOLTABLE_ERR_SYNTAX, 1, "T0");
+    expect_parse_error("T-1 P1 D10\n", TOOLTABLE_ERR_SYNTAX, 1, "negative");
+    expect_parse_error("TOOLNO POCKET LENGTH DIAMETER COMMENT\n1 1 +0.5 abc x\n",
+                       TOOLTABLE_ERR_SYNTAX, 2, "column 4 (D)");
+    expect_parse_error("TOOLNO POCKET WIDTH\n", TOOLTABLE_ERR_SYNTAX, 1, "WIDTH");
     expect_parse_error("T1 P1 D-10\n", TOOLTABLE_ERR_VALUE, 1, "negative diameter");
-    expect_parse_error("T1 D10\nT10001 Z0.1 D-0.1\n", TOOLTABLE_ERR_SYNTAX, 2, "wear entry");
 }
 END_TEST
 
 START_TEST(test_duplicates)
 {
-    expect_parse_error("T1 P1 D10\nT2 P2 D6\nT1 P3 D8\n", TOOLTABLE_ERR_DUPLICATE, 3,
-                       "first on line 1");
+    struct tooltable t;
+    char err[256] = "";
+    double r;
+    /* LinuxCNC uses the first of two lines for one tool (its woodpecker example has two T6);
+     * so does hexcnc, with a warning, and refuses compensation with that ambiguous tool. */
+    ck_assert_int_eq(tooltable_parse(&t, "T1 P1 D10\nT2 P2 D6\nT1 P3 D8\n", "x.tbl", err,
+                                     sizeof err), TOOLTABLE_OK);
+    ck_assert_int_eq(t.count, 2);
+    ck_assert_int_eq(tooltable_find(&t, 1)->pocket, 1);
+    ck_assert_int_eq(tooltable_find(&t, 1)->duplicate_line, 3);
+    ck_assert_int_eq(t.nwarnings, 1);
+    ck_assert_msg(!strncmp(t.warning, "x.tbl:3: tool T1 appears again (first on line 1)", 47),
+                  "%s", t.warning);
+    ck_assert_int_eq(tooltable_radius(&t, 1, &r), TOOLTABLE_ERR_DUPLICATE);
+    ck_assert_int_eq(tooltable_radius(&t, 2, &r), TOOLTABLE_OK);
     expect_parse_error("T1 D10\nT10001 D-0.1\nT10001 D-0.2\n", TOOLTABLE_ERR_DUPLICATE, 3,
                        "line 2");
-    expect_parse_error("T1 D10\nT10002 D-0.1\n", TOOLTABLE_ERR_NO_TOOL, 2, "T2");
+}
+END_TEST
+
+/* What LinuxCNC's shipped tables hold: T0, big tool numbers, wear entries with every field,
+ * T10000+n without tool n, the older headed format, header and comment lines. */
+START_TEST(test_linuxcnc_cases)
+{
+    struct tooltable t;
+    char err[256] = "";
+    ck_assert_msg(tooltable_parse(&t,
+        "; header comment\n"
+        "T0 P0 X0 Y0 Z0 A0 B0 C0 U0 V0 W0 D0 I0 J0 Q0 ;NO TOOL LOADED \n"
+        "T1 P1 X0.10000 Y0 Z0 A0 B0 C0 U0 V0 W0 D0.10000 I95.0 J155.0 Q1 ;face \n"
+        "T99999 P99999 Z+0.1 ;big tool number\n"
+        "T10005 P5 D3 ;no T5: an ordinary tool\n"
+        "T10001 P0 X0.00100 Y0 Z0.00100 A0 B0 C0 U0 V0 W0 D-0.02 I0 J0 Q0 ;Wear Offset 1 \n",
+        "lathe.tbl", err, sizeof err) == TOOLTABLE_OK, "%s", err);
+    ck_assert_int_eq(t.count, 4);                       /* T0 T1 T99999 T10005 */
+    ck_assert_ptr_nonnull(tooltable_find(&t, 0));
+    ck_assert_double_eq(tooltable_find(&t, 99999)->z_offset_mm, 0.1);
+    ck_assert_double_eq(tooltable_find(&t, 10005)->diameter_mm, 3);
+    ck_assert_ptr_null(tooltable_find(&t, 10001));      /* tool 1's wear */
+    ck_assert_double_eq(tooltable_find(&t, 1)->wear_mm, -0.02);
+    ck_assert_int_eq(tooltable_find(&t, 1)->orientation, 1);
+    ck_assert_double_eq(tooltable_find(&t, 1)->front_angle_deg, 95);
+    /* a number that would read back as something else is refused */
+    struct tool_entry e = { .tool = 10001, .pocket = 1 };
+    ck_assert_int_eq(tooltable_set(&t, &e), TOOLTABLE_ERR_DUPLICATE);
+    e.tool = 5;
+    ck_assert_int_eq(tooltable_set(&t, &e), TOOLTABLE_ERR_DUPLICATE);
+    /* LinuxCNC's older format: a header naming the columns, rows of bare numbers */
+    ck_assert_msg(tooltable_parse(&t,
+        "TOOLNO POCKET       LENGTH    DIAMETER  COMMENT\n\n"
+        "     1      1    +0.511000    0.125000  1/8 end mill\n"
+        " 99999  99999    +0.100000    0.000000  big tool number\n",
+        "gantry.tbl", err, sizeof err) == TOOLTABLE_OK, "%s", err);
+    ck_assert_int_eq(t.count, 2);
+    ck_assert_double_eq(tooltable_find(&t, 1)->z_offset_mm, 0.511);
+    ck_assert_double_eq(tooltable_find(&t, 1)->diameter_mm, 0.125);
+    ck_assert_str_eq(tooltable_find(&t, 1)->comment, "1/8 end mill");
 }
 END_TEST
 
@@ -284,6 +338,7 @@ static Suite *tooltable_suite(void)
     tcase_add_test(tc, test_save_fails_cleanly);
     tcase_add_test(tc, test_syntax_errors);
     tcase_add_test(tc, test_duplicates);
+    tcase_add_test(tc, test_linuxcnc_cases);
     tcase_add_test(tc, test_radius);
     tcase_add_test(tc, test_g10_l1);
     tcase_add_test(tc, test_full);

@@ -83,6 +83,8 @@ int cmd_interp(int argc, char **argv)
             fprintf(stderr, "error: %s\n", err);
             goto out;
         }
+        if (tt->warning[0])
+            fprintf(stderr, "warning: %s\n", tt->warning);
         interp_set_tooltable(in, tt);
     }
     struct interp_printer *pr = malloc(sizeof *pr);

@@ -1,5 +1,6 @@
 /* stream.c: `streamer` (rows of values from a file or the loadrt line onto out pins, one row
- * per period) and `sampler` (in-pin values to a file, one line per period), for graph tests. */
+ * per period) and `sampler` (in-pin values to a file, one line per period, saved atomically),
+ * for graph tests. */
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
@@ -9,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/atomicfile.h"
 #include "common/config.h"
 #include "hal/hal.h"
 
@@ -288,54 +290,113 @@ static int streamer_load(struct hal *h, int argc, char **argv)
     return hal_export_functf(h, streamer_run, s, "%s", name);
 }
 
+/* The sampler's file: written through common/atomicfile (a private temporary next to the
+ * target, renamed into place when the runtime closes), or straight into an existing FIFO or
+ * device (file=/dev/stdout, a pipe a reader follows live). */
 struct sampler {
     char cfg[STREAM_MAX_COLS + 1];
     union stream_pin pins[STREAM_MAX_COLS];    /* in: the values written each period */
     bool *enable;                              /* in: sample only while TRUE (default) */
     int32_t *sample_num;                       /* out: lines written so far */
-    FILE *f;
+    /* Written by the thread function only, read by sampler_free after the threads stop. */
+    FILE *f;                                   /* the temporary, or the FIFO / device */
+    bool failed;                               /* a write failed: no more lines, no rename */
+    /* Set at load. */
+    struct atomicfile af;                      /* the save in progress (atomic mode) */
+    bool atomic;                               /* f belongs to af */
+    bool loaded;                               /* loadrt succeeded: commit at the end */
+    struct hal *h;                             /* for the fault message */
+    char name[HAL_INST_NAME_MAX];
+    char path[PATH_MAX];
 };
 
+/* Renames the finished file into place (or drops it after a write error) and frees s. */
 static void sampler_free(void *arg)
 {
     struct sampler *s = arg;
-    if (s->f)
+    char err[PATH_MAX + 128];
+    if (s->atomic && s->loaded && !s->failed) {
+        if (atomicfile_commit(&s->af, err, sizeof err) != ATOMICFILE_OK)
+            fprintf(stderr, "sampler: %s\n", err);   /* the runtime is going: no one else */
+    } else if (s->atomic) {
+        atomicfile_abort(&s->af);
+    } else if (s->f) {
         fclose(s->f);
+    }
     free(s);
 }
 
-/* One period: one line with every column (floats %.9g, bits 0/1). */
+/* Writes one line with every column (floats %.9g, bits 0/1); false on a write error. */
+static bool sampler_line(struct sampler *s)
+{
+    int bad = 0;
+    for (int i = 0; s->cfg[i]; i++) {
+        if (i)
+            bad |= fputc(' ', s->f) == EOF;
+        switch (s->cfg[i]) {
+        case 'f': bad |= fprintf(s->f, "%.9g", *s->pins[i].f) < 0; break;
+        case 'b': bad |= fputc(*s->pins[i].b ? '1' : '0', s->f) == EOF; break;
+        case 's': bad |= fprintf(s->f, "%" PRId32, *s->pins[i].s) < 0; break;
+        default: bad |= fprintf(s->f, "%" PRIu32, *s->pins[i].u) < 0; break;
+        }
+    }
+    bad |= fputc('\n', s->f) == EOF;
+    return !bad && !ferror(s->f);
+}
+
+/* One period: one line while enabled. A write error (disk full, ...) stops the sampler
+ * with a fault message; the file it was to replace is left as it was. */
 static void sampler_run(void *arg, long period_ns)
 {
     struct sampler *s = arg;
-    if (!*s->enable)
+    (void)period_ns;
+    if (!*s->enable || s->failed)
         return;
-    for (int i = 0; s->cfg[i]; i++) {
-        if (i)
-            fputc(' ', s->f);
-        switch (s->cfg[i]) {
-        case 'f': fprintf(s->f, "%.9g", *s->pins[i].f); break;
-        case 'b': fputc(*s->pins[i].b ? '1' : '0', s->f); break;
-        case 's': fprintf(s->f, "%" PRId32, *s->pins[i].s); break;
-        default: fprintf(s->f, "%" PRIu32, *s->pins[i].u); break;
-        }
+    int e = errno;
+    errno = 0;
+    if (!sampler_line(s)) {
+        s->failed = true;
+        hal_msg_post(s->h, HAL_MSG_FAULT, s->name, "cannot write %s: %s: sampling stopped "
+                     "after %d lines%s", s->path, strerror(errno ? errno : EIO),
+                     (int)*s->sample_num, s->atomic ? ", the file is left as it was" : "");
+    } else {
+        (*s->sample_num)++;
     }
-    fputc('\n', s->f);
-    (*s->sample_num)++;
+    errno = e;
+}
+
+/* Opens the output: straight into an existing FIFO or device, else an atomic save. */
+static int sampler_open(struct hal *h, struct sampler *s)
+{
+    struct stat st;
+    char err[PATH_MAX + 128];
+    if (stat(s->path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        if (!(s->f = fopen(s->path, "w")))
+            return hal_error(h, HAL_ERR_IO, "sampler: cannot write '%s': %s", s->path,
+                             strerror(errno));
+    } else {
+        if (atomicfile_open(&s->af, s->path, err, sizeof err) != ATOMICFILE_OK)
+            return hal_error(h, HAL_ERR_IO, "sampler: %s", err);
+        s->atomic = true;
+        s->f = s->af.f;
+    }
+    setvbuf(s->f, NULL, _IOLBF, 0);        /* whole lines: a write error shows at once */
+    return HAL_OK;
 }
 
 /* loadrt sampler cfg=LETTERS file=PATH [names=NAME]. */
 static int sampler_load(struct hal *h, int argc, char **argv)
 {
     const char *cfg = hal_arg(argc, argv, "cfg"), *file = hal_arg(argc, argv, "file");
-    char name[HAL_INST_NAME_MAX], path[PATH_MAX];
+    char path[PATH_MAX];
     int ncols, st = hal_args_check(h, "sampler", argc, argv, "cfg,file,names");
     if (st == HAL_OK)
         st = stream_cfg(h, "sampler", cfg, &ncols);
     if (st != HAL_OK)
         return st;
     if (!file || hal_path_resolve(h, file, path, sizeof path) != HAL_OK)
-        return hal_error(h, HAL_ERR_ARG, "loadrt sampler: needs file=PATH");
+        return hal_error(h, HAL_ERR_ARG, "loadrt sampler: needs file=PATH (shorter than %d "
+                         "characters)", PATH_MAX);
     struct sampler *s = calloc(1, sizeof *s);
     if (!s)
         return hal_error(h, HAL_ERR_NOMEM, "loadrt sampler: out of memory");
@@ -344,20 +405,23 @@ static int sampler_load(struct hal *h, int argc, char **argv)
         return st;
     }
     snprintf(s->cfg, sizeof s->cfg, "%s", cfg);
-    if (!(s->f = fopen(path, "w")))
-        return hal_error(h, HAL_ERR_IO, "sampler: cannot write '%s': %s", path,
-                         strerror(errno));
-    setvbuf(s->f, NULL, _IOLBF, 0);        /* whole lines, so others can read it live */
-    stream_name(h, "sampler", argc, argv, name, sizeof name);
-    st = stream_pins(h, name, cfg, HAL_IN, s->pins);
+    memcpy(s->path, path, sizeof path);
+    s->h = h;
+    if ((st = sampler_open(h, s)) != HAL_OK)
+        return st;
+    stream_name(h, "sampler", argc, argv, s->name, sizeof s->name);
+    st = stream_pins(h, s->name, cfg, HAL_IN, s->pins);
     if (st == HAL_OK)
-        st = hal_pin_bit_newf(h, HAL_IN, &s->enable, "%s.enable", name);
+        st = hal_pin_bit_newf(h, HAL_IN, &s->enable, "%s.enable", s->name);
     if (st == HAL_OK)
-        st = hal_pin_s32_newf(h, HAL_OUT, &s->sample_num, "%s.sample-num", name);
+        st = hal_pin_s32_newf(h, HAL_OUT, &s->sample_num, "%s.sample-num", s->name);
+    if (st == HAL_OK)
+        st = hal_export_functf(h, sampler_run, s, "%s", s->name);
     if (st != HAL_OK)
         return st;
     *s->enable = true;
-    return hal_export_functf(h, sampler_run, s, "%s", name);
+    s->loaded = true;
+    return HAL_OK;
 }
 
 const struct hal_comp_type hal_comp_streamer = { "streamer", streamer_load };
