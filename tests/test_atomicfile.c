@@ -13,60 +13,7 @@
 #include <unistd.h>
 
 #include "common/atomicfile.h"
-
-/* A fresh folder for one test. */
-static void make_dir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/hexcnc_atomic_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(dir));
-}
-
-/* Entries in dir whose name contains `part` ("" for all). */
-static int count_entries(const char *dir, const char *part)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    ck_assert_ptr_nonnull(d);
-    while ((e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..") && strstr(e->d_name, part);
-    closedir(d);
-    return n;
-}
-
-/* Removes dir and the files in it (one level). */
-static void rm_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    char p[4200];
-    while (d && (e = readdir(d))) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-            continue;
-        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        unlink(p);
-    }
-    if (d)
-        closedir(d);
-    rmdir(dir);
-}
-
-static void write_plain(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void read_all(const char *path, char *buf, size_t len)
-{
-    FILE *f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    size_t n = fread(buf, 1, len - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-}
+#include "test_file_util.h"
 
 /* Mode kept, new file from the umask, the temporary's name, nothing left behind. */
 START_TEST(mode_kept_and_temporary_named)
@@ -76,17 +23,17 @@ START_TEST(mode_kept_and_temporary_named)
     struct atomicfile a;
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/t.txt", dir);
-    write_plain(path, "old\n");
+    write_file(path, "old\n");
     ck_assert_int_eq(chmod(path, 0640), 0);
     ck_assert_int_eq(atomicfile_open(&a, path, err, sizeof err), ATOMICFILE_OK);
     char want[160];
     snprintf(want, sizeof want, "%s/.t.txt.hexcnc-%ld-", dir, (long)getpid());
     ck_assert_msg(!strncmp(a.tmp, want, strlen(want)), "%s", a.tmp);
     fputs("new\n", a.f);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "old\n");                 /* nothing visible before the commit */
     ck_assert_int_eq(atomicfile_commit(&a, err, sizeof err), ATOMICFILE_OK);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "new\n");
     ck_assert_int_eq(stat(path, &st), 0);
     ck_assert_uint_eq(st.st_mode & 07777, 0640);
@@ -111,12 +58,12 @@ START_TEST(read_only_and_special_refused)
     struct atomicfile a;
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/ro.tbl", dir);
-    write_plain(path, "keep\n");
+    write_file(path, "keep\n");
     ck_assert_int_eq(chmod(path, 0444), 0);
     ck_assert_int_eq(atomicfile_write(path, "x", 1, err, sizeof err), ATOMICFILE_ERR_READ_ONLY);
     ck_assert_msg(strstr(err, path) && strstr(err, "read-only") && strstr(err, "0444"), "%s",
                   err);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "keep\n");
     ck_assert_int_eq(stat(path, &st), 0);
     ck_assert_uint_eq(st.st_mode & 07777, 0444);
@@ -128,7 +75,7 @@ START_TEST(read_only_and_special_refused)
     ck_assert_int_eq(atomicfile_open(&a, path, err, sizeof err), ATOMICFILE_OK);
     fputs("half", a.f);
     atomicfile_abort(&a);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "keep\n");
     ck_assert_int_eq(count_entries(dir, ".hexcnc-"), 0);
     rm_dir(dir);
@@ -143,12 +90,12 @@ START_TEST(symlink_target_replaced)
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/real.var", dir);
     snprintf(link_path, sizeof link_path, "%s/link.var", dir);
-    write_plain(path, "old\n");
+    write_file(path, "old\n");
     ck_assert_int_eq(symlink("real.var", link_path), 0);
     ck_assert_int_eq(atomicfile_write(link_path, "new\n", 4, err, sizeof err), ATOMICFILE_OK);
     ck_assert_int_eq(lstat(link_path, &st), 0);
     ck_assert(S_ISLNK(st.st_mode));
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "new\n");
     rm_dir(dir);
 }
@@ -162,7 +109,7 @@ START_TEST(concurrent_savers)
     enum { SAVES = 300, LINES = 200 };
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/shared.var", dir);
-    write_plain(path, "start\n");
+    write_file(path, "start\n");
     pid_t kids[2];
     for (int k = 0; k < 2; k++) {
         kids[k] = fork();
@@ -219,7 +166,7 @@ START_TEST(stale_temporaries_removed)
     char dir[64], path[128], err[512];
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/tool.tbl", dir);
-    write_plain(path, "T1 P1 D1\n");
+    write_file(path, "T1 P1 D1\n");
     for (int k = 0; k < 200; k++) {
         pid_t pid = fork();
         ck_assert_int_ge(pid, 0);
@@ -282,7 +229,7 @@ START_TEST(long_path)
     ck_assert_uint_gt(strlen(path), 511);
     ck_assert_int_eq(atomicfile_write(path, "v1\n", 3, err, sizeof err), ATOMICFILE_OK);
     ck_assert_int_eq(atomicfile_write(path, "v2\n", 3, err, sizeof err), ATOMICFILE_OK);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "v2\n");
     path[n] = '\0';
     ck_assert_int_eq(count_entries(path, ""), 1);
@@ -303,7 +250,7 @@ START_TEST(write_error_fails_cleanly)
     char dir[64], path[128], err[512] = "", text[64];
     make_dir(dir, sizeof dir);
     snprintf(path, sizeof path, "%s/p.var", dir);
-    write_plain(path, "old\n");
+    write_file(path, "old\n");
     pid_t pid = fork();
     ck_assert_int_ge(pid, 0);
     if (pid == 0) {
@@ -320,7 +267,7 @@ START_TEST(write_error_fails_cleanly)
     ck_assert_int_eq(waitpid(pid, &status, 0), pid);
     ck_assert(WIFEXITED(status));
     ck_assert_int_eq(WEXITSTATUS(status), 0);
-    read_all(path, text, sizeof text);
+    read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "old\n");
     ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);

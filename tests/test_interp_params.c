@@ -13,58 +13,8 @@
 #include <unistd.h>
 
 #include "interp/interp_int.h"
+#include "test_file_util.h"
 #include "test_interp_util.h"
-
-static void make_dir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/hexcnc_params_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(dir));
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void read_file(const char *path, char *buf, size_t len)
-{
-    FILE *f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    size_t n = fread(buf, 1, len - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-}
-
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    ck_assert_ptr_nonnull(d);
-    while ((e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    closedir(d);
-    return n;
-}
-
-static void rm_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    char p[600];
-    while (d && (e = readdir(d))) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-            continue;
-        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        unlink(p);
-    }
-    if (d)
-        closedir(d);
-    rmdir(dir);
-}
 
 /* Runs a program on in, then saves the persistent parameters as the machine does once the
  * program's settings have executed (interpreting alone writes nothing); returns the status. */
@@ -141,7 +91,7 @@ START_TEST(planted_symlink_not_followed)
     ck_assert_str_eq(text, "precious\n");
     read_file(path, text, sizeof text);
     ck_assert_ptr_nonnull(strstr(text, "5161\t"));
-    ck_assert_int_eq(count_entries(dir), 3);              /* var, the planted link, victim */
+    ck_assert_int_eq(count_entries(dir, ""), 3);              /* var, the planted link, victim */
     rm_dir(dir);
 }
 END_TEST
@@ -197,7 +147,7 @@ START_TEST(concurrent_saves)
         }
     }
     ck_assert_int_eq(incomplete, 0);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
@@ -218,7 +168,7 @@ START_TEST(read_only_refused)
     interp_destroy(in);
     read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "5161 1.5\n");
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
@@ -250,7 +200,7 @@ START_TEST(write_error_reported)
     ck_assert_int_eq(WEXITSTATUS(status), 0);
     read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "5161 1.5\n");
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST

@@ -8,50 +8,7 @@
 #include <unistd.h>
 
 #include "interp/tooltable.h"
-
-/* A fresh folder for this test's files (removed by rm_dir). */
-static void make_dir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/hexcnc_tooltable_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(dir));
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-/* Number of entries in dir (to see that no temporary file is left behind). */
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    ck_assert_ptr_nonnull(d);
-    while ((e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    closedir(d);
-    return n;
-}
-
-static void rm_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    char p[600];
-    while (d && (e = readdir(d))) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-            continue;
-        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        unlink(p);
-    }
-    if (d)
-        closedir(d);
-    rmdir(dir);
-}
+#include "test_file_util.h"
 
 static const char paper_table[] =
     "; the paper's tools\n"
@@ -109,7 +66,7 @@ START_TEST(test_save_round_trip)
     snprintf(old_link, sizeof old_link, "%s/old.tbl", dir);
     ck_assert_int_eq(link(path, old_link), 0);
     ck_assert_int_eq(tooltable_save(&t, path, err, sizeof err), TOOLTABLE_OK);
-    ck_assert_int_eq(count_entries(dir), 2); /* tool.tbl and old.tbl: no temporary left */
+    ck_assert_int_eq(count_entries(dir, ""), 2); /* tool.tbl and old.tbl: no temporary left */
     ck_assert_int_eq(tooltable_load(&u, old_link, err, sizeof err), TOOLTABLE_OK);
     ck_assert_double_eq(tooltable_find(&u, 3)->wear_mm, 0.0);
     unlink(old_link);

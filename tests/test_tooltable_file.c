@@ -12,57 +12,7 @@
 #include <unistd.h>
 
 #include "interp/tooltable.h"
-
-static void make_dir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/hexcnc_ttfile_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(dir));
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void read_file(const char *path, char *buf, size_t len)
-{
-    FILE *f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    size_t n = fread(buf, 1, len - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-}
-
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    ck_assert_ptr_nonnull(d);
-    while ((e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    closedir(d);
-    return n;
-}
-
-static void rm_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    char p[600];
-    while (d && (e = readdir(d))) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-            continue;
-        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        unlink(p);
-    }
-    if (d)
-        closedir(d);
-    rmdir(dir);
-}
+#include "test_file_util.h"
 
 /* Lines of a and b that differ (same line count expected); *which gets the last one. */
 static int lines_changed(const char *a, const char *b, int *which)
@@ -129,7 +79,7 @@ START_TEST(rewrite_changes_one_line)
     ck_assert_double_eq(tooltable_find(&u, 2)->wear_mm, -0.01);
     ck_assert_double_eq(tooltable_find(&u, 1)->wear_mm, -0.04);
     ck_assert_double_eq(tooltable_find(&u, 12)->diameter_mm, 7);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
@@ -157,7 +107,7 @@ START_TEST(read_only_refused_mode_kept)
     ck_assert_int_eq(tooltable_save(&t, path, err, sizeof err), TOOLTABLE_OK);
     ck_assert_int_eq(stat(path, &st), 0);
     ck_assert_uint_eq(st.st_mode & 07777, 0640);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
@@ -184,7 +134,7 @@ START_TEST(long_path_not_cut)
     read_file(path, text, sizeof text);
     ck_assert_str_eq(text, "T1 P1 D8\n");
     path[n] = '\0';
-    ck_assert_int_eq(count_entries(path), 1);
+    ck_assert_int_eq(count_entries(path, ""), 1);
     for (int k = 0; k < 5; k++) {
         rm_dir(path);
         path[strlen(path) - strlen(strrchr(path, '/'))] = '\0';
@@ -221,7 +171,7 @@ START_TEST(write_error_keeps_table)
     ck_assert_int_eq(WEXITSTATUS(status), 0);
     read_file(path, text, sizeof text);
     ck_assert_str_eq(text, lcnc_table);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
@@ -241,9 +191,9 @@ START_TEST(load_removes_stale_temporary)
     ck_assert_int_eq(waitpid(pid, NULL, 0), pid);
     snprintf(stale, sizeof stale, "%s/.tool.tbl.hexcnc-%ld-AbC123", dir, (long)pid);
     write_file(stale, "T1 P1 D");
-    ck_assert_int_eq(count_entries(dir), 2);
+    ck_assert_int_eq(count_entries(dir, ""), 2);
     ck_assert_int_eq(tooltable_load(&t, path, err, sizeof err), TOOLTABLE_OK);
-    ck_assert_int_eq(count_entries(dir), 1);
+    ck_assert_int_eq(count_entries(dir, ""), 1);
     rm_dir(dir);
 }
 END_TEST
