@@ -130,7 +130,7 @@ static int tooltable_write_row(FILE *f, const struct tool_entry *e,
                                char *err, size_t errlen)
 {
     char n[40];
-    for (const char *c = TOOLTABLE_LETTERS + 1; *c; c++)
+    for (const char *c = &TOOLTABLE_LETTERS[1]; *c; c++)
         if (!strchr(fmt->cols, *c) && tooltable_field_value(e, *c) != (*c == 'P' ? e->tool : 0))
             return errbuf_set(err, errlen, TOOLTABLE_ERR_IO, "%s: tool T%d needs a field %c, "
                               "which this table's columns (header line) cannot hold: not "

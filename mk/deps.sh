@@ -4,10 +4,11 @@
 # libceres-dev: Ceres Solver, the least squares of `hexcnc calibrate fit` (docs/calibration.md).
 # linuxcnc-uspace is there for tests only: its `rs274` and the programs and tool tables it
 # ships are the reference that hexcnc's G-code and tool-table reading are compared with.
+# clang links the libFuzzer target of the interpreter (`make fuzz`; `make test` links it too).
 # mbpoll is there for tests only: a third-party Modbus client for `hexcnc modbus_sim`.
 set -eu
 PKGS="build-essential pkg-config check libmodbus-dev libeigen3-dev liblcm-dev liblcm-bin \
-libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll libceres-dev"
+libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll libceres-dev clang"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
