@@ -82,6 +82,7 @@ struct canon_cmd {
                                           * interpreter's); canon_prog_sink keeps a copy */
     int has_n;             /* the source block had an N word (for printers) */
     int n_number;          /* its value */
+    int n_digits;          /* digits as written, leading zeros kept (N0100: 4), for printers */
 };
 
 /* Where the interpreter sends commands. Return 0 to continue, non-zero to stop the

@@ -17,6 +17,7 @@ void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
     c->file = in->file;
     c->has_n = in->blk.n_present;
     c->n_number = in->blk.n_number;
+    c->n_digits = in->blk.n_digits;
 }
 
 /* Hands a command to the sink; a refusal stops the run. */

@@ -43,6 +43,7 @@ struct interp_block {
     double assign_val[INTERP_MAX_ASSIGN];
     int n_present;               /* the block has an N word */
     int n_number;
+    int n_digits;                /* digits the N word was written with (N0100: 4), 0 if none */
     int has_comment;
     char comment[256];           /* last ( ) comment of the line, as written */
 };

@@ -144,6 +144,9 @@ static int read_word(struct interp *in, int *pos)
         k++;
     if (in->norm[*pos] == 0 || (k > *pos && in->norm[k] != '['))
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value", c - 32);
+    int digits = 0;  /* an N word keeps the digits it was written with, as rs274 prints it */
+    while (in->norm[*pos + digits] >= '0' && in->norm[*pos + digits] <= '9')
+        digits++;
     double v;
     CHP(interp_read_value(in, pos, &v));
     if (!isfinite(v))
@@ -162,6 +165,7 @@ static int read_word(struct interp *in, int *pos)
             return interp_fail(in, INTERP_ERR_WORD, col, "negative N line number %d",
                                b->n_number);
         b->n_present = 1;
+        b->n_digits = digits;
         return 0;
     }
     k = c - 'a';

@@ -58,15 +58,22 @@ static size_t put_int(char *out, long n, int width, int left)
     return len + pad;
 }
 
-/* The first columns: rs274's output counter (%5d) and the N number ("N%-5d") or "N.....". */
+/* The first columns: rs274's output counter (%5d) and the N number as written (leading
+ * zeros kept, left-aligned in 5 columns) or "N.....". */
 static void line_start(struct interp_printer *p, const struct canon_cmd *c)
 {
-    char tmp[64];
+    char tmp[112];  /* counter, 'N', at most 30 leading zeros and an int, blanks */
     size_t n = put_int(tmp, ++p->seq, 5, 0);
     tmp[n++] = ' ';
     tmp[n++] = 'N';
     if (c && c->has_n) {
-        n += put_int(tmp + n, c->n_number, 5, 1);
+        size_t start = n;
+        int len = snprintf(tmp + n, 32, "%d", c->n_number);
+        for (int z = len; z < c->n_digits && z < 30; z++)
+            tmp[n++] = '0';          /* the leading zeros it was written with */
+        n += (size_t)snprintf(tmp + n, 32, "%d", c->n_number);
+        while (n - start < 5)
+            tmp[n++] = ' ';
     } else {
         memcpy(tmp + n, ".....", 5);
         n += 5;

@@ -1,0 +1,52 @@
+#!/bin/sh
+# linuxcnc_corpus.sh: every G-code program LinuxCNC ships (Debian linuxcnc-uspace:
+# /usr/share/linuxcnc/ncfiles and /usr/share/doc/linuxcnc/examples; lathe programs aside) run
+# through LinuxCNC's `rs274 -g` and `hexcnc interp`, each in the program's folder. Of the
+# programs rs274 accepts, it counts those hexcnc accepts and those whose motion lines
+# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL, with the N column) are identical, and
+# lists hexcnc's refusals grouped by their message. It fails when either count falls below
+# the figures recorded here (raise them as the interpreter learns more); it prints SKIP
+# where rs274 or the programs are not installed.
+root=${HEXCNC_ROOT:-.}
+bin=${HEXCNC_BIN:-$root/bin/hexcnc}
+MIN_ACCEPTED=14      # of the programs rs274 accepts (measured: 14 of 169)
+MIN_IDENTICAL=13     # of those, motion identical to rs274's (measured: 13)
+if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ]; then
+    echo "SKIP linuxcnc_corpus: rs274 or LinuxCNC's programs are not installed (linuxcnc-uspace)"
+    exit 0
+fi
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL' | cut -c7-; }
+find /usr/share/linuxcnc/ncfiles /usr/share/doc/linuxcnc/examples -name '*.ngc' |
+    grep -vi lathe | sort > "$tmp/list"
+total=0; reference=0; accepted=0; identical=0
+: > "$tmp/refused"
+while IFS= read -r f; do
+    total=$((total + 1))
+    d=$(dirname "$f"); b=$(basename "$f")
+    (cd "$d" && timeout 20 rs274 -g "$b" < /dev/null > "$tmp/rs.out" 2> /dev/null) || continue
+    reference=$((reference + 1))
+    if ! (cd "$d" && timeout 20 "$bin" interp "$b" < /dev/null > "$tmp/hx.out" 2> "$tmp/hx.err")
+    then
+        msg=$(head -1 "$tmp/hx.err" | sed -E 's/^[^:]*:[0-9]+(:[0-9]+)?: (error: )?//' | cut -c1-90)
+        printf '%s\t%s\n' "$msg" "$f" >> "$tmp/refused"
+        continue
+    fi
+    accepted=$((accepted + 1))
+    motion < "$tmp/rs.out" > "$tmp/rs.m"
+    motion < "$tmp/hx.out" > "$tmp/hx.m"
+    if cmp -s "$tmp/rs.m" "$tmp/hx.m"; then
+        identical=$((identical + 1))
+    else
+        echo "differs from rs274: $f (first difference: $(diff "$tmp/rs.m" "$tmp/hx.m" | sed -n 2p))"
+    fi
+done < "$tmp/list"
+echo "refused by hexcnc, by message (count, message):"
+cut -f1 "$tmp/refused" | sort | uniq -c | sort -rn
+echo "linuxcnc_corpus: $total programs, $reference accepted by rs274; hexcnc accepts $accepted" \
+     "of those, $identical with identical motion"
+fails=0
+[ "$accepted" -ge "$MIN_ACCEPTED" ] || { echo "FAIL accepted $accepted < $MIN_ACCEPTED"; fails=1; }
+[ "$identical" -ge "$MIN_IDENTICAL" ] || { echo "FAIL identical $identical < $MIN_IDENTICAL"; fails=1; }
+[ "$fails" -eq 0 ]
