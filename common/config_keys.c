@@ -153,6 +153,10 @@ const struct config_key config_keys[] = {
     { "RS274NGC", "TOOL_TABLE", PATH, "", "", 0, 0, "", "tool table (LinuxCNC's format)" },
     { "RS274NGC", "PARAMETER_FILE", PATH, "", "", 0, 0, "", "numbered parameters kept "
       "between runs" },
+    { "RS274NGC", "SUBROUTINE_PATH", STR, "", "", 0, 0, "", "folders (':' separated, relative "
+      "to the INI) where `o<name> call` finds name.ngc, after the program's folder" },
+    { "RS274NGC", "LOOP_LIMIT", INT, "", "> 0", 0, 0, "10000000", "loop iterations (while, "
+      "do, repeat) one program may run before it is refused as a loop that never ends" },
     { "EMCIO", "TOOL_TABLE", PATH, "", "", 0, 0, "", "tool table, when [RS274NGC] has none "
       "(LinuxCNC's place for it)" },
 

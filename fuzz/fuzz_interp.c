@@ -44,6 +44,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     interp_set_tooltable(in, &tt);
     interp_set_block_delete(in, size & 1);
+    interp_set_loop_limit(in, 10000);  /* a loop that never ends fails fast, not at 10^7 */
     interp_printer_init(&pr, in, 4, discard, NULL);
     interp_run_text(in, "fuzz.ngc", (const char *)data, size, interp_printer_sink, &pr);
     interp_printer_flush(&pr);

@@ -97,6 +97,7 @@ void interp_destroy(struct interp *in)
     if (!in)
         return;
     interp_named_free(in);
+    oword_free(in);
     comp5_free(&in->comp);
     free(in->param_path);
     free(in);
@@ -156,6 +157,21 @@ void interp_set_feed_factor(struct interp *in, double mm_min_per_f_unit)
 void interp_set_block_delete(struct interp *in, int on)
 {
     in->block_delete = on != 0;
+}
+
+/* Folders (':' separated) where o<name> call finds name.ngc after the program's folder. */
+int interp_set_subroutine_path(struct interp *in, const char *path)
+{
+    free(in->ow.path);
+    in->ow.path = path ? strdup(path) : NULL;
+    return path && !in->ow.path ? INTERP_ERR_NOMEM : INTERP_OK;
+}
+
+/* How many loop iterations (while, do, repeat) one program may run: more is a runaway
+ * program, refused with the loop's label. Default OWORD_LOOP_LIMIT. */
+void interp_set_loop_limit(struct interp *in, long iterations)
+{
+    in->ow.loop_limit = iterations > 0 ? iterations : OWORD_LOOP_LIMIT;
 }
 
 /* The operator's stop request, checked before every line. */
@@ -231,17 +247,22 @@ static int percent_line(struct interp *in, int first)
     return 0;
 }
 
-/* Reads and runs every line until the end of the text or of the program. */
+/* Reads and runs every line until the end of the text or of the program; O-words move the
+ * line to read next (oword.c). */
 static int run_lines(struct interp *in, const char *text, size_t len)
 {
-    const char *p = text, *end = text + len;
     int first = 1;
-    if (len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3))
-        p += 3;  /* a UTF-8 byte order mark, as editors on Windows write: not part of line 1 */
-    while (p < end && !in->ended) {
-        const char *nl = memchr(p, '\n', (size_t)(end - p));
-        size_t l = nl ? (size_t)(nl - p) : (size_t)(end - p);
-        in->line++;
+    if (len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3)) {
+        text += 3;  /* a UTF-8 byte order mark, as editors on Windows write: not part of line 1 */
+        len -= 3;
+    }
+    CHP(oword_begin(in, text, len));
+    const char *p;
+    size_t l;
+    int more;
+    while (!in->ended && (more = oword_next_line(in, &p, &l)) != 0) {
+        if (more < 0)
+            return in->err.status;
         if (in->cancel && *in->cancel)
             return interp_fail(in, INTERP_ERR_CANCELLED, 0, "stopped by the operator while "
                                "reading the program");
@@ -252,10 +273,12 @@ static int run_lines(struct interp *in, const char *text, size_t len)
             CHP(percent_line(in, first));
         else if (kind == 1)
             CHP(interp_execute(in));
+        else if (kind == 3)
+            CHP(oword_execute(in));
         if (kind == 2 || in->norm[0] || in->blk.has_comment)
             first = 0;
-        p = nl ? nl + 1 : end;
     }
+    CHP(oword_end(in));
     /* A program opened by % and not closed is a truncated file, as rs274 says ("File ended
      * with no percent sign"): refused, so that no motion starts on it. */
     if (!in->ended && in->pct_open)
@@ -291,6 +314,12 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
     memset(&in->err, 0, sizeof in->err);
     snprintf(in->file, sizeof in->file, "%s", path);
     in->line = 0;
+    free(in->ow.dir);  /* o<name> call looks for name.ngc beside the program first */
+    const char *slash = strrchr(path, '/');
+    in->ow.dir = slash ? strndup(path, (size_t)(slash - path == 0 ? 1 : slash - path))
+                       : strdup(".");
+    if (!in->ow.dir)
+        return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory");
     FILE *f = fopen(path, "rb");
     if (!f)
         return interp_fail(in, INTERP_ERR_IO, 0, "cannot open the program: %s", strerror(errno));

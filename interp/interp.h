@@ -57,6 +57,11 @@ int interp_set_param_file(struct interp *in, const char *path);
 /* Loads a parameter file as interp_set_param_file() does but remembers no file to save to,
  * so that even interp_setting_apply() leaves the machine's offsets as they are. */
 int interp_load_param_file(struct interp *in, const char *path);
+/* Folders, ':' separated, where `o<name> call` looks for name.ngc when the program does not
+ * define the subroutine (after the program's own folder). NULL: none. */
+int interp_set_subroutine_path(struct interp *in, const char *path);
+/* Loop iterations one program may run before it is refused as a runaway (default 10^7). */
+void interp_set_loop_limit(struct interp *in, long iterations);
 /* Tool table for T/M6, G43 H and the D word of G141/G142; not owned. NULL: no table. */
 void interp_set_tooltable(struct interp *in, struct tooltable *tt);
 /* F multiplier for metric programs: 1 for FEED_UNITS = mm/min, 1000 for m/min. */

@@ -64,6 +64,54 @@ struct named_table {
     size_t nslot;
 };
 
+/* O-words (oword.c): the texts lines are read from, the open conditions and loops, the
+ * subroutines known so far and the calls in progress. Positions are (text, line index). */
+#define OWORD_LABEL_MAX 72       /* "123" or "<name>" as normalised, with the brackets */
+#define OWORD_MAX_CALLS 64       /* subroutine nesting (recursion included) */
+#define OWORD_LOOP_LIMIT 10000000L /* loop iterations in one program: more is a runaway */
+struct ow_text {
+    char *owned;                 /* the text, when read from a subroutine file, else NULL */
+    const char *text;
+    size_t len;
+    size_t *off;                 /* where each line starts */
+    int nlines;
+    char file[256];              /* for messages */
+};
+struct ow_ctl {                  /* an open if, while, do or repeat */
+    char label[OWORD_LABEL_MAX];
+    int kind;                    /* OW_IF, OW_WHILE, OW_DO, OW_REPEAT */
+    int text, idx;               /* the opening line */
+    long count;                  /* repeat: iterations left */
+    int done;                    /* if: a branch has run */
+};
+struct ow_sub {                  /* a subroutine: where its `sub` line is */
+    char label[OWORD_LABEL_MAX];
+    int text, idx;
+};
+struct ow_call {                 /* a call in progress */
+    char label[OWORD_LABEL_MAX];
+    int text, idx;               /* where to go on when it returns */
+    int nctl;                    /* the open constructs of the caller */
+    double args[30];             /* the caller's #1..#30 */
+    struct named_entry *locals;  /* the caller's local named parameters */
+    size_t nlocals;
+};
+struct oword {
+    struct ow_text *texts;       /* [0] is the program */
+    int ntexts, captexts;
+    struct ow_ctl *ctl;
+    int nctl, capctl;
+    struct ow_sub *subs;
+    int nsubs, capsubs;
+    struct ow_call *calls;       /* [OWORD_MAX_CALLS], allocated at the first call */
+    int ncalls;
+    int text, idx;               /* the next line to read */
+    long loops;                  /* loop iterations so far */
+    long loop_limit;
+    char *path;                  /* folders searched for o<name> call files, ':' separated */
+    char *dir;                   /* the program's folder */
+};
+
 struct interp {
     /* configuration */
     double start[6];             /* initial machine pose, mm/deg */
@@ -121,6 +169,7 @@ struct interp {
     double spindle_rpm;
     double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
 
+    struct oword ow;             /* O-word control flow */
     struct comp5 comp;           /* G141/G142 run in progress */
     struct interp_block blk;     /* the block being worked on */
     char norm[INTERP_LINE_MAX];  /* the line lowercased without spaces and comments */
@@ -132,7 +181,7 @@ int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
 /* lexer.c: reads one raw line into in->blk (evaluating expressions). *kind: 1 = a block
- * to run, 0 = nothing (deleted line), 2 = a lone '%'. Returns a status. */
+ * to run, 0 = nothing (deleted line), 2 = a lone '%', 3 = an O-word line (in->norm). */
 int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind);
 /* expr.c: reads a real value at norm[*pos] ([expr], #n, function, number). */
 int interp_read_value(struct interp *in, int *pos, double *out);
@@ -148,6 +197,14 @@ int interp_named_target(struct interp *in, const char *name, int len, int col, i
 void interp_named_set(struct interp *in, int entry, double v);
 void interp_named_clear_locals(struct interp *in);
 void interp_named_free(struct interp *in);
+/* oword.c */
+int oword_begin(struct interp *in, const char *text, size_t len);
+int oword_next_line(struct interp *in, const char **line, size_t *len);
+int oword_execute(struct interp *in);
+int oword_end(struct interp *in);
+void oword_free(struct interp *in);
+int interp_named_push_locals(struct interp *in, struct named_entry **saved, size_t *nsaved);
+int interp_named_pop_locals(struct interp *in, struct named_entry *saved, size_t nsaved);
 /* predef.c: 1 and *out = its value when name is one of the read-only #<_...> parameters. */
 int interp_predefined(const struct interp *in, const char *name, int len, double *out);
 

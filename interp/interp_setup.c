@@ -1,9 +1,11 @@
-/* interp_setup.c: reads [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE and applies them. */
+/* interp_setup.c: reads [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE, SUBROUTINE_PATH and
+ * LOOP_LIMIT and applies them. */
 #include "interp/interp_setup.h"
 
 #include <stdio.h>
 #include <string.h>
 
+#include "common/config.h"
 #include "common/errbuf.h"
 #include "interp/interp.h"
 #include "interp/tooltable.h"
@@ -45,6 +47,32 @@ int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, voi
     if (st == INTERP_OK)
         st = setup_path("RS274NGC", "PARAMETER_FILE", get(ctx, "RS274NGC", "PARAMETER_FILE"),
                         dir, s->param_file, sizeof s->param_file, err, errlen);
+    /* SUBROUTINE_PATH: ':'-separated folders, each relative to the INI's folder */
+    const char *sp = get(ctx, "RS274NGC", "SUBROUTINE_PATH");
+    for (size_t used = 0; st == INTERP_OK && sp && *sp;) {
+        const char *e = strchr(sp, ':');
+        size_t l = e ? (size_t)(e - sp) : strlen(sp);
+        char one[1024], folder[1100];
+        snprintf(one, sizeof one, "%.*s", (int)(l < sizeof one ? l : sizeof one - 1), sp);
+        st = setup_path("RS274NGC", "SUBROUTINE_PATH", one, dir, folder, sizeof folder, err,
+                        errlen);
+        int n = st ? 0 : snprintf(s->subroutine_path + used, sizeof s->subroutine_path - used,
+                                  "%s%s", used ? ":" : "", folder);
+        if (!st && (n < 0 || used + (size_t)n >= sizeof s->subroutine_path))
+            st = errbuf_set(err, errlen, INTERP_ERR_CONFIG, "[RS274NGC] SUBROUTINE_PATH is "
+                            "longer than %zu characters", sizeof s->subroutine_path - 1);
+        used += st ? 0 : (size_t)n;
+        sp = e ? e + 1 : sp + l;
+    }
+    const char *lim = get(ctx, "RS274NGC", "LOOP_LIMIT");
+    if (st == INTERP_OK && lim && lim[0]) {
+        char why[200];
+        long v = 0;
+        if (config_parse_integer(lim, &v, why, sizeof why) != 0 || v <= 0)
+            st = errbuf_set(err, errlen, INTERP_ERR_CONFIG, "[RS274NGC] LOOP_LIMIT = %s: a "
+                            "whole number of loop iterations above 0 is expected", lim);
+        s->loop_limit = v;
+    }
     return st;
 }
 
@@ -53,6 +81,10 @@ int interp_settings_apply(struct interp *in, const struct interp_settings *s,
                           struct tooltable *tt, unsigned flags, char *err, size_t errlen)
 {
     interp_set_feed_factor(in, s->feed_factor);
+    if (s->subroutine_path[0] && interp_set_subroutine_path(in, s->subroutine_path))
+        return errbuf_set(err, errlen, INTERP_ERR_NOMEM, "out of memory");
+    if (s->loop_limit > 0)
+        interp_set_loop_limit(in, s->loop_limit);
     if (tt && s->tool_table[0]) {
         char msg[600];
         if (tooltable_load(tt, s->tool_table, msg, sizeof msg) != TOOLTABLE_OK)

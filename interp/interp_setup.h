@@ -16,6 +16,8 @@ struct interp_settings {
     double feed_factor;            /* mm/min per F unit: 1 (mm/min, the default) or 1000 */
     char tool_table[1024];         /* [RS274NGC] TOOL_TABLE, else [EMCIO] TOOL_TABLE; "" = none */
     char param_file[1024];         /* [RS274NGC] PARAMETER_FILE; "" = none */
+    char subroutine_path[4096];    /* [RS274NGC] SUBROUTINE_PATH, folders made absolute */
+    long loop_limit;               /* [RS274NGC] LOOP_LIMIT: loop iterations in one program */
 };
 
 /* Flags of interp_settings_apply() and interp_setup(). */

@@ -126,7 +126,7 @@ static int read_word(struct interp *in, int *pos)
     int col = in->normcol[*pos], first = *pos == 0;
     if (c == 'o')
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, col,
-                           "O-words (subroutines, loops, conditions) are not supported yet");
+                           "an O-word (o100 if, o<name> call, ...) must start its line");
     if (c == 'u' || c == 'v')
         return interp_fail(in, INTERP_ERR_WORD, col,
                            "this machine has no %c axis (axes are X Y Z A B C)", c - 32);
@@ -195,6 +195,10 @@ int interp_read_line(struct interp *in, const char *raw, size_t len, int *kind)
     CHP(normalise(in, raw, len, i, &n));
     if (n == 1 && in->norm[0] == '%') {
         *kind = 2;
+        return INTERP_OK;
+    }
+    if (in->norm[0] == 'o') {  /* an O-word line: control flow, run by oword.c */
+        *kind = 3;
         return INTERP_OK;
     }
     for (int pos = 0; pos < n;) {

@@ -174,6 +174,69 @@ void interp_named_clear_locals(struct interp *in)
     fill_index(t);
 }
 
+/* A subroutine call starts with no local names: the caller's locals (those not starting with
+ * '_') move out of the table into *saved (the caller keeps them in its call frame). Returns
+ * 0, or -1 when out of memory (nothing moved). */
+int interp_named_push_locals(struct interp *in, struct named_entry **saved, size_t *nsaved)
+{
+    struct named_table *t = &in->named;
+    size_t nloc = 0;
+    for (size_t i = 0; i < t->n; i++)
+        nloc += t->e[i].name[0] != '_';
+    *saved = NULL;
+    *nsaved = 0;
+    if (nloc == 0)
+        return 0;
+    struct named_entry *out = malloc(nloc * sizeof *out);
+    if (!out)
+        return -1;
+    size_t k = 0, j = 0;
+    for (size_t i = 0; i < t->n; i++) {
+        if (t->e[i].name[0] == '_')
+            t->e[k++] = t->e[i];
+        else
+            out[j++] = t->e[i];
+    }
+    t->n = k;
+    fill_index(t);
+    *saved = out;
+    *nsaved = nloc;
+    return 0;
+}
+
+/* The return of a call: the subroutine's locals are freed and the caller's come back.
+ * Returns 0, or -1 when out of memory (the caller's locals are then lost). */
+int interp_named_pop_locals(struct interp *in, struct named_entry *saved, size_t nsaved)
+{
+    interp_named_clear_locals(in);
+    struct named_table *t = &in->named;
+    size_t need = t->n + nsaved, nslot = t->nslot ? t->nslot : 32;
+    while (need * 2 > nslot)
+        nslot *= 2;
+    int rc = 0;
+    if (need > t->cap) {
+        struct named_entry *e = realloc(t->e, need * sizeof *e);
+        if (e) {
+            t->e = e;
+            t->cap = need;
+        } else {
+            rc = -1;
+        }
+    }
+    if (!rc && nslot != t->nslot && reindex(t, nslot))
+        rc = -1;
+    for (size_t i = 0; i < nsaved; i++) {
+        if (rc)
+            free(saved[i].name);
+        else
+            t->e[t->n++] = saved[i];
+    }
+    if (!rc)
+        fill_index(t);
+    free(saved);
+    return rc;
+}
+
 /* Frees every name. */
 void interp_named_free(struct interp *in)
 {

@@ -10,7 +10,7 @@ enum predef {
     PD_METRIC, PD_IMPERIAL, PD_ABSOLUTE, PD_INCREMENTAL, PD_INVERSE_TIME, PD_UNITS_PER_MINUTE,
     PD_PLANE, PD_COORD_SYSTEM, PD_RETRACT_R_PLANE, PD_RETRACT_OLD_Z, PD_IJK_ABSOLUTE,
     PD_MOTION_MODE, PD_FEED, PD_RPM, PD_SPINDLE_ON, PD_SPINDLE_CW, PD_CURRENT_TOOL,
-    PD_SELECTED_TOOL, PD_FLOOD, PD_MIST, PD_LINE,
+    PD_SELECTED_TOOL, PD_FLOOD, PD_MIST, PD_TASK, PD_CALL_LEVEL, PD_LINE,
 };
 
 static const struct { const char *name; enum predef id; } predef_table[] = {
@@ -25,7 +25,8 @@ static const struct { const char *name; enum predef id; } predef_table[] = {
     {"_motion_mode", PD_MOTION_MODE}, {"_feed", PD_FEED}, {"_rpm", PD_RPM},
     {"_spindle_on", PD_SPINDLE_ON}, {"_spindle_cw", PD_SPINDLE_CW},
     {"_current_tool", PD_CURRENT_TOOL}, {"_selected_tool", PD_SELECTED_TOOL},
-    {"_flood", PD_FLOOD}, {"_mist", PD_MIST}, {"_line", PD_LINE},
+    {"_flood", PD_FLOOD}, {"_mist", PD_MIST}, {"_task", PD_TASK},
+    {"_call_level", PD_CALL_LEVEL}, {"_line", PD_LINE},
 };
 
 /* G54..G59.3 as LinuxCNC reports them: 540, 550, ... 590, 591, 592, 593. */
@@ -73,6 +74,10 @@ static double predef_value(const struct interp *in, enum predef id)
     case PD_SELECTED_TOOL: return in->selected_tool;
     case PD_FLOOD: return in->flood;
     case PD_MIST: return in->mist;
+    /* _task is 1 in LinuxCNC's task and 0 in its previews and rs274; hexcnc's interp, check
+     * and run read it as 0 alike, so a program verified is the program run */
+    case PD_TASK: return 0.0;
+    case PD_CALL_LEVEL: return in->ow.ncalls;
     default: return in->line; /* PD_LINE */
     }
 }

@@ -395,9 +395,8 @@ START_TEST(modal_groups)
     e = fail_of("G41 G1 X1 F1\nM2\n");
     ck_assert_int_eq(e.status, INTERP_ERR_UNSUPPORTED);
     ck_assert_ptr_nonnull(strstr(e.message, "G141"));
-    e = fail_of("O100 sub\nM2\n");
-    ck_assert_ptr_nonnull(strstr(e.message, "O-words"));
-    ck_assert_ptr_nonnull(strstr(e.message, "not supported yet"));
+    e = fail_of("G1 X1 F1 O100\nM2\n");  /* an O-word is a line of its own */
+    ck_assert_ptr_nonnull(strstr(e.message, "must start its line"));
 }
 END_TEST
 
@@ -442,6 +441,59 @@ START_TEST(sink_can_stop)
 END_TEST
 
 /* Two interpreters, interleaved, keep their own state. */
+/* A loop that never ends is refused at the loop bound, naming its label and line; the count
+ * covers every loop of the program, and a program under the bound runs. */
+START_TEST(oword_loop_bound)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    interp_set_loop_limit(in, 100);
+    struct canon_prog p;
+    int rc = run_on(in, "G21 F100\n#1=0\no7 while [1]\n#1=[#1+1]\no7 endwhile\nM2\n", &p);
+    canon_prog_free(&p);
+    ck_assert_int_eq(rc, INTERP_ERR_SYNTAX);
+    const struct interp_error *e = interp_last_error(in);
+    ck_assert_int_eq(e->line, 3);                    /* the 101st time the body would start */
+    ck_assert_msg(strstr(e->message, "o7: more than 100 loop iterations"), "%s", e->message);
+    ck_assert_double_eq(interp_param(in, 1), 100);
+    /* 60 + 40 iterations are within 100; 61 + 61 are not */
+    rc = run_on(in, "G21 F100\no1 repeat [60]\no1 endrepeat\no2 repeat [40]\no2 endrepeat\nM2\n",
+                &p);
+    canon_prog_free(&p);
+    ck_assert_int_eq(rc, INTERP_OK);
+    rc = run_on(in, "G21 F100\no1 repeat [61]\no1 endrepeat\no2 repeat [61]\no2 endrepeat\nM2\n",
+                &p);
+    canon_prog_free(&p);
+    ck_assert_int_eq(rc, INTERP_ERR_SYNTAX);
+    interp_destroy(in);
+}
+END_TEST
+
+/* A subroutine's #1..#30 and local names are its own; the caller's come back on return, and
+ * globals (#<_name>) are shared. */
+START_TEST(oword_call_scope)
+{
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    struct canon_prog p;
+    int rc = run_on(in, "G21 F100\n"
+                        "o<s> sub\n#<loc>=5\n#<_glob>=[#1+#2]\n#3=9\no<s> endsub [#<loc>]\n"
+                        "#1=1\n#3=3\n#<loc>=2\no<s> call [10] [20]\n"
+                        "#10=#<_value>\n#11=#<loc>\n#12=#<_glob>\n#13=#1\n#14=#3\n"
+                        "#15=#<_value_returned>\n#16=#<_call_level>\nM2\n", &p);
+    canon_prog_free(&p);
+    ck_assert_msg(rc == INTERP_OK, "%s", interp_last_error(in)->message);
+    ck_assert_double_eq(interp_param(in, 10), 5);   /* the returned value */
+    ck_assert_double_eq(interp_param(in, 11), 2);   /* the caller's #<loc> untouched */
+    ck_assert_double_eq(interp_param(in, 12), 30);  /* the global the sub set */
+    ck_assert_double_eq(interp_param(in, 13), 1);   /* #1 restored */
+    ck_assert_double_eq(interp_param(in, 14), 3);   /* #3 restored */
+    ck_assert_double_eq(interp_param(in, 15), 1);
+    ck_assert_double_eq(interp_param(in, 16), 0);
+    interp_destroy(in);
+}
+END_TEST
+
 START_TEST(two_interpreters)
 {
     struct interp *a = interp_create(), *b = interp_create();
@@ -483,6 +535,8 @@ static Suite *interp_suite(void)
     tcase_add_test(tc, error_stops_output);
     tcase_add_test(tc, sink_can_stop);
     tcase_add_test(tc, two_interpreters);
+    tcase_add_test(tc, oword_loop_bound);
+    tcase_add_test(tc, oword_call_scope);
     suite_add_tcase(s, tc);
     return s;
 }

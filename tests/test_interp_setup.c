@@ -1,6 +1,7 @@
 /* test_interp_setup.c: the interpreter's INI settings (FEED_UNITS, TOOL_TABLE with LinuxCNC's
  * [EMCIO] fallback, PARAMETER_FILE), paths relative to the INI's folder, and their errors. */
 #include <check.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,6 +114,44 @@ START_TEST(every_key_applied_with_relative_paths)
     ck_assert_double_eq_tol(v.tool_mm[2], 5.0, 1e-12);
     interp_destroy(in);
     free(tt);
+    remove_dir(dir);
+}
+END_TEST
+
+/* [RS274NGC] SUBROUTINE_PATH: folders relative to the INI where o<name> call finds name.ngc;
+ * LOOP_LIMIT bounds the loops of one program. */
+START_TEST(subroutine_path_and_loop_limit)
+{
+    char dir[64], err[512], sub[100];
+    make_dir(dir, sizeof dir);
+    snprintf(sub, sizeof sub, "%s/subs", dir);
+    ck_assert_int_eq(mkdir(sub, 0755), 0);
+    put(sub, "twice.ngc", "o<twice> sub\no<twice> endsub [#1 * 2]\nM2\n");
+    struct fake_ini ini = { { { "RS274NGC", "SUBROUTINE_PATH", "nowhere:subs" },
+                              { "RS274NGC", "LOOP_LIMIT", "5" } } };
+    struct interp_settings s;
+    ck_assert_int_eq(interp_settings_read(&s, fake_get, &ini, dir, err, sizeof err), INTERP_OK);
+    char want[300];
+    snprintf(want, sizeof want, "%s/nowhere:%s/subs", dir, dir);
+    ck_assert_str_eq(s.subroutine_path, want);
+    ck_assert_int_eq(s.loop_limit, 5);
+    struct interp *in = interp_create();
+    ck_assert_ptr_nonnull(in);
+    ck_assert_int_eq(interp_setup(in, NULL, fake_get, &ini, dir, 0, err, sizeof err), INTERP_OK);
+    const char prog[] = "o<twice> call [21]\n#1 = #<_value>\nM2\n";
+    ck_assert_int_eq(interp_run_text(in, "t.ngc", prog, strlen(prog), drop, NULL), INTERP_OK);
+    ck_assert_double_eq(interp_param(in, 1), 42);
+    const char loop[] = "o1 repeat [6]\no1 endrepeat\nM2\n";  /* 6 > LOOP_LIMIT */
+    ck_assert_int_eq(interp_run_text(in, "t.ngc", loop, strlen(loop), drop, NULL),
+                     INTERP_ERR_SYNTAX);
+    ck_assert_ptr_nonnull(strstr(interp_last_error(in)->message, "more than 5 loop"));
+    interp_destroy(in);
+    struct fake_ini bad = { { { "RS274NGC", "LOOP_LIMIT", "0" } } };
+    ck_assert_int_eq(interp_settings_read(&s, fake_get, &bad, dir, err, sizeof err),
+                     INTERP_ERR_CONFIG);
+    ck_assert_ptr_nonnull(strstr(err, "LOOP_LIMIT"));
+    unlink(strcat(strcpy(want, sub), "/twice.ngc"));
+    rmdir(sub);
     remove_dir(dir);
 }
 END_TEST
@@ -235,6 +274,7 @@ static Suite *interp_setup_suite(void)
     Suite *s = suite_create("interp_setup");
     TCase *tc = tcase_create("setup");
     tcase_add_test(tc, every_key_applied_with_relative_paths);
+    tcase_add_test(tc, subroutine_path_and_loop_limit);
     tcase_add_test(tc, defaults_absolute_paths_and_the_emcio_fallback);
     tcase_add_test(tc, errors_name_the_key_or_the_file);
     tcase_add_test(tc, read_only_never_writes_the_parameter_file);
