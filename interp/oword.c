@@ -582,7 +582,11 @@ int oword_execute(struct interp *in)
         kw[k++] = in->norm[pos++];
     kw[k] = 0;
     if (!strcmp(kw, "sub")) {    /* a definition met in the flow: remember it, skip its body */
-        if (ow->nsubs == ow->capsubs) {
+        int known = -1;          /* met again (in a loop): the newest definition wins */
+        for (int i = 0; i < ow->nsubs && known < 0; i++)
+            if (!strcmp(ow->subs[i].label, label))
+                known = i;
+        if (known < 0 && ow->nsubs == ow->capsubs) {
             int cap = ow->capsubs ? ow->capsubs * 2 : 16;
             struct ow_sub *s = realloc(ow->subs, (size_t)cap * sizeof *s);
             if (!s)
@@ -590,7 +594,7 @@ int oword_execute(struct interp *in)
             ow->subs = s;
             ow->capsubs = cap;
         }
-        struct ow_sub *s = &ow->subs[ow->nsubs++];
+        struct ow_sub *s = &ow->subs[known >= 0 ? known : ow->nsubs++];
         snprintf(s->label, sizeof s->label, "%s", label);
         s->text = ow->text;
         s->idx = ow->idx - 1;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "interp/interp_int.h"
 #include "tests/test_interp_util.h"
 
 /* X of the first traverse of a one-line program "G0 X<expr>". */
@@ -490,6 +491,13 @@ START_TEST(oword_call_scope)
     ck_assert_double_eq(interp_param(in, 14), 3);   /* #3 restored */
     ck_assert_double_eq(interp_param(in, 15), 1);
     ck_assert_double_eq(interp_param(in, 16), 0);
+    /* a definition met again and again (inside a loop) is kept once */
+    rc = run_on(in, "G21 F100\no1 repeat [1000]\no<d> sub\no<d> endsub [7]\no1 endrepeat\n"
+                    "o<d> call\n#20=#<_value>\nM2\n", &p);
+    canon_prog_free(&p);
+    ck_assert_msg(rc == INTERP_OK, "%s", interp_last_error(in)->message);
+    ck_assert_double_eq(interp_param(in, 20), 7);
+    ck_assert_int_eq(in->ow.nsubs, 1);
     interp_destroy(in);
 }
 END_TEST
