@@ -74,10 +74,10 @@ int interp_add_m(struct interp *in, double v, int column)
     CHP(interp_to_int(in, v, column, "an M code", &c));
     switch (c) {
     case 0: case 1: case 2: case 30: grp = 4; break;
-    case 6: grp = 6; break;
+    case 6: case 61: grp = 6; break;
     case 3: case 4: case 5: grp = 7; break;
     case 7: case 8: case 9: grp = 8; break;
-    case 48: case 49: case 50: case 51: case 52: case 53: case 60: case 61: case 62: case 63:
+    case 48: case 49: case 50: case 51: case 52: case 53: case 60: case 62: case 63:
     case 64: case 65: case 66: case 67: case 68: case 70: case 71: case 72: case 73:
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "M%d is not supported yet", c);
     default:
@@ -170,7 +170,8 @@ static int word_used(const struct interp *in, char w)
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 ||
                      (cycle && (m == 820 || m == 890));
-    case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640;
+    case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640 ||
+                     b->m[6] == 61;
     case 'l': return cycle || g0 == 100;
     case 'h': return b->g[8] == 430;
     case 'd': case 'w': return comp;
@@ -188,7 +189,7 @@ static int check_unused(struct interp *in)
         "I, J and K are arc centre words: use them with G2 or G3",
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
         "P is used by G4 (dwell), G10, G64, G2/G3 (turns) and G82/G89 (dwell)",
-        "Q is used by the peck cycles G73 and G83, G10 and G64",
+        "Q is used by the peck cycles G73 and G83, G10, G64 and M61",
         "L is used by G10 and canned cycles (repeats)",
         "H is used by G43 (tool length offset)",
         "D (tool for the radius) is only used with G141/G142",

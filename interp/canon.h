@@ -23,7 +23,8 @@ enum canon_type {
     CANON_SPINDLE_SPEED,   /* S: value = rpm */
     CANON_SPINDLE_ON,      /* M3 (value = +1) / M4 (value = -1) */
     CANON_SPINDLE_STOP,    /* M5 */
-    CANON_TOOL_CHANGE,     /* M6: ivalue = tool number */
+    CANON_TOOL_CHANGE,     /* M6 (value 0) or M61 Q (value 1: the number only, no change):
+                            * ivalue = the tool now in the spindle */
     CANON_COOLANT,         /* M7 (ivalue 7), M8 (8), M9 (9) */
     CANON_COMMENT,         /* ( ... ): text */
     CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */

@@ -132,6 +132,18 @@ static int exec_machine_words(struct interp *in)
     if (b->m[6] == 6) {
         in->current_tool = in->selected_tool;
         CHP(emit_simple(in, CANON_TOOL_CHANGE, 0, in->current_tool));
+    } else if (b->m[6] == 61) {  /* M61 Q: the tool in the spindle is n, nothing moves */
+        int t;
+        if (!W('q'))
+            return interp_fail(in, INTERP_ERR_WORD, b->mcol[6], "M61 needs a Q word: the number "
+                               "of the tool now in the spindle");
+        CHP(interp_to_int(in, V('q'), W('q'), "M61 Q (tool number)", &t));
+        if (t < 0 || (t > 0 && in->tt && !tooltable_find(in->tt, t)))
+            return interp_fail(in, INTERP_ERR_TOOL, W('q'), "M61 Q%d: tool %d is not in the "
+                               "tool table%s%s", t, t, in->tt && in->tt->path[0] ? " " : "",
+                               in->tt ? in->tt->path : "");
+        in->current_tool = t;
+        CHP(emit_simple(in, CANON_TOOL_CHANGE, 1, in->current_tool));
     }
     if (b->m[7] == 3 || b->m[7] == 4) {
         in->spindle_dir = b->m[7] == 3 ? 1 : -1;

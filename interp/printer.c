@@ -213,7 +213,10 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
         snprintf(tmp, sizeof tmp, "START_SPINDLE_%sCLOCKWISE(0)\n", c->value < 0 ? "COUNTER" : "");
         break;
     case CANON_SPINDLE_STOP: snprintf(tmp, sizeof tmp, "STOP_SPINDLE_TURNING(0)\n"); break;
-    case CANON_TOOL_CHANGE: snprintf(tmp, sizeof tmp, "CHANGE_TOOL(%d)\n", c->ivalue); break;
+    case CANON_TOOL_CHANGE:
+        snprintf(tmp, sizeof tmp, c->value != 0.0 ? "CHANGE_TOOL_NUMBER(%d)\n" : "CHANGE_TOOL(%d)\n",
+                 c->ivalue);
+        break;
     case CANON_COOLANT:
         snprintf(tmp, sizeof tmp, "%s\n", c->ivalue == 7 ? "MIST_ON()" : c->ivalue == 8 ?
                  "FLOOD_ON()" : "FLOOD_OFF()");

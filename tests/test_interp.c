@@ -491,6 +491,12 @@ START_TEST(oword_call_scope)
     ck_assert_double_eq(interp_param(in, 14), 3);   /* #3 restored */
     ck_assert_double_eq(interp_param(in, 15), 1);
     ck_assert_double_eq(interp_param(in, 16), 0);
+    /* M61 Q sets the tool in the spindle (#<_current_tool> reads it, as LinuxCNC's task
+     * does; rs274 alone keeps the old number there) */
+    rc = run_on(in, "T2 M6\nM61 Q3\n#21=#<_current_tool>\nM2\n", &p);
+    canon_prog_free(&p);
+    ck_assert_msg(rc == INTERP_OK, "%s", interp_last_error(in)->message);
+    ck_assert_double_eq(interp_param(in, 21), 3);
     /* a definition met again and again (inside a loop) is kept once */
     rc = run_on(in, "G21 F100\no1 repeat [1000]\no<d> sub\no<d> endsub [7]\no1 endrepeat\n"
                     "o<d> call\n#20=#<_value>\nM2\n", &p);
