@@ -30,6 +30,7 @@ const struct config_section config_sections[] = {
     { "EMCIO", CONFIG_OPEN, "LinuxCNC's I/O controller; hexcnc reads TOOL_TABLE only" },
     { "HAL", CONFIG_STRICT, "HAL files run when the machine starts (docs/hal.md)" },
     { "TASK", CONFIG_STRICT, "`hexcnc run` (docs/running.md)" },
+    { "API", CONFIG_STRICT, "the machine session's command socket (docs/api.md)" },
     { "DISPLAY", CONFIG_OPEN, "LinuxCNC's GUI settings; hexcnc reads OPEN_FILE only" },
     { "LCM", CONFIG_STRICT, "status publishing over LCM (docs/lcm.md)" },
     { "MODBUS", CONFIG_STRICT, "Modbus drives, settings common to all (docs/modbus.md)" },
@@ -113,6 +114,8 @@ const struct config_key config_keys[] = {
       "corner cut when blending" },
     { "TRAJ", "SETPOINT_PERIOD", INT, "ns", ">= 0", 0, 0, "servo period", "period at which "
       "drives take set points, for the kinematic-error bound" },
+    { "TRAJ", "NO_FORCE_HOMING", BOOL, "", "", 0, 0, "0", "1: programs and MDI may run "
+      "before the legs are homed (the session, docs/machine.md)" },
     { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },
     { "TRAJ", "COORDINATES", STR, "", "", 0, IGN, "", "LinuxCNC's axis letters; hexcnc's are "
       "always X Y Z A B C" },
@@ -145,6 +148,29 @@ const struct config_key config_keys[] = {
       "limit (0 or absent: none)" },
     { "JOINT_#", "STEPGEN_MAXACCEL", NUM, "mm/s^2", ">= 0", 0, 0, "", "step generator "
       "acceleration limit (0 or absent: none)" },
+    { "JOINT_#", "HOME_SEARCH_VEL", NUM, "mm/s", "", 0, 0, "0", "homing: speed towards the "
+      "home switch, its sign the direction; 0 = no switch: the leg's feedback is absolute "
+      "(docs/machine.md)" },
+    { "JOINT_#", "HOME_LATCH_VEL", NUM, "mm/s", "!= 0", 0, 0, "", "homing: speed of the "
+      "slow, precise pass over the switch (same sign as the search: approach again; "
+      "opposite: latch where it releases); required with HOME_SEARCH_VEL" },
+    { "JOINT_#", "HOME_FINAL_VEL", NUM, "mm/s", "> 0", 0, 0, "MAX_VELOCITY", "homing: speed "
+      "of the move to HOME after the latch" },
+    { "JOINT_#", "HOME_OFFSET", NUM, "mm", "", 0, 0, "", "homing: the leg's length where the "
+      "switch latches; required with HOME_SEARCH_VEL" },
+    { "JOINT_#", "HOME", NUM, "mm", "", 0, 0, "leg length at [KINS] HOME", "homing: the leg "
+      "length the leg moves to after the latch" },
+    { "JOINT_#", "HOME_SEQUENCE", INT, "", "-9..9", 0, 0, "0", "homing: legs home in groups "
+      "of equal |HOME_SEQUENCE|, lowest first; the legs of a group move together" },
+    { "JOINT_#", "HOME_IGNORE_LIMITS", BOOL, "", "", 0, 0, "0", "homing: the switch shares "
+      "the limit switch (hexcnc checks no limit switch while homing either way)" },
+    { "JOINT_#", "HOME_ABSOLUTE_ENCODER", INT, "", "0..2", 0, 0, "0", "homing without "
+      "motion: the feedback is absolute (1, 2: as LinuxCNC; both leave the platform where "
+      "it is)" },
+    { "JOINT_#", "HOME_SEARCH_DISTANCE", NUM, "mm", "> 0", 0, 0, "1.5 x leg range", "homing: "
+      "travel without finding the switch after which homing stops with a fault" },
+    { "JOINT_#", "HOME_USE_INDEX", BOOL, "", "", 0, IGN, "", "LinuxCNC's encoder index "
+      "homing (not used)" },
     { "JOINT_#", "TYPE", STR, "", "", 0, IGN, "", "LinuxCNC's joint type; legs are linear" },
 
     /* [RS274NGC] */
@@ -170,6 +196,10 @@ const struct config_key config_keys[] = {
       "between progress lines (they also come at every 10 % and every wall second)" },
     { "TASK", "MAX_PROGRAM_MB", INT, "MB", "> 0", 0, 0, "64", "largest program file "
       "`hexcnc run` loads (10^6 bytes); a larger one is refused before it is read" },
+    { "API", "SOCKET", PATH, "", "", 0, 0, "$XDG_RUNTIME_DIR/hexcnc.sock", "Unix socket of "
+      "`hexcnc machine` (else /tmp/hexcnc-UID/hexcnc.sock)" },
+    { "API", "GROUP", STR, "", "", 0, 0, "", "group allowed to use the socket (mode 0660); "
+      "absent: its owner only (0600)" },
     { "TASK", "TASK", STR, "", "", 0, IGN, "", "LinuxCNC's task program" },
     { "TASK", "CYCLE_TIME", NUM, "s", "", 0, IGN, "", "LinuxCNC's task period" },
     { "DISPLAY", "OPEN_FILE", PATH, "", "", 0, 0, "", "program `hexcnc run` runs when none "

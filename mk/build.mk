@@ -29,7 +29,7 @@ PREFIX  ?= /usr/local
 
 CC      ?= cc
 CXX     ?= c++
-PKGS    := libmodbus lcm inih
+PKGS    := libmodbus lcm inih jansson
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wpointer-arith \
            -Wcast-align -Wwrite-strings -Wundef -Wformat=2 -Wvla -Wnull-dereference \
            -Wdouble-promotion -Wold-style-definition -Wno-unused-parameter

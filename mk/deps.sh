@@ -8,7 +8,7 @@
 # mbpoll is there for tests only: a third-party Modbus client for `hexcnc modbus_sim`.
 set -eu
 PKGS="build-essential pkg-config check libmodbus-dev libeigen3-dev liblcm-dev liblcm-bin \
-libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll libceres-dev clang"
+libinih-dev libglib2.0-dev iproute2 util-linux linuxcnc-uspace mbpoll libceres-dev clang libjansson-dev"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

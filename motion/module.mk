@@ -1,7 +1,7 @@
 # motion/: segment queue, velocity planner, servo-period interpolator, and its HAL component.
 LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/motion_plan.c \
             motion/motion_caps.c motion/motion_blend.c motion/motion_chord.c \
-            motion/motion_step.c
+            motion/motion_step.c motion/motion_manual.c motion/motion_home.c
 TESTS += test_motion test_motion_run test_motion_legs test_motion_hal test_motion_blend \
          test_motion_stop
 # The HAL component `motion` (loadrt motion) and the runner's entry points (motion_hal.h).

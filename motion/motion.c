@@ -58,6 +58,9 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     memcpy(m->pose, k->home, sizeof m->pose);
     memcpy(m->start_pose, k->home, sizeof m->start_pose);
     kins_inverse(k, m->pose, m->joint_cmd);
+    memcpy(m->joint_fb, m->joint_cmd, sizeof m->joint_fb);
+    memcpy(m->motor_fb, m->joint_cmd, sizeof m->motor_fb);
+    m->pose_known = 1;
     *out = m;
     return MOTION_OK;
 }
@@ -222,6 +225,8 @@ int motion_set_feed_override(struct motion *m, double scale)
 /* Stops at once: the command freezes. */
 static void halt(struct motion *m, int status)
 {
+    memset(&m->man, 0, sizeof m->man);
+    m->homing = 0;
     m->state = MOTION_FAULT;
     m->fault_status = status;
     m->rate = 0;
@@ -261,10 +266,13 @@ int motion_feedback(struct motion *m, const double *fb)
 {
     if (!m || !fb)
         return MOTION_ERR_ARG;
-    for (int i = 0; i < m->nj; i++)
-        m->ferror[i] = m->joint_cmd[i] - fb[i];
+    for (int i = 0; i < m->nj; i++) {
+        m->motor_fb[i] = fb[i];
+        m->joint_fb[i] = fb[i] - m->motor_offset[i];
+        m->ferror[i] = m->joint_cmd[i] - m->joint_fb[i];
+    }
     if (m->state != MOTION_RUNNING && m->state != MOTION_PAUSING && m->state != MOTION_PAUSED &&
-        m->state != MOTION_STOPPING)
+        m->state != MOTION_STOPPING && m->state != MOTION_MANUAL)
         return MOTION_OK;
     for (int i = 0; i < m->nj; i++) {
         const struct motion_joint_config *j = &m->cfg.joint[i];

@@ -3,6 +3,7 @@
 #define HEXCNC_MOTION_H
 
 #include <signal.h>
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "interp/canon.h"
@@ -49,6 +50,8 @@ enum motion_state {
     MOTION_STOPPING,         /* decelerating along the path after motion_abort */
     MOTION_DONE,             /* program end reached */
     MOTION_FAULT,            /* e-stop or following error: stopped, see motion_last_error */
+    MOTION_MANUAL,           /* manual motion under way: a jog, homing, a move to a pose
+                              * (motion_manual.c); back to IDLE at rest */
     MOTION_STATE_COUNT
 };
 const char *motion_state_name(enum motion_state s);
@@ -59,6 +62,17 @@ struct motion_joint_config {
     double max_acc_mm_s2;    /* MAX_ACCELERATION, mm/s^2 */
     double ferror_mm;        /* FERROR: following-error limit at MAX_VELOCITY, mm */
     double min_ferror_mm;    /* MIN_FERROR: following-error limit at standstill, mm */
+    /* Homing ([JOINT_n] HOME_*, docs/machine.md). search_vel 0: no switch (absolute). */
+    double home_search_vel;  /* mm/s, signed: the direction towards the switch */
+    double home_latch_vel;   /* mm/s, signed: same sign approaches again, opposite latches on
+                              * the release */
+    double home_final_vel;   /* mm/s of the move to HOME after the latch */
+    double home_offset;      /* leg length where the switch latches, mm */
+    double home_pos;         /* leg length after homing, mm (NAN: the leg's length at the
+                              * kinematics' home pose) */
+    double home_search_mm;   /* travel without a switch after which homing faults, mm */
+    int home_sequence;       /* legs home in groups of equal |sequence|, lowest first */
+    int home_absolute;       /* HOME_ABSOLUTE_ENCODER: homed without motion */
 };
 
 /* Everything the planner needs, filled by the caller (or by motion_config_read). */
@@ -135,6 +149,8 @@ struct motion_out {
     double pose_vel[KINS_POSE_DIM];    /* its rate: mm/s, deg/s */
     double joint_pos[KINS_MAX_JOINTS]; /* leg position commands, mm */
     double joint_vel[KINS_MAX_JOINTS]; /* leg rate commands, mm/s */
+    double motor_pos[KINS_MAX_JOINTS]; /* what the drives get: joint_pos + home offset, mm */
+    double joint_fb[KINS_MAX_JOINTS];  /* leg feedback: motor feedback - home offset, mm */
     double ferror_mm[KINS_MAX_JOINTS]; /* last following error (command - feedback), mm */
     int njoints;
     int line;                          /* program line being executed (0 before any) */
@@ -173,6 +189,44 @@ int motion_abort(struct motion *m);
 int motion_set_feed_override(struct motion *m, double scale);
 /* Emergency stop: command freezes where it is, state FAULT (status MOTION_ERR_ESTOP). */
 int motion_estop(struct motion *m);
+
+/* ---- Manual motion (motion_manual.c, motion_home.c): allowed in IDLE, DONE (and MANUAL, to
+ * change a jog); never while a program runs. Leg positions below are joint positions (leg
+ * lengths); the drives get motor positions = joint + the leg's home offset. */
+enum motion_jog_frame { MOTION_JOG_WORLD, MOTION_JOG_TOOL, MOTION_JOG_JOINT };
+/* Jog axis (0..5: X Y Z A B C; in the tool frame 0..2 are the platform's own X Y Z; in the
+ * joint frame the leg) at vel (signed, mm/s or deg/s). dist > 0: that far, else until
+ * motion_jog_stop. Speed and acceleration stay within the axis's and every leg's limits; a
+ * jog stops at the edge of the reachable workspace (a leg's limit), and motion_manual_note
+ * says so. World and tool jogs need every leg homed. */
+int motion_jog(struct motion *m, enum motion_jog_frame frame, int axis, double vel,
+               double dist);
+/* Decelerates any manual motion to rest (homing stops too, unhomed). */
+int motion_jog_stop(struct motion *m);
+/* A straight move in pose space to pose at speed_scale (0..1] of the path limits. */
+int motion_move_to(struct motion *m, const double pose[KINS_POSE_DIM], double speed_scale);
+/* Starts homing: joint -1 all legs by HOME_SEQUENCE then the move to the kinematics' home
+ * pose, else that leg alone. */
+int motion_home(struct motion *m, int joint);
+int motion_unhome(struct motion *m, int joint);
+/* The home switch of each leg, this period (the component's pins). */
+void motion_set_home_switches(struct motion *m, const bool *sw);
+/* Whether leg i is homed; whether a homing run is under way. */
+bool motion_homed(const struct motion *m, int joint);
+bool motion_homing(const struct motion *m);
+/* The last note of manual motion (a limit reached, homing finished or failed), "" when
+ * none; a counter that grows with each new note, so a reader sees each once. */
+const char *motion_manual_note(const struct motion *m, unsigned *seq);
+/* While the machine is off: takes the commanded legs from the feedback when they differ by
+ * more than MIN_FERROR, and the pose from the forward kinematics of them. Out of FAULT on
+ * the machine's next start (motion_reset). */
+void motion_track_feedback(struct motion *m);
+/* Leaves FAULT (the program is dropped); the pose stays where the legs are. */
+int motion_reset(struct motion *m);
+/* Whether the commanded pose is known (the forward kinematics of the legs has an answer). */
+bool motion_pose_known(const struct motion *m);
+/* Homed status of all legs. */
+bool motion_all_homed(const struct motion *m);
 
 enum motion_state motion_get_state(const struct motion *m);
 /* The last error or fault message ("" when none): file:line and what happened. */

@@ -36,7 +36,7 @@ const char *motion_strerror(int status)
 const char *motion_state_name(enum motion_state s)
 {
     static const char *const names[MOTION_STATE_COUNT] = {
-        "idle", "running", "pausing", "paused", "stopping", "done", "fault"};
+        "idle", "running", "pausing", "paused", "stopping", "done", "fault", "manual"};
     return (unsigned)s < MOTION_STATE_COUNT ? names[s] : "unknown";
 }
 
@@ -61,7 +61,67 @@ void motion_config_default(struct motion_config *c)
         c->joint[i].max_acc_mm_s2 = 1000;
         c->joint[i].ferror_mm = 1;
         c->joint[i].min_ferror_mm = 0.1;
+        c->joint[i].home_pos = NAN;
     }
+}
+
+static int read_num(const struct kins_config *cfg, const char *sec, const char *key,
+                    double scale, int allow_zero, int required, double *out, char *err,
+                    size_t errlen);
+
+/* A signed number [sec]key (homing speeds and positions): absent keeps *out, *present says
+ * whether it was there. */
+static int read_signed(const struct kins_config *cfg, const char *sec, const char *key,
+                       double *out, int *present, char *err, size_t errlen)
+{
+    const char *v = cfg->get(cfg->ctx, sec, key);
+    *present = v != NULL;
+    if (!v)
+        return MOTION_OK;
+    char why[64];
+    if (config_parse_number(v, out, why, sizeof why) != 0) {
+        snprintf(err, errlen, "[%s] %s = %s: %s", sec, key, v, why);
+        return MOTION_ERR_CONFIG;
+    }
+    return MOTION_OK;
+}
+
+/* [JOINT_n] HOME_*: a switch (HOME_SEARCH_VEL != 0) needs HOME_LATCH_VEL and HOME_OFFSET,
+ * since a wrong guess would put the leg's zero anywhere. */
+static int read_homing(const struct kins_config *cfg, const char *sec,
+                       struct motion_joint_config *j, char *err, size_t errlen)
+{
+    int has_search, has_latch, has_offset, has_home, has, st;
+    double seq = 0, absolute = 0;
+    j->home_final_vel = j->max_vel_mm_s;
+    if ((st = read_signed(cfg, sec, "HOME_SEARCH_VEL", &j->home_search_vel, &has_search, err,
+                          errlen)) ||
+        (st = read_signed(cfg, sec, "HOME_LATCH_VEL", &j->home_latch_vel, &has_latch, err,
+                          errlen)) ||
+        (st = read_signed(cfg, sec, "HOME_OFFSET", &j->home_offset, &has_offset, err,
+                          errlen)) ||
+        (st = read_signed(cfg, sec, "HOME", &j->home_pos, &has_home, err, errlen)) ||
+        (st = read_signed(cfg, sec, "HOME_SEQUENCE", &seq, &has, err, errlen)) ||
+        (st = read_signed(cfg, sec, "HOME_ABSOLUTE_ENCODER", &absolute, &has, err, errlen)) ||
+        (st = read_num(cfg, sec, "HOME_FINAL_VEL", 1, 0, 0, &j->home_final_vel, err,
+                       errlen)) ||
+        (st = read_num(cfg, sec, "HOME_SEARCH_DISTANCE", 1, 0, 0, &j->home_search_mm, err,
+                       errlen)))
+        return st;
+    j->home_sequence = (int)seq;
+    j->home_absolute = (int)absolute;
+    if (j->home_search_vel != 0 && !j->home_absolute && (!has_latch || !has_offset)) {
+        snprintf(err, errlen, "[%s] HOME_SEARCH_VEL = %g needs HOME_LATCH_VEL and HOME_OFFSET "
+                 "(the leg length at the switch): %s missing", sec, j->home_search_vel,
+                 !has_latch ? "HOME_LATCH_VEL" : "HOME_OFFSET");
+        return MOTION_ERR_CONFIG;
+    }
+    if (j->home_search_vel != 0 && j->home_latch_vel == 0) {
+        snprintf(err, errlen, "[%s] HOME_LATCH_VEL: must not be 0 when HOME_SEARCH_VEL is set",
+                 sec);
+        return MOTION_ERR_CONFIG;
+    }
+    return MOTION_OK;
 }
 
 /* Reads one number [sec]key into *out (times scale). Absent: keeps *out, or fails when the
@@ -162,6 +222,7 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
         st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, 1, &j->ferror_mm, err, errlen);
         st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, 0, &j->min_ferror_mm, err,
                                 errlen);
+        st = st ? st : read_homing(cfg, sec, j, err, errlen);
     }
     c->optional_stop = opt != 0;
     return st ? st : check_config(c, err, errlen);

@@ -33,6 +33,24 @@ int motion_hal_out(const struct hal *h, struct motion_out *out);
 /* The commanded pose now (mm, deg): where a program handed over next starts from. */
 int motion_hal_pose(const struct hal *h, double pose[KINS_POSE_DIM]);
 
+/* Manual-motion commands the task queues for the servo thread (applied at the next
+ * motion.update while the machine is on; dropped when it is off). */
+enum motion_hal_cmd_kind { MOTION_CMD_JOG, MOTION_CMD_JOG_STOP, MOTION_CMD_MOVE_TO,
+                           MOTION_CMD_HOME, MOTION_CMD_UNHOME, MOTION_CMD_PAUSE,
+                           MOTION_CMD_RESUME };
+struct motion_hal_cmd {
+    enum motion_hal_cmd_kind kind;
+    enum motion_jog_frame frame;
+    int axis;                     /* jog axis; home/unhome: joint, -1 all */
+    double vel;                   /* jog: signed speed; move_to: share of the limits */
+    double dist;                  /* jog: distance, 0 continuous */
+    double pose[KINS_POSE_DIM];   /* move_to */
+};
+/* MOTION_ERR_STATE when the queue is full or no motion is loaded. */
+int motion_hal_command(struct hal *h, const struct motion_hal_cmd *cmd);
+/* Runs fn on the motion core with the servo update kept out meanwhile (it holds still). */
+int motion_hal_with(struct hal *h, void (*fn)(struct motion *m, void *ctx), void *ctx);
+
 /* The fault or last error text ("" when none): what the runner shows the machinist. */
 const char *motion_hal_fault(const struct hal *h);
 

@@ -78,6 +78,27 @@ struct motion_plan {
     struct motion_plan_info info;
 };
 
+/* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
+enum motion_man_kind { MAN_NONE, MAN_LINE, MAN_JOINTS };
+struct motion_manual {
+    enum motion_man_kind kind;
+    double p0[KINS_POSE_DIM], u[KINS_POSE_DIM]; /* MAN_LINE: pose(s) = p0 + s u */
+    double s, v;             /* position along the line and speed (>= 0) */
+    double s_end;            /* where it stops (HUGE_VAL: until stopped) */
+    double v_req;            /* requested speed */
+    double a_max;            /* path acceleration limit along s */
+    int stop;                /* decelerate to rest now */
+    int limited;             /* s_end was pulled in to a workspace edge */
+    /* MAN_JOINTS: each leg its own profile towards jt at jvreq */
+    int jact[KINS_MAX_JOINTS];
+    double jv[KINS_MAX_JOINTS], jt[KINS_MAX_JOINTS], jvreq[KINS_MAX_JOINTS];
+    int jfree[KINS_MAX_JOINTS]; /* leg not held to its limits (homing, unhomed) */
+};
+
+/* Homing of one leg (motion_home.c). */
+enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOME_BACKOFF,
+                         HOME_LATCH, HOME_SETTLE, HOME_FINAL, HOME_DONE };
+
 /* The motion instance. */
 struct motion {
     struct motion_config cfg;
@@ -112,6 +133,22 @@ struct motion {
     double ferror[KINS_MAX_JOINTS];
     double path_vel;
     double dist_mm;          /* XYZ path length covered, mm */
+    /* manual motion and homing */
+    struct motion_manual man;
+    double motor_offset[KINS_MAX_JOINTS];  /* motor = joint + offset, mm */
+    double joint_fb[KINS_MAX_JOINTS];      /* last leg feedback (joint positions), mm */
+    double motor_fb[KINS_MAX_JOINTS];      /* last motor feedback, mm */
+    bool home_sw[KINS_MAX_JOINTS];         /* home switches this period */
+    bool home_sw_prev[KINS_MAX_JOINTS];
+    int homed[KINS_MAX_JOINTS];
+    enum motion_home_phase hphase[KINS_MAX_JOINTS];
+    double hstart[KINS_MAX_JOINTS];        /* joint position where the phase began */
+    int homing;              /* 1: a homing run is under way */
+    int home_group;          /* |HOME_SEQUENCE| being homed, -1 before the first */
+    int home_all;            /* the run homes every leg, then moves to the home pose */
+    int pose_known;          /* the forward kinematics of the legs has an answer */
+    char note[240];          /* last manual-motion note */
+    unsigned note_seq;
     int line;
     const char *file;
 };
@@ -130,6 +167,14 @@ static inline void motion_phases(double v0, double v1, double vp, double a, doub
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Manual motion (motion_manual.c) and homing (motion_home.c). */
+void motion_note(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void motion_manual_step(struct motion *m, double dt);
+void motion_home_step(struct motion *m);
+void motion_joint_move(struct motion *m, int i, double target, double vel, int free_leg);
+void motion_joint_halt(struct motion *m, int i);
+bool motion_joint_idle(const struct motion *m, int i);
 
 /* Checks a caller-filled configuration (motion_config.c). */
 int motion_config_check(const struct motion_config *c, char *err, size_t errlen);

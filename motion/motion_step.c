@@ -199,7 +199,9 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
                  m->state == MOTION_STOPPING;
     if (m->state == MOTION_PAUSED)
         m->elapsed_s += period_s;
-    if (moving && m->loaded && m->plan.nseg) {
+    if (m->state == MOTION_MANUAL) {
+        motion_manual_step(m, period_s);
+    } else if (moving && m->loaded && m->plan.nseg) {
         advance(m, period_s);
         pass_marks(m);
         int st = evaluate(m);
@@ -221,6 +223,10 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
     memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
+    for (int i = 0; i < m->nj; i++) {
+        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];
+        out->joint_fb[i] = m->joint_fb[i];
+    }
     memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
     out->njoints = m->nj;
     out->line = m->line;

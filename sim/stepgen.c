@@ -1,6 +1,7 @@
 /* stepgen.c: HAL component `stepgen`, a simulated step generator (position or velocity mode). */
 #include "sim/stepgen.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,6 +27,9 @@ struct stepgen_chan {
     double scale;             /* param: steps per mm (sign sets the direction) */
     double maxvel;            /* param: mm/s, 0 = no limit */
     double maxaccel;          /* param: mm/s^2, 0 = no limit */
+    double sim_start;         /* param: where the motor is at power-up, mm; 0 = where the
+                               * first command says (the simulated machine "powers up homed") */
+    bool started;             /* sim_start has been applied */
     struct stepgen_state st;  /* the controller's state */
 };
 
@@ -45,6 +49,13 @@ static void stepgen_update(void *arg, long period_ns)
         if (ch->scale == 0.0)
             continue;  /* unconfigured: nothing sensible to count */
         struct stepgen_limits lim = { ch->scale, ch->maxvel, ch->maxaccel };
+        if (!ch->started && ch->sim_start != 0.0) {
+            /* the motor is where the machine was left, whatever the command says */
+            stepgen_state_init(&ch->st, ch->sim_start);
+            ch->st.counts = (int64_t)llround(ch->sim_start * ch->scale);
+            ch->st.primed = true;
+        }
+        ch->started = true;
         int64_t n = ch->velocity_mode
                         ? stepgen_step_velocity(&ch->st, &lim, *ch->vel_cmd, *ch->enable, dt_s)
                         : stepgen_step(&ch->st, &lim, *ch->pos_cmd, *ch->enable, dt_s);
@@ -66,7 +77,8 @@ static int stepgen_chan_new(struct hal *h, struct stepgen_chan *ch, int i)
         (rc = hal_pin_float_newf(h, HAL_IN, &ch->vel_cmd, "stepgen.%d.velocity-cmd", i)) ||
         (rc = hal_param_float_newf(h, HAL_RW, &ch->scale, "stepgen.%d.position-scale", i)) ||
         (rc = hal_param_float_newf(h, HAL_RW, &ch->maxvel, "stepgen.%d.maxvel", i)) ||
-        (rc = hal_param_float_newf(h, HAL_RW, &ch->maxaccel, "stepgen.%d.maxaccel", i)))
+        (rc = hal_param_float_newf(h, HAL_RW, &ch->maxaccel, "stepgen.%d.maxaccel", i)) ||
+        (rc = hal_param_float_newf(h, HAL_RW, &ch->sim_start, "stepgen.%d.sim-start", i)))
         return rc;
     ch->scale = 1.0;  /* LinuxCNC's default: one step per unit until setp says otherwise */
     stepgen_state_init(&ch->st, 0.0);

@@ -21,6 +21,8 @@
  *   stepgen.N.position-scale float param steps per mm
  *   stepgen.N.maxvel         float param mm/s (0 = no limit)
  *   stepgen.N.maxaccel       float param mm/s^2 (0 = no limit)
+ *   stepgen.N.sim-start      float param where the motor is at power-up, mm (0, the
+ *                            default: where the first command puts it)
  * Funct: stepgen.update (all channels; add it after the funct that writes position-cmd).
  * `loadrt stepgen count=N [ctrl_type=p,v,...]`: as in LinuxCNC, p (the default) follows
  * position-cmd, v follows velocity-cmd.

@@ -1,10 +1,12 @@
 /* motion.c: the `motion` HAL component: planner and interpolator of motion/ on the servo thread. */
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "hal/hal.h"
+#include "hal/ring.h"
 #include "kins/kins.h"
 #include "motion/motion.h"
 #include "motion/motion_hal.h"
@@ -18,6 +20,13 @@ struct motion_comp {
     atomic_int start_pending;                /* a program waits to start (motion_hal_start) */
     atomic_int abort_pending;                /* motion_hal_abort was called */
     struct motion_out last;                  /* output of the last update (motion_hal_out) */
+    struct ring_spsc cmds;                   /* manual-motion commands from the task */
+    pthread_mutex_t plan_lock;               /* held by the task while it replaces the plan
+                                              * (at rest); the update skips a period then */
+    bool *home_sw[KINS_MAX_JOINTS];          /* in: home switch of each leg */
+    double *joint_fb_out[KINS_MAX_JOINTS];   /* out: leg length feedback (motor - offset) */
+    bool *homed_pin[KINS_MAX_JOINTS];        /* out: leg homed */
+    bool was_enabled;                        /* enable in the last update */
     double *joint_pos_cmd[KINS_MAX_JOINTS];  /* out: leg length commands, mm */
     double *joint_vel_cmd[KINS_MAX_JOINTS];  /* out: leg rate commands, mm/s */
     double *joint_pos_fb[KINS_MAX_JOINTS];   /* in: leg length feedback, mm */
@@ -38,14 +47,39 @@ struct motion_comp {
     bool last_pause, last_resume, last_abort;/* previous values, for the edges */
 };
 
+/* Applies the manual-motion commands the task queued (motion_hal_command). */
+static void motion_comp_manual(struct motion_comp *c)
+{
+    struct motion_hal_cmd cmd;
+    while (ring_spsc_pop(&c->cmds, &cmd)) {
+        if (!*c->enable)
+            continue;  /* the machine went off meanwhile */
+        switch (cmd.kind) {
+        case MOTION_CMD_JOG: motion_jog(c->m, cmd.frame, cmd.axis, cmd.vel, cmd.dist); break;
+        case MOTION_CMD_JOG_STOP: motion_jog_stop(c->m); break;
+        case MOTION_CMD_MOVE_TO: motion_move_to(c->m, cmd.pose, cmd.vel); break;
+        case MOTION_CMD_HOME: motion_home(c->m, cmd.axis); break;
+        case MOTION_CMD_UNHOME: motion_unhome(c->m, cmd.axis); break;
+        case MOTION_CMD_PAUSE: motion_pause(c->m); break;
+        case MOTION_CMD_RESUME: motion_resume(c->m); break;
+        }
+    }
+}
+
 /* The command inputs: e-stop, enable, edges of pause/resume/abort, override. */
 static void motion_comp_commands(struct motion_comp *c)
 {
     enum motion_state st = motion_get_state(c->m);
     int moving = st == MOTION_RUNNING || st == MOTION_PAUSING || st == MOTION_PAUSED ||
                  st == MOTION_STOPPING;
-    if (*c->estop || (!*c->enable && moving))
+    if (*c->estop || (!*c->enable && (moving || st == MOTION_MANUAL)))
         motion_estop(c->m);
+    if (!*c->enable)
+        motion_track_feedback(c->m);  /* off: the command follows the legs */
+    else if (!c->was_enabled)
+        motion_reset(c->m);           /* switched on: out of a fault, from where it is */
+    c->was_enabled = *c->enable;
+    motion_comp_manual(c);
     if (*c->enable && c->start_pending && st == MOTION_IDLE) {
         c->start_pending = 0;
         motion_start(c->m);
@@ -67,17 +101,25 @@ static void motion_comp_update(void *arg, long period_ns)
 {
     struct motion_comp *c = arg;
     double fb[KINS_MAX_JOINTS];
+    bool sw[KINS_MAX_JOINTS];
     struct motion_out o;
-    for (int i = 0; i < c->nj; i++)
+    if (pthread_mutex_trylock(&c->plan_lock) != 0)
+        return;  /* the task is replacing the plan at rest: the outputs hold */
+    for (int i = 0; i < c->nj; i++) {
         fb[i] = *c->joint_pos_fb[i];
+        sw[i] = *c->home_sw[i];
+    }
+    motion_set_home_switches(c->m, sw);
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
     c->last = o;
     for (int i = 0; i < c->nj; i++) {
-        *c->joint_pos_cmd[i] = o.joint_pos[i];
+        *c->joint_pos_cmd[i] = o.motor_pos[i];
         *c->joint_vel_cmd[i] = o.joint_vel[i];
         *c->ferror[i] = o.ferror_mm[i];
+        *c->joint_fb_out[i] = o.joint_fb[i];
+        *c->homed_pin[i] = motion_homed(c->m, i);
     }
     for (int i = 0; i < KINS_POSE_DIM; i++)
         *c->pose_cmd[i] = o.pose[i];
@@ -89,6 +131,7 @@ static void motion_comp_update(void *arg, long period_ns)
     *c->done = o.state == MOTION_DONE;
     *c->fault = o.state == MOTION_FAULT;
     *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
+    pthread_mutex_unlock(&c->plan_lock);
 }
 
 /* Frees the instance at hal_destroy. */
@@ -96,6 +139,8 @@ static void motion_comp_free(void *arg)
 {
     struct motion_comp *c = arg;
     motion_destroy(c->m);
+    ring_spsc_free(&c->cmds);
+    pthread_mutex_destroy(&c->plan_lock);
     free(c);
 }
 
@@ -111,6 +156,12 @@ static int motion_comp_joint_pins(struct hal *h, struct motion_comp *c)
             st = hal_pin_float_newf(h, HAL_IN, &c->joint_pos_fb[i], "motion.joint-pos-fb-%d", i);
         if (st == HAL_OK)
             st = hal_pin_float_newf(h, HAL_OUT, &c->ferror[i], "motion.ferror-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_bit_newf(h, HAL_IN, &c->home_sw[i], "motion.joint-home-sw-in-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_float_newf(h, HAL_OUT, &c->joint_fb_out[i], "motion.joint-fb-%d", i);
+        if (st == HAL_OK)
+            st = hal_pin_bit_newf(h, HAL_OUT, &c->homed_pin[i], "motion.joint-homed-%d", i);
     }
     for (int i = 0; i < KINS_POSE_DIM && st == HAL_OK; i++)
         st = hal_pin_float_newf(h, HAL_OUT, &c->pose_cmd[i], "motion.pose-cmd-%c",
@@ -157,7 +208,13 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     struct motion_comp *c = calloc(1, sizeof *c);
     if (!c)
         return hal_error(h, HAL_ERR_NOMEM, "loadrt motion: out of memory");
+    pthread_mutex_init(&c->plan_lock, NULL);
+    if (ring_spsc_init(&c->cmds, 64, sizeof(struct motion_hal_cmd)) != RING_OK) {
+        free(c);
+        return hal_error(h, HAL_ERR_NOMEM, "loadrt motion: out of memory");
+    }
     if (motion_create(&cfg, k, &c->m, err, sizeof err) != MOTION_OK) {
+        ring_spsc_free(&c->cmds);
         free(c);
         return hal_error(h, HAL_ERR_COMPONENT, "loadrt motion: %s", err);
     }
@@ -179,7 +236,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     motion_step(c->m, cfg.servo_period_s, &o);
     c->last = o;
     for (int i = 0; i < c->nj; i++)
-        *c->joint_pos_cmd[i] = *c->joint_pos_fb[i] = o.joint_pos[i];
+        *c->joint_pos_cmd[i] = *c->joint_pos_fb[i] = *c->joint_fb_out[i] = o.joint_pos[i];
     for (int i = 0; i < KINS_POSE_DIM; i++)
         *c->pose_cmd[i] = o.pose[i];
     *c->feed_override = 1;
@@ -204,8 +261,10 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
             snprintf(err, errlen, "no motion component: the HAL files must `loadrt motion`");
         return MOTION_ERR_STATE;
     }
+    pthread_mutex_lock(&c->plan_lock);
     int st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK;
+    pthread_mutex_unlock(&c->plan_lock);
     return st;
 }
 
@@ -257,4 +316,25 @@ const char *motion_hal_fault(const struct hal *h)
 {
     struct motion *m = motion_hal_get(h);
     return m ? motion_last_error(m) : "no motion component loaded";
+}
+
+/* Queues a manual-motion command for the next update. */
+int motion_hal_command(struct hal *h, const struct motion_hal_cmd *cmd)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    return ring_spsc_push(&c->cmds, cmd) ? MOTION_OK : MOTION_ERR_STATE;
+}
+
+/* Runs fn(m, ctx) with the update kept out (for work on the motion core at rest). */
+int motion_hal_with(struct hal *h, void (*fn)(struct motion *m, void *ctx), void *ctx)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    pthread_mutex_lock(&c->plan_lock);
+    fn(c->m, ctx);
+    pthread_mutex_unlock(&c->plan_lock);
+    return MOTION_OK;
 }
