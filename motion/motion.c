@@ -54,6 +54,7 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     m->nj = k->njoints;
     m->cfg.njoints = m->nj;
     m->override_cmd = 1;
+    m->rapid_cmd = 1;
     m->state = MOTION_IDLE;
     memcpy(m->pose, k->home, sizeof m->pose);
     memcpy(m->start_pose, k->home, sizeof m->start_pose);
@@ -83,6 +84,7 @@ static void rewind_plan(struct motion *m)
     m->ci = 0;
     m->cs = 0;
     m->paused_at_seg = 0;
+    m->step_until_seg = 0;
     m->marks_done = 0;
     m->path_vel = 0;
     memset(m->pose_vel, 0, sizeof m->pose_vel);
@@ -219,6 +221,33 @@ int motion_set_feed_override(struct motion *m, double scale)
     if (!m || isnan(scale))
         return MOTION_ERR_ARG;
     m->override_cmd = scale < 0 ? 0 : scale > 2 ? 2 : scale;
+    return MOTION_OK;
+}
+
+int motion_set_rapid_override(struct motion *m, double scale)
+{
+    if (!m || isnan(scale))
+        return MOTION_ERR_ARG;
+    m->rapid_cmd = scale < 0 ? 0 : scale > 1 ? 1 : scale;
+    return MOTION_OK;
+}
+
+int motion_set_optional_stop(struct motion *m, bool on)
+{
+    if (!m)
+        return MOTION_ERR_ARG;
+    m->cfg.optional_stop = on;
+    return MOTION_OK;
+}
+
+int motion_step_block(struct motion *m)
+{
+    if (!m)
+        return MOTION_ERR_ARG;
+    if (m->state != MOTION_PAUSED && m->state != MOTION_PAUSING && m->state != MOTION_RUNNING)
+        return MOTION_ERR_STATE;
+    m->step_until_seg = m->cs + 1;
+    m->state = MOTION_RUNNING;
     return MOTION_OK;
 }
 

@@ -187,6 +187,13 @@ int motion_abort(struct motion *m);
 /* Feed override 0..2 (clamped); applied smoothly within the acceleration limits, and never
  * beyond a leg or machine speed limit. */
 int motion_set_feed_override(struct motion *m, double scale);
+/* Rapid override 0..1 (clamped): the override of rapid (G0) moves, in place of the feed
+ * override, as LinuxCNC applies it. */
+int motion_set_rapid_override(struct motion *m, double scale);
+/* Whether M1 pauses (the optional-stop switch), for programs loaded from now on. */
+int motion_set_optional_stop(struct motion *m, bool on);
+/* Step: run to the end of the present block, then pause (decelerating on the path). */
+int motion_step_block(struct motion *m);
 /* Emergency stop: command freezes where it is, state FAULT (status MOTION_ERR_ESTOP). */
 int motion_estop(struct motion *m);
 

@@ -17,6 +17,10 @@ struct motion *motion_hal_get(const struct hal *h);
  * MOTION_ERR_* with a message naming file and line in err on failure. */
 int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, size_t errlen);
 
+/* Whether motion_hal_load marks the program to start (default true); false: only
+ * motion_hal_start does (a check must never start anything). */
+int motion_hal_set_autostart(struct hal *h, bool on);
+
 /* Asks the component to start the program loaded into its motion instance (by
  * motion_hal_load or motion_load): it starts at the next motion.update that sees
  * motion.enable true. MOTION_ERR_STATE when no program is loaded or motion is not idle. */
@@ -25,6 +29,10 @@ int motion_hal_start(struct hal *h);
 /* Asks the component to abort (controlled stop along the path, then idle) at its next
  * motion.update. Safe from another thread than the servo thread. */
 int motion_hal_abort(struct hal *h);
+
+/* Whether a start, an abort or a manual command is queued and not yet taken by the servo
+ * thread (the task waits for it before answering, so that what it reports has happened). */
+bool motion_hal_pending(const struct hal *h);
 
 /* The component's output of its last motion.update (pose, legs, state, line, progress);
  * before the first one, the pose it holds. MOTION_ERR_STATE without `loadrt motion`. */
@@ -37,7 +45,7 @@ int motion_hal_pose(const struct hal *h, double pose[KINS_POSE_DIM]);
  * motion.update while the machine is on; dropped when it is off). */
 enum motion_hal_cmd_kind { MOTION_CMD_JOG, MOTION_CMD_JOG_STOP, MOTION_CMD_MOVE_TO,
                            MOTION_CMD_HOME, MOTION_CMD_UNHOME, MOTION_CMD_PAUSE,
-                           MOTION_CMD_RESUME };
+                           MOTION_CMD_RESUME, MOTION_CMD_STEP, MOTION_CMD_RAPID };
 struct motion_hal_cmd {
     enum motion_hal_cmd_kind kind;
     enum motion_jog_frame frame;

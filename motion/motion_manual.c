@@ -66,6 +66,12 @@ static double profile_step(double *v, double vt, double a, double rem, double dt
     double ds = 0.5 * (*v + vn) * dt;
     if (ds > rem)
         ds = rem > 0 ? rem : 0;
+    /* the last bit: arrive and stop this period (a braking of at most a), rather than
+     * creep up on the end ever more slowly */
+    if (rem > 0 && vn <= a * dt && rem <= vn * dt + 0.5 * a * dt * dt) {
+        *v = 0;
+        return rem;
+    }
     *v = vn;
     return ds;
 }
@@ -176,6 +182,7 @@ static void line_step(struct motion *m, double dt)
         mm->limited = 1;
         mm->v = 0;
         ds = 0;
+        mm->s_end = mm->s;
         line_pose(mm, mm->s, p);
         kins_inverse(m->kins, p, L);
     }
@@ -224,7 +231,7 @@ static void joints_step(struct motion *m, double dt)
         m->joint_cmd[i] += dir * d;
         mm->jv[i] = v * dir;
         m->joint_vel[i] = d * dir / dt;
-        if (v == 0 && (mm->stop || rem - d <= 1e-12))
+        if (v == 0 && (mm->stop || rem - d <= 1e-9))
             mm->jact[i] = 0;
         else
             any = 1;

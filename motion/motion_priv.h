@@ -120,6 +120,9 @@ struct motion {
     double tau_s;            /* position on the plan's time axis, s */
     double rate;             /* current time-scaling rate (feed override in effect) */
     double override_cmd;     /* requested feed override */
+    double rapid_cmd;        /* requested rapid override */
+    size_t step_until_seg;   /* step: pause when the path leaves segment step_until_seg - 1
+                              * (0: no step pending) */
     double elapsed_s;
     size_t ci;               /* current interval */
     size_t cs;               /* segment holding knot ci */

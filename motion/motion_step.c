@@ -127,13 +127,18 @@ static void advance(struct motion *m, double dt)
         else
             m->rate = 0;
     } else {
-        double target = m->state == MOTION_RUNNING ? m->override_cmd : 0;
+        double ovr = sg->kind == SEG_LINE && sg->feed == 0 ? m->rapid_cmd : m->override_cmd;
+        double target = m->state == MOTION_RUNNING ? ovr : 0;
         plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
         double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
         m->tau_s += 0.5 * (m->rate + rn) * dt;
         m->rate = rn;
     }
     follow_knots(m);
+    if (m->step_until_seg && m->cs >= m->step_until_seg && m->state == MOTION_RUNNING) {
+        m->step_until_seg = 0;   /* the block is done: pause on the path */
+        m->state = MOTION_PAUSING;
+    }
     if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED) {
         m->tau_s = p->total_time_s;
         m->state = MOTION_DONE;

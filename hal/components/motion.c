@@ -27,6 +27,10 @@ struct motion_comp {
     double *joint_fb_out[KINS_MAX_JOINTS];   /* out: leg length feedback (motor - offset) */
     bool *homed_pin[KINS_MAX_JOINTS];        /* out: leg homed */
     bool was_enabled;                        /* enable in the last update */
+    long updates;                            /* updates run so far */
+    bool autostart;                          /* motion_hal_load marks the program to start
+                                              * (tests and `hexcnc run`); the session starts
+                                              * it itself (motion_hal_set_autostart) */
     double *joint_pos_cmd[KINS_MAX_JOINTS];  /* out: leg length commands, mm */
     double *joint_vel_cmd[KINS_MAX_JOINTS];  /* out: leg rate commands, mm/s */
     double *joint_pos_fb[KINS_MAX_JOINTS];   /* in: leg length feedback, mm */
@@ -47,6 +51,9 @@ struct motion_comp {
     bool last_pause, last_resume, last_abort;/* previous values, for the edges */
 };
 
+/* Updates before the feedback is believed (see motion_comp_commands). */
+#define MOTION_FEEDBACK_SETTLE 2
+
 /* Applies the manual-motion commands the task queued (motion_hal_command). */
 static void motion_comp_manual(struct motion_comp *c)
 {
@@ -62,6 +69,8 @@ static void motion_comp_manual(struct motion_comp *c)
         case MOTION_CMD_UNHOME: motion_unhome(c->m, cmd.axis); break;
         case MOTION_CMD_PAUSE: motion_pause(c->m); break;
         case MOTION_CMD_RESUME: motion_resume(c->m); break;
+        case MOTION_CMD_STEP: motion_step_block(c->m); break;
+        case MOTION_CMD_RAPID: motion_set_rapid_override(c->m, cmd.vel); break;
         }
     }
 }
@@ -74,12 +83,17 @@ static void motion_comp_commands(struct motion_comp *c)
                  st == MOTION_STOPPING;
     if (*c->estop || (!*c->enable && (moving || st == MOTION_MANUAL)))
         motion_estop(c->m);
-    if (!*c->enable)
-        motion_track_feedback(c->m);  /* off: the command follows the legs */
-    else if (!c->was_enabled)
+    /* Off: the command follows the legs. Not in the first updates: until the drives'
+     * functs have run once, their feedback pins hold nothing but the signals' zeros. */
+    if (!*c->enable) {
+        c->start_pending = 0;  /* a start queued before the machine went off is dropped */
+        if (c->updates > MOTION_FEEDBACK_SETTLE)
+            motion_track_feedback(c->m);
+    } else if (!c->was_enabled) {
         motion_reset(c->m);           /* switched on: out of a fault, from where it is */
+    }
+    c->updates++;
     c->was_enabled = *c->enable;
-    motion_comp_manual(c);
     if (*c->enable && c->start_pending && st == MOTION_IDLE) {
         c->start_pending = 0;
         motion_start(c->m);
@@ -93,6 +107,7 @@ static void motion_comp_commands(struct motion_comp *c)
         motion_abort(c->m);
     }
     c->last_pause = *c->pause, c->last_resume = *c->resume, c->last_abort = *c->abort;
+    motion_comp_manual(c);  /* after a start, so that a step can follow it at once */
     motion_set_feed_override(c->m, *c->feed_override);
 }
 
@@ -240,6 +255,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     for (int i = 0; i < KINS_POSE_DIM; i++)
         *c->pose_cmd[i] = o.pose[i];
     *c->feed_override = 1;
+    c->autostart = true;
     return HAL_OK;
 }
 
@@ -263,7 +279,7 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
     }
     pthread_mutex_lock(&c->plan_lock);
     int st = motion_load(c->m, prog, err, errlen);
-    c->start_pending = st == MOTION_OK;
+    c->start_pending = st == MOTION_OK && c->autostart;
     pthread_mutex_unlock(&c->plan_lock);
     return st;
 }
@@ -279,6 +295,14 @@ int motion_hal_start(struct hal *h)
         return MOTION_ERR_STATE;           /* running, done, faulted or nothing loaded */
     c->start_pending = 1;
     return MOTION_OK;
+}
+
+/* Whether a start, an abort or a manual command waits for the servo thread to take it. */
+bool motion_hal_pending(const struct hal *h)
+{
+    const struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    return c && (atomic_load(&c->start_pending) || atomic_load(&c->abort_pending) ||
+                 ring_spsc_pushed(&c->cmds) != ring_spsc_popped(&c->cmds));
 }
 
 /* Requests an abort at the next update. */
@@ -336,5 +360,15 @@ int motion_hal_with(struct hal *h, void (*fn)(struct motion *m, void *ctx), void
     pthread_mutex_lock(&c->plan_lock);
     fn(c->m, ctx);
     pthread_mutex_unlock(&c->plan_lock);
+    return MOTION_OK;
+}
+
+/* Whether motion_hal_load marks a program to start by itself. */
+int motion_hal_set_autostart(struct hal *h, bool on)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    c->autostart = on;
     return MOTION_OK;
 }
