@@ -212,6 +212,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     v->path_mode = in->path_mode;
     v->path_tol_mm = in->path_tol_mm;
     v->naive_cam_tol_mm = in->naive_cam_tol_mm;
+    v->comp5_active = in->comp.active;
 }
 
 /* Reads numbered parameter #n. */
@@ -285,10 +286,15 @@ static int run_lines(struct interp *in, const char *text, size_t len)
         return interp_fail(in, INTERP_ERR_SYNTAX, 0, "the program opened with '%%' on line %d "
                            "ends without its closing '%%' line (a truncated file?)",
                            in->pct_line);
-    if (!in->ended)
+    if (!in->ended && !in->mdi)
         return interp_fail(in, INTERP_ERR_SYNTAX, 0, "the program ends without M2, M30 or a "
                            "closing %% line");
     return 0;
+}
+
+void interp_set_mdi(struct interp *in, int on)
+{
+    in->mdi = on != 0;
 }
 
 int interp_run_text(struct interp *in, const char *file_name, const char *text, size_t len,

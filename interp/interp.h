@@ -101,6 +101,8 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
 int interp_run_text(struct interp *in, const char *file_name, const char *text, size_t len,
                     canon_sink_fn sink, void *ctx);
 const struct interp_error *interp_last_error(const struct interp *in);
+/* MDI: lines come one at a time (a run need not end with M2 or M30). */
+void interp_set_mdi(struct interp *in, int on);
 
 /* A read-only view of the modal state, for tools that print program coordinates. */
 struct interp_view {
@@ -115,6 +117,7 @@ struct interp_view {
     int path_mode;            /* 610 (G61), 611 (G61.1) or 640 (G64) */
     double path_tol_mm;       /* G64 P: blend tolerance, mm (0: none given) */
     double naive_cam_tol_mm;  /* G64 Q: naive CAM tolerance, mm (0: none given) */
+    int comp5_active;         /* a G141/G142 run is open */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */

@@ -117,6 +117,7 @@ struct interp {
     double start[6];             /* initial machine pose, mm/deg */
     char *param_path;            /* parameter file or NULL */
     struct tooltable *tt;        /* tool table or NULL (not owned) */
+    int mdi;                     /* lines typed one at a time: no program end needed */
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
