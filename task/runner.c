@@ -261,6 +261,7 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     if ((st = runner_setup_interp(r, in, tt, err, errlen)))
         goto out;
     interp_set_cancel(in, r->cancel);
+    interp_set_block_delete(in, r->block_delete);
     if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {
         char msg[600];
         const struct interp_error *e = interp_last_error(in);
@@ -276,23 +277,23 @@ out:
     return st;
 }
 
-/* Interprets then plans; nothing is handed to motion unless both succeed. */
-int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen)
+void runner_set_block_delete(struct runner *r, bool on)
+{
+    r->block_delete = on;
+}
+
+/* Settings, then the plan; nothing is handed to motion unless both succeed. */
+int runner_load_canon(struct runner *r, const struct canon_prog *prog, char *err,
+                      size_t errlen)
 {
     if (runner_moving(r))
         return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
-    struct canon_prog prog;
-    canon_prog_init(&prog);
     r->loaded = false;
-    int st = runner_check_size(r, path, err, errlen);
-    if (st == RUNNER_OK)
-        st = runner_interpret(r, path, &prog, err, errlen);
-    if (st == RUNNER_OK)
-        st = runner_settings_load(r, &prog, err, errlen);
+    int st = runner_settings_load(r, prog, err, errlen);
     if (st == RUNNER_OK) {
         char msg[512];
         motion_set_cancel(r->motion, r->cancel);
-        int ms = motion_hal_load(r->hal, &prog, msg, sizeof msg);
+        int ms = motion_hal_load(r->hal, prog, msg, sizeof msg);
         motion_set_cancel(r->motion, NULL);
         if (ms != MOTION_OK)
             st = errbuf_set(err, errlen, ms == MOTION_ERR_CANCELLED ? RUNNER_ERR_ABORTED
@@ -300,9 +301,87 @@ int runner_load_program(struct runner *r, const char *path, char *err, size_t er
         else if (motion_plan_info(r->motion, &r->plan) != MOTION_OK)
             st = errbuf_set(err, errlen, RUNNER_ERR_PLAN, "%s", motion_hal_fault(r->hal));
     }
-    canon_prog_free(&prog);
     r->loaded = st == RUNNER_OK;
     return st;
+}
+
+/* Whether a command is a move or another command that happens on the path. */
+static bool runner_is_motion(enum canon_type t)
+{
+    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC || t == CANON_DWELL ||
+           t == CANON_PAUSE || t == CANON_SETTING;
+}
+
+/* The program from line from_line on (see runner.h): modal commands of the lines before it
+ * stay, their moves and settings go; a rapid to the start of from_line comes first. */
+static int runner_cut_before(const struct canon_prog *in, int from_line, struct canon_prog *out,
+                             char *err, size_t errlen)
+{
+    double at[KINS_POSE_DIM];
+    memcpy(at, in->start, sizeof at);
+    memcpy(out->start, in->start, sizeof at);
+    bool started = false;
+    int last_comp = 0;
+    for (size_t i = 0; i < in->count; i++) {
+        const struct canon_cmd *c = &in->cmds[i];
+        if (!started && c->line >= from_line && c->type != CANON_OFFSETS) {
+            started = true;
+            if ((c->type == CANON_FEED || c->type == CANON_ARC) && c->compensated &&
+                last_comp)
+                return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s:%d: the program cannot "
+                                  "start inside a G141/G142 run: start at the line that "
+                                  "begins it", c->file, c->line);
+            struct canon_cmd go = *c;
+            go.type = CANON_TRAVERSE;
+            memcpy(go.end, at, sizeof go.end);
+            go.compensated = 0;
+            go.setting = NULL;
+            go.text = NULL;
+            if (canon_prog_sink(out, &go) != 0)
+                return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
+        }
+        if (!started && runner_is_motion(c->type)) {
+            if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC) {
+                memcpy(at, c->end, sizeof at);
+                last_comp = c->compensated;
+            }
+            continue;
+        }
+        if (canon_prog_sink(out, c) != 0)
+            return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
+    }
+    if (!started)
+        return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "the program has no line %d or "
+                          "later to start from", from_line);
+    return RUNNER_OK;
+}
+
+/* Interprets, then plans from line from_line (1: the whole program). */
+int runner_load_program_from(struct runner *r, const char *path, int from_line, char *err,
+                             size_t errlen)
+{
+    if (runner_moving(r))
+        return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+    struct canon_prog prog, cut;
+    canon_prog_init(&prog);
+    canon_prog_init(&cut);
+    r->loaded = false;
+    int st = runner_check_size(r, path, err, errlen);
+    if (st == RUNNER_OK)
+        st = runner_interpret(r, path, &prog, err, errlen);
+    if (st == RUNNER_OK && from_line > 1)
+        st = runner_cut_before(&prog, from_line, &cut, err, errlen);
+    if (st == RUNNER_OK)
+        st = runner_load_canon(r, from_line > 1 ? &cut : &prog, err, errlen);
+    canon_prog_free(&prog);
+    canon_prog_free(&cut);
+    return st;
+}
+
+/* Interprets then plans the whole program. */
+int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen)
+{
+    return runner_load_program_from(r, path, 1, err, errlen);
 }
 
 /* The plan of the loaded program (time, length, peak leg rates). */

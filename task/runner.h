@@ -117,6 +117,17 @@ const char *runner_default_program(const struct runner *r);
 /* Interprets the whole program (with [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE)
  * and plans it. Nothing moves; on failure err holds "file:line: what". */
 int runner_load_program(struct runner *r, const char *path, char *err, size_t errlen);
+/* The same from line from_line on (run from line): the whole program is interpreted, so the
+ * modal state of the lines before it is rebuilt (units, offsets, tool, feed, spindle); their
+ * moves and settings are left out, and a rapid move from the present pose to where line
+ * from_line starts comes first, checked like any move. Refused inside a G141/G142 run. */
+int runner_load_program_from(struct runner *r, const char *path, int from_line, char *err,
+                             size_t errlen);
+/* Plans an interpreted program (MDI): its settings are saved as they execute. */
+int runner_load_canon(struct runner *r, const struct canon_prog *prog, char *err,
+                      size_t errlen);
+/* Block delete switch for the programs loaded next. */
+void runner_set_block_delete(struct runner *r, bool on);
 /* The operator's stop request (Ctrl-C) for runner_load_program: a flag the caller's signal
  * handler sets (NULL: none). The interpreter checks it before every line and the planner at
  * every command and knot; once set, loading ends with RUNNER_ERR_ABORTED and nothing moves.

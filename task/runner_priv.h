@@ -24,6 +24,7 @@ struct runner {
     long ready_since;                   /* monitor periods when the drives were first seen
                                          * ready after the start; -1 not yet */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
+    bool block_delete;                  /* the block-delete switch for the next load */
     runner_message_fn msg_fn;           /* gets every component message (may be NULL) */
     void *msg_ctx;
     char first_fault[300];              /* "source: text" of the first fault message: the cause */
