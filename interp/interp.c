@@ -213,6 +213,20 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     v->path_tol_mm = in->path_tol_mm;
     v->naive_cam_tol_mm = in->naive_cam_tol_mm;
     v->comp5_active = in->comp.active;
+    v->motion = in->motion;
+    v->incremental = in->incremental;
+    v->inverse_time = in->inverse_time;
+    v->feed_mm_min = in->feed_mm_min;
+    v->spindle_dir = in->spindle_dir;
+    v->spindle_rpm = in->spindle_rpm;
+    v->flood = in->flood;
+    v->mist = in->mist;
+    v->selected_tool = in->selected_tool;
+}
+
+void interp_set_current_tool(struct interp *in, int tool)
+{
+    in->current_tool = in->selected_tool = tool;
 }
 
 /* Reads numbered parameter #n. */

@@ -103,6 +103,8 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
 const struct interp_error *interp_last_error(const struct interp *in);
 /* MDI: lines come one at a time (a run need not end with M2 or M30). */
 void interp_set_mdi(struct interp *in, int on);
+/* The tool in the spindle (as M61 Q sets it, without a tool change). */
+void interp_set_current_tool(struct interp *in, int tool);
 
 /* A read-only view of the modal state, for tools that print program coordinates. */
 struct interp_view {
@@ -118,6 +120,14 @@ struct interp_view {
     double path_tol_mm;       /* G64 P: blend tolerance, mm (0: none given) */
     double naive_cam_tol_mm;  /* G64 Q: naive CAM tolerance, mm (0: none given) */
     int comp5_active;         /* a G141/G142 run is open */
+    int motion;               /* group 1 modal code x10 (0 G0, 10 G1, ...), -1: G80 */
+    int incremental;          /* 1 under G91 */
+    int inverse_time;         /* 1 under G93 */
+    double feed_mm_min;       /* F in force, mm/min */
+    int spindle_dir;          /* 1 (M3), -1 (M4), 0 (M5) */
+    double spindle_rpm;       /* S in force */
+    int flood, mist;          /* M8, M7 in force */
+    int selected_tool;        /* T of the last T word */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */

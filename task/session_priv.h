@@ -1,0 +1,120 @@
+/* session_priv.h: the session's state, shared by session*.c. */
+#ifndef HEXCNC_TASK_SESSION_PRIV_H
+#define HEXCNC_TASK_SESSION_PRIV_H
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "interp/tooltable.h"
+#include "task/runner_priv.h"
+#include "task/session.h"
+
+enum session_state { SESS_ESTOP, SESS_OFF, SESS_ON };
+enum session_mode { SESS_MANUAL, SESS_AUTO, SESS_MDI };
+
+/* JSON-RPC error codes (docs/api.md). */
+enum {
+    RPC_PARSE = -32700, RPC_INVALID = -32600, RPC_NO_METHOD = -32601, RPC_PARAMS = -32602,
+    RPC_STATE = -32001, RPC_CONTROL = -32002, RPC_PROGRAM = -32003, RPC_NOT_FOUND = -32004,
+    RPC_FAILED = -32005,
+};
+
+#define SESSION_MAX_CLIENTS 32
+
+struct session_client {
+    int fd;
+    unsigned id;                 /* for control and messages */
+    char *in;                    /* bytes read, not yet a whole line */
+    size_t inlen, incap;
+    char *out;                   /* bytes to write */
+    size_t outlen, outcap;
+    double status_rate_hz;       /* status notifications (0: none) */
+    int64_t next_status_ns;
+    bool messages;               /* message notifications */
+    bool closing;                /* close once out is written */
+};
+
+struct session {
+    struct runner *r;
+    struct hal *hal;
+    struct motion *m;
+    struct kins *k;
+    int nj;
+    bool sim;
+    long period_ns;
+    int quiet;
+    enum session_state state;
+    enum session_mode mode;
+    bool running;                /* a program or MDI line is under way */
+    bool run_is_mdi;
+    bool stopping;               /* program.abort asked */
+    char program[1024];          /* open program ("" when none) */
+    long program_lines;
+    char last_error[800];
+    bool no_force_homing;
+    bool shutdown;
+    /* MDI: one interpreter for the session, so modal state carries from line to line */
+    struct interp *mdi;
+    struct tooltable mdi_tt;
+    /* overrides and switches */
+    double feed_ovr, rapid_ovr, spindle_ovr;
+    bool optional_stop, block_delete;
+    double *feed_ovr_pin;        /* motion.feed-override (NULL when wired by the HAL files) */
+    unsigned note_seq;           /* last manual-motion note reported */
+    int last_mstate;             /* motion state at the last tick */
+    /* the socket */
+    char sock_path[512];
+    int lfd;
+    struct session_client *cl[SESSION_MAX_CLIENTS];
+    unsigned next_id;
+    unsigned holder;             /* client id holding control, 0: none */
+};
+
+/* session.c: commands (each returns 0 or an RPC error code with the message in err). */
+int session_estop(struct session *s, bool active, char *err, size_t len);
+int session_power(struct session *s, bool on, char *err, size_t len);
+int session_home(struct session *s, int joint, char *err, size_t len);
+int session_unhome(struct session *s, int joint, char *err, size_t len);
+int session_set_mode(struct session *s, enum session_mode mode, char *err, size_t len);
+int session_jog(struct session *s, int frame, int axis, double vel, double dist, char *err,
+                size_t len);
+int session_jog_stop(struct session *s, char *err, size_t len);
+int session_mdi(struct session *s, const char *line, char *err, size_t len);
+int session_open(struct session *s, const char *path, char *err, size_t len);
+int session_check(struct session *s, json_t **result, char *err, size_t len);
+int session_run_program(struct session *s, int from_line, char *err, size_t len);
+int session_pause(struct session *s, char *err, size_t len);
+int session_resume(struct session *s, char *err, size_t len);
+int session_step(struct session *s, char *err, size_t len);
+int session_abort(struct session *s, char *err, size_t len);
+int session_overrides(struct session *s, const double *feed, const double *rapid,
+                      const double *spindle, char *err, size_t len);
+/* One tick: machine state, program end, messages. */
+void session_tick(struct session *s);
+/* Whether anything moves or waits (the simulated clock then runs flat out). */
+bool session_busy(const struct session *s);
+/* Posts a message to subscribers (and stderr unless quiet). sev: info, warning, error. */
+void session_message(struct session *s, const char *sev, const char *source,
+                     const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+
+/* session_status.c */
+json_t *session_status(struct session *s);
+const char *session_state_name(enum session_state st);
+const char *session_mode_name(enum session_mode md);
+
+/* session_api.c: one request line in, the response (or NULL for a notification). */
+json_t *session_dispatch(struct session *s, struct session_client *c, const char *line,
+                         size_t len);
+
+/* session_server.c */
+int session_server_open(struct session *s, const char *path, char *err, size_t len);
+void session_server_close(struct session *s);
+/* Serves the socket for at most timeout_ms. */
+void session_server_poll(struct session *s, int timeout_ms);
+void session_server_send(struct session *s, struct session_client *c, json_t *msg);
+/* Sends to every client subscribed to messages / due for a status. */
+void session_server_broadcast_message(struct session *s, json_t *msg);
+void session_server_status(struct session *s);
+
+#endif

@@ -1,0 +1,146 @@
+/* session_status.c: the session's status object (docs/api.md, "Status"). */
+#include "task/session_priv.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "interp/interp.h"
+#include "motion/motion_hal.h"
+
+const char *session_state_name(enum session_state st)
+{
+    return st == SESS_ESTOP ? "estop" : st == SESS_OFF ? "off" : "on";
+}
+
+const char *session_mode_name(enum session_mode md)
+{
+    return md == SESS_MANUAL ? "manual" : md == SESS_AUTO ? "auto" : "mdi";
+}
+
+/* An array of n doubles (null entries for NaN). */
+static json_t *vec(const double *v, int n)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, isfinite(v[i]) ? json_real(v[i]) : json_null());
+    return a;
+}
+
+/* What the interpreter is doing, as LinuxCNC names it. */
+static const char *interp_name(const struct session *s, enum motion_state st)
+{
+    if (!s->running)
+        return "idle";
+    if (st == MOTION_PAUSED || st == MOTION_PAUSING)
+        return "paused";
+    return "reading";
+}
+
+/* The modal G codes of the MDI interpreter (the program's are its own while it runs). */
+static json_t *gcodes(const struct session *s)
+{
+    struct interp_view v;
+    interp_get_view(s->mdi, &v);
+    char buf[16];
+    json_t *a = json_array();
+    snprintf(buf, sizeof buf, "G%d", v.plane);
+    json_array_append_new(a, json_string(buf));
+    json_array_append_new(a, json_string(v.inch ? "G20" : "G21"));
+    static const char *const cs[] = { "G54", "G55", "G56", "G57", "G58", "G59", "G59.1",
+                                      "G59.2", "G59.3" };
+    if (v.coord_system >= 1 && v.coord_system <= 9)
+        json_array_append_new(a, json_string(cs[v.coord_system - 1]));
+    json_array_append_new(a, json_string(v.path_mode == 640 ? "G64" : v.path_mode == 611
+                                         ? "G61.1" : "G61"));
+    if (v.motion < 0)
+        snprintf(buf, sizeof buf, "G80");
+    else if (v.motion % 10)
+        snprintf(buf, sizeof buf, "G%d.%d", v.motion / 10, v.motion % 10);
+    else
+        snprintf(buf, sizeof buf, "G%d", v.motion / 10);
+    json_array_insert_new(a, 0, json_string(buf));
+    json_array_append_new(a, json_string(v.incremental ? "G91" : "G90"));
+    json_array_append_new(a, json_string(v.inverse_time ? "G93" : "G94"));
+    return a;
+}
+
+/* The session's modal M codes: spindle and coolant. */
+static json_t *mcodes(const struct interp_view *v)
+{
+    json_t *a = json_array();
+    json_array_append_new(a, json_string(v->spindle_dir > 0 ? "M3" : v->spindle_dir < 0
+                                         ? "M4" : "M5"));
+    if (v->mist)
+        json_array_append_new(a, json_string("M7"));
+    if (v->flood)
+        json_array_append_new(a, json_string("M8"));
+    if (!v->mist && !v->flood)
+        json_array_append_new(a, json_string("M9"));
+    return a;
+}
+
+json_t *session_status(struct session *s)
+{
+    struct motion_out o;
+    motion_hal_out(s->hal, &o);
+    enum motion_state st = o.state;
+    json_t *homed = json_array();
+    for (int i = 0; i < s->nj; i++)
+        json_array_append_new(homed, json_boolean(motion_homed(s->m, i)));
+    /* the actual pose: forward kinematics of the legs' feedback, warm-started at the command */
+    double actual[KINS_POSE_DIM], nanpose[KINS_POSE_DIM];
+    memcpy(actual, o.pose, sizeof actual);
+    bool ok = motion_pose_known(s->m) &&
+              kins_forward(s->k, o.joint_fb, actual, NULL) == KINS_OK;
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        nanpose[i] = (double)NAN;
+    const double *cmd = motion_pose_known(s->m) ? o.pose : nanpose;
+    struct interp_view v;
+    interp_get_view(s->mdi, &v);
+    double off[KINS_POSE_DIM], pcmd[KINS_POSE_DIM], pact[KINS_POSE_DIM];
+    for (int i = 0; i < KINS_POSE_DIM; i++) {
+        off[i] = v.g5x_mm[i] + v.g92_mm[i] + v.tool_mm[i];
+        pcmd[i] = cmd[i] - off[i];
+        pact[i] = ok ? actual[i] - off[i] : (double)NAN;
+    }
+    json_t *legs = json_array();
+    for (int i = 0; i < s->nj; i++)
+        json_array_append_new(legs, json_pack("{s:f, s:f, s:f, s:f, s:f}", "length",
+                                              o.joint_fb[i], "rate", o.joint_vel[i],
+                                              "ferror", o.ferror_mm[i], "min",
+                                              s->k->joint_min[i], "max", s->k->joint_max[i]));
+    struct runner_progress p;
+    runner_get_progress(s->r, &p);
+    double progress = s->running ? fmin(1.0, p.percent / 100.0) : 0.0;
+    json_t *j = json_pack(
+        "{s:f, s:s, s:s, s:o, s:b, s:s, s:s, s:s?, s:i, s:f,"
+        " s:{s:o, s:o}, s:{s:o, s:o}, s:o, s:o, s:o, s:{s:i, s:i, s:f}, s:f,"
+        " s:{s:f, s:i, s:f}, s:{s:b, s:b}, s:{s:f, s:f, s:f}, s:{s:b, s:b}, s:s?}",
+        "time", (double)hal_now_ns(s->hal) * 1e-9,
+        "state", session_state_name(s->state),
+        "mode", session_mode_name(s->mode),
+        "homed", homed,
+        "homing", motion_homing(s->m),
+        "interp", interp_name(s, st),
+        "motion", motion_state_name(st),
+        "program", s->program[0] ? s->program : NULL,
+        "line", s->running ? o.line : 0,
+        "progress", progress,
+        "pose", "commanded", vec(pcmd, KINS_POSE_DIM), "actual",
+        ok ? vec(pact, KINS_POSE_DIM) : json_null(),
+        "machine_pose", "commanded", vec(cmd, KINS_POSE_DIM), "actual",
+        ok ? vec(actual, KINS_POSE_DIM) : json_null(),
+        "legs", legs,
+        "gcodes", gcodes(s),
+        "mcodes", mcodes(&v),
+        "tool", "number", v.current_tool, "selected", v.selected_tool, "length",
+        v.tool_mm[2],
+        "feed", v.feed_mm_min,
+        "spindle", "speed", v.spindle_rpm, "direction", v.spindle_dir, "override",
+        s->spindle_ovr,
+        "coolant", "mist", v.mist != 0, "flood", v.flood != 0,
+        "overrides", "feed", s->feed_ovr, "rapid", s->rapid_ovr, "spindle", s->spindle_ovr,
+        "switches", "optional_stop", s->optional_stop, "block_delete", s->block_delete,
+        "error", s->last_error[0] ? s->last_error : NULL);
+    return j;
+}

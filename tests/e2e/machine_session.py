@@ -1,0 +1,413 @@
+"""machine_session.py: `hexcnc machine` end to end through its Unix socket, on the simulated
+clock: states and refusals, homing (with simulated home switches and an error the controller
+cannot see), starting where the machine stands, jogs in each frame up to a workspace edge,
+MDI, a program's check, run, pause, resume, step, abort and run from a line, overrides, and
+hostile clients. Standard library only; run by machine_session.sh."""
+import json
+import math
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.environ.get("HEXCNC_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.environ.get("HEXCNC_BIN", os.path.join(ROOT, "bin", "hexcnc"))
+SIM = os.path.join(ROOT, "configs", "sim")
+FAILS = []
+
+
+def check(name, cond, detail=""):
+    print(("ok   " if cond else "FAIL ") + name + ("" if cond else "  " + str(detail)))
+    if not cond:
+        FAILS.append(name)
+
+
+class Conn:
+    """One client: requests by id, notifications kept aside."""
+
+    def __init__(self, path):
+        self.s = socket.socket(socket.AF_UNIX)
+        self.s.settimeout(30)
+        self.s.connect(path)
+        self.buf = b""
+        self.notes = []
+        self.id = 0
+
+    def send(self, method, **params):
+        self.id += 1
+        msg = {"jsonrpc": "2.0", "id": self.id, "method": method, "params": params}
+        self.s.sendall(json.dumps(msg).encode() + b"\n")
+        return self.id
+
+    def line(self):
+        while b"\n" not in self.buf:
+            chunk = self.s.recv(1 << 16)
+            if not chunk:
+                return None
+            self.buf += chunk
+        l, self.buf = self.buf.split(b"\n", 1)
+        return json.loads(l)
+
+    def reply(self, rid):
+        while True:
+            m = self.line()
+            if m is None:
+                return None
+            if m.get("id") == rid:
+                return m
+            self.notes.append(m)
+
+    def call(self, method, **params):
+        return self.reply(self.send(method, **params))
+
+    def ok(self, method, **params):
+        r = self.call(method, **params)
+        if "error" in r:
+            raise AssertionError("%s: %s" % (method, r["error"]["message"]))
+        return r["result"]
+
+    def status(self):
+        return self.ok("status.get")
+
+    def wait(self, timeout=60):
+        end = time.time() + timeout
+        while time.time() < end:
+            st = self.status()
+            if (st["interp"] == "idle" and not st["homing"]
+                    and st["motion"] in ("idle", "done", "fault")):
+                return st
+            time.sleep(0.01)
+        raise AssertionError("still busy after %s s: %s" % (timeout, st))
+
+    def messages(self):
+        return [n["params"]["text"] for n in self.notes if n.get("method") == "message"]
+
+
+def start(ini, sock, script=False):
+    """hexcnc machine, or scripts/hexcnc-start without a program (the same session)."""
+    if script:
+        env = dict(os.environ, HEXCNC_BIN=BIN)
+        p = subprocess.Popen(["sh", os.path.join(ROOT, "scripts", "hexcnc-start"),
+                              "--sim-clock", "--quiet", "--socket", sock, ini], env=env)
+    else:
+        p = subprocess.Popen([BIN, "machine", "--sim-clock", "--quiet", "--socket", sock, ini])
+    for _ in range(500):
+        if os.path.exists(sock):
+            return p
+        if p.poll() is not None:
+            raise AssertionError("hexcnc machine exited with %d" % p.returncode)
+        time.sleep(0.01)
+    raise AssertionError("no socket")
+
+
+def stop(p, c):
+    c.ok("machine.shutdown")
+    p.wait(timeout=20)
+    return p.returncode
+
+
+def err_code(r):
+    return r.get("error", {}).get("code")
+
+
+def plain_session(tmp):
+    sock = os.path.join(tmp, "m.sock")
+    p = start(os.path.join(SIM, "tmu-hexapod.ini"), sock, script=True)
+    c = Conn(sock)
+    c.ok("messages.subscribe")
+    st = c.status()
+    check("starts in e-stop, unhomed", st["state"] == "estop" and not any(st["homed"]), st)
+    check("jog in e-stop refused (-32001, says why)",
+          err_code(c.call("jog.move", frame="joint", axis=0, velocity=1)) == -32001)
+    c.ok("machine.estop", active=False)
+    c.ok("machine.power", on=True)
+    r = c.call("program.open", path="tmu-hexapod-demo.ngc")
+    check("program.open gives path and lines", r.get("result", {}).get("lines", 0) > 5, r)
+    r = c.call("program.run")
+    check("run before homing refused", err_code(r) == -32001 and "homed" in
+          r["error"]["message"], r)
+    r = c.call("jog.move", frame="world", axis="X", velocity=5)
+    check("world jog before homing refused", err_code(r) == -32001, r)
+    c.ok("machine.home")
+    st = c.wait()
+    check("homed: every leg", all(st["homed"]), st["homed"])
+    home = st["machine_pose"]["commanded"]
+    check("at [KINS] HOME after homing", max(abs(a - b) for a, b in
+                                             zip(home, [0, 0, 645, 0, 0, 0])) < 1e-6, home)
+
+    # incremental world jog: exactly the distance
+    c.ok("jog.move", frame="world", axis="X", velocity=20, distance=10)
+    st = c.wait()
+    x = st["machine_pose"]["commanded"]
+    check("world jog X+10 lands on X10", abs(x[0] - 10) < 1e-6 and abs(x[1]) < 1e-9, x)
+    # rotary world jog
+    c.ok("jog.move", frame="world", axis="C", velocity=-10, distance=5)
+    st = c.wait()
+    check("world jog C-5", abs(st["machine_pose"]["commanded"][5] + 5) < 1e-6,
+          st["machine_pose"]["commanded"])
+    # tool frame: along the platform's own Z, turned by C
+    c.ok("jog.move", frame="tool", axis="X", velocity=10, distance=4)
+    st = c.wait()
+    q = st["machine_pose"]["commanded"]
+    dx, dy = q[0] - 10, q[1]
+    check("tool jog X4 goes along the turned platform X", abs(math.hypot(dx, dy) - 4) < 1e-6
+          and abs(math.degrees(math.atan2(dy, dx)) + 5) < 1e-4, q)
+    # continuous jog up to the workspace edge
+    c.notes.clear()
+    c.ok("jog.move", frame="world", axis="Z", velocity=50)
+    st = c.wait()
+    legs = [l["length"] for l in st["legs"]]
+    check("continuous Z jog stops at a leg's limit, not beyond",
+          max(legs) <= 980 and max(legs) > 979.5, legs)
+    check("the stop at the edge is reported", any("edge of the reachable workspace" in m for m in c.messages()),
+          c.messages())
+    # joint jog back down
+    c.ok("jog.move", frame="joint", axis=0, velocity=-20, distance=30)
+    st2 = c.wait()
+    check("joint jog moves one leg 30 mm", abs(st2["legs"][0]["length"] -
+                                              (st["legs"][0]["length"] - 30)) < 0.01,
+          (st["legs"][0], st2["legs"][0]))
+
+    # MDI
+    c.ok("mdi.execute", line="G0 X5 Y5 Z650 A0 B0 C0")
+    st = c.wait()
+    check("MDI G0 reaches its point", max(abs(a - b) for a, b in zip(
+        st["machine_pose"]["commanded"], [5, 5, 650, 0, 0, 0])) < 1e-6,
+        st["machine_pose"]["commanded"])
+    c.ok("mdi.execute", line="G91")
+    c.ok("mdi.execute", line="G1 X1 F600")
+    st = c.wait()
+    check("MDI keeps its modal state (G91 from the line before)",
+          abs(st["machine_pose"]["commanded"][0] - 6) < 1e-6, st["machine_pose"])
+    c.ok("mdi.execute", line="M3 S1200")
+    c.ok("mdi.execute", line="M8")
+    st = c.status()
+    check("status shows the modal state: G91, M3 S1200, M8", "G91" in st["gcodes"] and
+          "M3" in st["mcodes"] and "M8" in st["mcodes"] and st["spindle"]["speed"] == 1200
+          and st["spindle"]["direction"] == 1 and st["coolant"]["flood"],
+          (st["gcodes"], st["mcodes"], st["spindle"], st["coolant"]))
+    c.ok("mdi.execute", line="M5 M9")
+    c.ok("mdi.execute", line="G90")
+    st = c.status()
+    check("... and its changes: G90, M5, M9", "G90" in st["gcodes"] and "M5" in st["mcodes"]
+          and "M9" in st["mcodes"] and st["spindle"]["direction"] == 0, (st["gcodes"],
+                                                                         st["mcodes"]))
+    r = c.call("mdi.execute", line="G1 X10 Q")
+    check("a bad MDI line: -32003 naming MDI:1", err_code(r) == -32003 and
+          r["error"]["message"].startswith("MDI:1"), r)
+    r = c.call("mdi.execute", line="G0 Z2000")
+    check("an unreachable MDI move is refused before motion", err_code(r) == -32003, r)
+
+    # program: check, then run and pause in one turn (deterministic on the simulated clock)
+    r = c.ok("program.check")
+    check("program.check ok with time and length", r["ok"] and r["time_s"] > 1, r)
+    st = c.status()
+    check("check does not start the program", st["interp"] == "idle", st["interp"])
+    a, b = c.send("program.run"), c.send("program.pause")
+    c.reply(a), c.reply(b)
+    time.sleep(0.3)
+    st = c.status()
+    check("pause: the program holds on the path", st["interp"] == "paused" and
+          st["motion"] == "paused", (st["interp"], st["motion"]))
+    r = c.call("jog.move", frame="world", axis="X", velocity=1)
+    check("jog during a program refused", err_code(r) == -32001, r)
+    r = c.call("mdi.execute", line="G0 X0")
+    check("MDI during a program refused", err_code(r) == -32001, r)
+    c.ok("override.set", feed=1.5)
+    c.ok("program.resume")
+    st = c.wait()
+    check("resumed program runs to its end", st["motion"] == "done", st["motion"])
+    check("program finished reported", any("program finished" in m for m in c.messages()))
+
+    # step: one block, then paused on the path
+    c.ok("override.set", feed=1.0)
+    c.ok("program.step")
+    time.sleep(0.3)
+    st = c.status()
+    check("step runs one block and pauses", st["interp"] == "paused" and st["line"] > 0,
+          (st["interp"], st["line"]))
+    c.ok("program.abort")
+    st = c.wait()
+    check("abort from a pause: at rest", st["motion"] == "idle" and st["interp"] == "idle",
+          st["motion"])
+
+    # abort while moving: decelerates on the path, says so
+    c.notes.clear()
+    a, b = c.send("program.run"), c.send("program.abort")
+    c.reply(a), c.reply(b)
+    st = c.wait()
+    check("abort: stopped by the operator, at rest", any("stopped by the operator" in m for m
+                                                        in c.messages()), c.messages())
+    # run from a line: the modal state of the lines before it is rebuilt
+    c.ok("program.run", from_line=8)
+    st = c.wait()
+    check("run from line 8 runs to the end", st["motion"] == "done", st["motion"])
+
+    # e-stop during a run, then reset, on, and run again
+    a, b = c.send("program.run"), c.send("machine.estop", active=True)
+    c.reply(a), c.reply(b)
+    st = c.status()
+    check("e-stop: state estop, motion stopped, the program ended", st["state"] == "estop" and
+          st["motion"] in ("fault", "idle") and st["interp"] == "idle",
+          (st["state"], st["motion"], st["interp"]))
+    r = c.call("machine.power", on=True)
+    check("machine on refused in e-stop", err_code(r) == -32001, r)
+    c.ok("machine.estop", active=False)
+    c.ok("machine.power", on=True)
+    st = c.status()
+    check("after reset and on, the command is where the legs are",
+          st["state"] == "on" and st["machine_pose"]["actual"] is not None and
+          max(abs(a - b) for a, b in zip(st["machine_pose"]["commanded"],
+                                         st["machine_pose"]["actual"])) < 0.05, st)
+    c.ok("program.run", from_line=8)
+    st = c.wait()
+    check("runs again from a line after the e-stop", st["motion"] == "done", st["motion"])
+
+    # control: a second client is refused while the first holds it
+    c.ok("control.acquire")
+    d = Conn(sock)
+    r = d.call("mdi.execute", line="G0 X0")
+    check("another client's command refused while control is held", err_code(r) == -32002, r)
+    check("another client may read status", "result" in d.call("status.get"))
+    c.ok("control.release")
+    hostile(sock, c)
+    check("session exits 0 on machine.shutdown", stop(p, c) == 0)
+    check("socket removed at the end", not os.path.exists(sock))
+
+
+def hostile(sock, c):
+    """Clients that send garbage, too much, too many, or never read."""
+    h = Conn(sock)
+    h.s.sendall(b"this is not json\n")
+    r = h.line()
+    check("garbage: parse error -32700", err_code(r) == -32700, r)
+    check("unknown method: -32601", err_code(h.call("no.such")) == -32601)
+    check("wrong parameter type: -32602 naming it",
+          err_code(h.call("jog.move", frame="world", axis="X", velocity="fast")) == -32602)
+    h.s.sendall(b"[1,2]\n")
+    check("a batch: -32600", err_code(h.line()) == -32600)
+    big = Conn(sock)
+    try:
+        big.s.sendall(b'{"x":"' + b"a" * (2 << 20))
+    except OSError:
+        pass
+    r = big.line()
+    check("a 2 MiB line: -32600 and closed", r is not None and err_code(r) == -32600, r)
+    many = []
+    for _ in range(40):
+        for _ in range(100):  # a full listen backlog: a client tries again
+            try:
+                many.append(Conn(sock))
+                break
+            except BlockingIOError:
+                time.sleep(0.01)
+    time.sleep(0.2)
+    refused = 0
+    for m in many:
+        try:
+            m.s.settimeout(0.5)
+            m.s.sendall(b'{"jsonrpc":"2.0","id":1,"method":"status.get"}\n')
+            r = m.line()
+            refused += r is None or "error" in r
+        except OSError:
+            refused += 1
+    check("40 connections: the session serves its maximum, refuses the rest",
+          len(many) == 40 and refused >= 40 - 32 and refused < 40, (len(many), refused))
+    for m in many:
+        m.s.close()
+    lazy = Conn(sock)
+    lazy.send("status.subscribe", rate_hz=100)
+    lazy.s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    c.ok("mdi.execute", line="G0 X0 Y0 Z645")
+    t0 = time.time()
+    st = c.wait()
+    check("a client that never reads does not stall the session", time.time() - t0 < 30 and
+          st["motion"] == "done")
+    check("the session still answers after all that", c.status()["state"] == "on")
+
+
+def homing_ini(tmp):
+    """configs/sim with home switches on its legs, an offset the controller cannot see, and
+    legs that are not at HOME when the machine starts."""
+    text = open(os.path.join(SIM, "tmu-hexapod.ini")).read()
+    for name in ("tmu-hexapod.hal", "tmu-hexapod-task.hal", "tmu-hexapod.tbl",
+                 "tmu-hexapod-demo.ngc"):
+        text = text.replace("= " + name, "= " + os.path.join(SIM, name))
+    text = text.replace("HALFILE = " + os.path.join(SIM, "tmu-hexapod.hal"),
+                        "HALFILE = " + os.path.join(SIM, "tmu-hexapod.hal") +
+                        "\nHALFILE = homing.hal")
+    text = text.replace("HALFILE = lcm-status.hal", "")
+    for i in range(6):
+        text = text.replace("[JOINT_%d]\n" % i, "[JOINT_%d]\nHOME_SEARCH_VEL = 20\n"
+                            "HOME_LATCH_VEL = -2\nHOME_OFFSET = 760\nHOME_SEQUENCE = %d\n"
+                            % (i, i // 3))
+    open(os.path.join(tmp, "homing.ini"), "w").write(text)
+    offsets = [3.7, -5.2, 1.1, -0.4, 6.3, -2.9]
+    hal = ["loadrt sim-home count=6"]
+    for i, off in enumerate(offsets):
+        # no hysteresis: the switch opens (the latch, HOME_LATCH_VEL reversed) where it
+        # closed, so the homed length is the true one to a step
+        hal += ["setp sim-home.%d.offset %g" % (i, off), "setp sim-home.%d.home-pos 760" % i,
+                "setp sim-home.%d.hysteresis 0" % i,
+                "setp stepgen.%d.sim-start %g" % (i, 735 + 2 * i),
+                "net leg-%d-fb => sim-home.%d.motor-pos" % (i, i),
+                "net home-sw-%d sim-home.%d.home-sw => motion.joint-home-sw-in-%d" % (i, i, i)]
+    hal.append("addf sim-home.update servo-thread")
+    open(os.path.join(tmp, "homing.hal"), "w").write("\n".join(hal) + "\n")
+    return os.path.join(tmp, "homing.ini"), offsets
+
+
+def homing_session(tmp):
+    ini, offsets = homing_ini(tmp)
+    sock = os.path.join(tmp, "h.sock")
+    p = start(ini, sock)
+    c = Conn(sock)
+    c.ok("messages.subscribe")
+    c.ok("machine.estop", active=False)
+    c.ok("machine.power", on=True)
+    st = c.status()
+    cmd, act = st["machine_pose"]["commanded"], st["machine_pose"]["actual"]
+    check("machine on away from HOME: the command is where the legs are",
+          act is not None and max(abs(a - b) for a, b in zip(cmd, act)) < 0.01, (cmd, act))
+    check("... and that is not HOME", max(abs(a - b) for a, b in
+                                          zip(cmd, [0, 0, 645, 0, 0, 0])) > 1, cmd)
+    c.ok("machine.home")
+    st = c.wait(timeout=120)
+    check("homing with switches: every leg homed", all(st["homed"]), (st["homed"],
+                                                                      c.messages()))
+    errs = []
+    for i in range(6):
+        true_len = float(c.ok("hal.get", name="sim-home.%d.length" % i)["value"])
+        errs.append(abs(true_len - st["legs"][i]["length"]))
+    check("homed legs know their true length (the hidden offsets found) to a step",
+          max(errs) < 0.01, errs)
+    check("after homing the platform is at [KINS] HOME", max(
+        abs(a - b) for a, b in zip(st["machine_pose"]["commanded"], [0, 0, 645, 0, 0, 0]))
+        < 1e-6, st["machine_pose"])
+    check("actual pose (FK of the true legs) at HOME within 0.01 mm",
+          max(abs(a - b) for a, b in zip(st["machine_pose"]["actual"][:3], [0, 0, 645]))
+          < 0.01, st["machine_pose"]["actual"])
+    c.ok("program.open", path=os.path.join(SIM, "tmu-hexapod-demo.ngc"))
+    c.ok("program.run")
+    st = c.wait()
+    check("a program runs after homing", st["motion"] == "done", (st["motion"], st["error"]))
+    stop(p, c)
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="hexcnc-machine.")
+    try:
+        plain_session(tmp)
+        homing_session(tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("machine session: %d failed" % len(FAILS))
+    return 1 if FAILS else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
