@@ -47,33 +47,46 @@ const char *motion_manual_note(const struct motion *m, unsigned *seq)
     return m->note;
 }
 
-/* Speed from which a stop at acceleration a fits in dist after one more period dt. */
+/* The highest speed (distance per period over dt) from which a stop that lowers the speed by
+ * a dt each period fits in dist: m a dt with m (m + 1) / 2 = dist / (a dt^2). */
 static double stop_speed(double dist, double a, double dt)
 {
     if (dist <= 0)
         return 0;
-    return a * (sqrt(dt * dt + 2.0 * dist / a) - dt);
+    return a * dt * (sqrt(0.25 + 2.0 * dist / (a * dt * dt)) - 0.5);
 }
 
-/* One period of a 1-D profile: speed towards vt within +-a dt, and never faster than stops
- * within rem. Returns the distance moved (>= 0). */
+/* Braking runs at a / MAN_BRAKE_SLACK, so that the last period of a stop, which cannot fall
+ * on the grid of whole a dt steps, changes the speed by no more than a dt either. */
+#define MAN_BRAKE_SLACK 1.125
+
+/* The distance a stop from speed w takes (the inverse of stop_speed, braking as
+ * profile_step does). */
+static double stop_dist(double w, double a, double dt)
+{
+    w = fabs(w);
+    return MAN_BRAKE_SLACK * w * w / (2 * a) + 0.5 * w * dt;
+}
+
+/* One period of a 1-D profile in distance per period: *v (the last period's distance / dt)
+ * moves towards vt by at most a dt, and never so fast that a stop no longer fits in rem. The
+ * speeds a servo sees from successive set points change by at most a dt per period, so the
+ * differenced acceleration stays within a. Returns the distance moved (>= 0); one period
+ * after the end, *v is 0. */
 static double profile_step(double *v, double vt, double a, double rem, double dt)
 {
-    double vn = *v + (vt > *v ? fmin(vt - *v, a * dt) : -fmin(*v - vt, a * dt));
-    vn = fmin(vn, stop_speed(rem, a, dt));
-    if (vn < 0)
-        vn = 0;
-    double ds = 0.5 * (*v + vn) * dt;
-    if (ds > rem)
-        ds = rem > 0 ? rem : 0;
-    /* the last bit: arrive and stop this period (a braking of at most a), rather than
-     * creep up on the end ever more slowly */
-    if (rem > 0 && vn <= a * dt && rem <= vn * dt + 0.5 * a * dt * dt) {
+    double w = *v + (vt > *v ? fmin(vt - *v, a * dt) : -fmin(*v - vt, a * dt));
+    w = fmin(w, stop_speed(rem, a / MAN_BRAKE_SLACK, dt));
+    if (w <= 0 || rem <= 0) {
         *v = 0;
+        return 0;
+    }
+    if (w * dt >= rem) {  /* arrives: the last bit; the next period is at rest */
+        *v = rem / dt;
         return rem;
     }
-    *v = vn;
-    return ds;
+    *v = w;
+    return w * dt;
 }
 
 /* Whether the pose is inside the workspace: every leg solvable and within its limits
@@ -95,23 +108,36 @@ static void line_pose(const struct motion_manual *mm, double s, double *pose)
         pose[k] = mm->p0[k] + s * mm->u[k];
 }
 
-/* Speed and acceleration caps at s from the legs' sensitivity there. */
-static void line_caps(struct motion *m, double s, double *vcap, double *acap)
+/* Speed and acceleration caps at s (moving at v) from the legs' sensitivity there. A leg's
+ * acceleration is L' s'' + L'' s'^2: the second term (large on rotary jogs) takes its share
+ * of the leg's acceleration first, and the speed is held where it would take more than half. */
+static void line_caps(struct motion *m, double s, double v, double *vcap, double *acap)
 {
     struct motion_manual *mm = &m->man;
-    double p[KINS_POSE_DIM], q[KINS_POSE_DIM], L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS];
-    line_pose(mm, s, p);
-    line_pose(mm, s + MAN_DS, q);
+    double p[KINS_POSE_DIM], L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS], Lm[KINS_MAX_JOINTS];
+    const double h = MAN_DS;
     *vcap = mm->v_req;
     *acap = mm->a_max;
-    if (kins_inverse(m->kins, p, L0) != KINS_OK || kins_inverse(m->kins, q, L1) != KINS_OK)
+    line_pose(mm, s, p);
+    if (kins_inverse(m->kins, p, L0) != KINS_OK)
         return;
+    line_pose(mm, s + h, p);
+    if (kins_inverse(m->kins, p, L1) != KINS_OK)
+        return;
+    line_pose(mm, s - h, p);
+    bool curv = kins_inverse(m->kins, p, Lm) == KINS_OK;
+    double dt = m->cfg.servo_period_s;
     for (int i = 0; i < m->nj; i++) {
-        double d = fabs(L1[i] - L0[i]) / MAN_DS;
-        if (d < 1e-9)
+        double d1 = curv ? fabs(L1[i] - Lm[i]) / (2 * h) : fabs(L1[i] - L0[i]) / h;
+        double d2 = curv ? fabs(L1[i] - 2 * L0[i] + Lm[i]) / (h * h) : 0;
+        double amax = MAN_ACC_SHARE * m->cfg.joint[i].max_acc_mm_s2;
+        if (d2 > 1e-9)
+            *vcap = fmin(*vcap, sqrt(0.5 * amax / d2));
+        if (d1 < 1e-9)
             continue;
-        *vcap = fmin(*vcap, MAN_VEL_SHARE * m->cfg.joint[i].max_vel_mm_s / d);
-        *acap = fmin(*acap, MAN_ACC_SHARE * m->cfg.joint[i].max_acc_mm_s2 / d);
+        *vcap = fmin(*vcap, MAN_VEL_SHARE * m->cfg.joint[i].max_vel_mm_s / d1);
+        double vn = fmin(fmax(v, 0) + amax / d1 * dt, fmax(*vcap, v));
+        *acap = fmin(*acap, fmax(amax - d2 * vn * vn, 0.5 * amax) / d1);
     }
 }
 
@@ -157,9 +183,9 @@ static void line_step(struct motion *m, double dt)
 {
     struct motion_manual *mm = &m->man;
     double vcap, acap, p[KINS_POSE_DIM], L[KINS_MAX_JOINTS];
-    line_caps(m, mm->s, &vcap, &acap);
+    line_caps(m, mm->s, mm->v, &vcap, &acap);
     /* Look ahead one stopping distance and two periods: an edge there pulls s_end in. */
-    double look = mm->s + mm->v * mm->v / (2 * acap) + 2 * fmax(mm->v, vcap) * dt +
+    double look = mm->s + stop_dist(mm->v, acap, dt) + 3 * fmax(mm->v, vcap) * dt +
                   MAN_EDGE_MARGIN;
     if (look < mm->s_end) {
         line_pose(mm, look, p);
@@ -176,7 +202,8 @@ static void line_step(struct motion *m, double dt)
     double vt = mm->stop ? 0 : vcap;
     double ds = profile_step(&mm->v, vt, acap, mm->s_end - mm->s, dt);
     line_pose(mm, mm->s + ds, p);
-    if (ds > 0 && !pose_ok(m, p, L)) {  /* never step outside, whatever the estimate said */
+    bool inside = pose_ok(m, p, L);  /* L: the legs at p, whatever pose_ok said */
+    if (ds > 0 && !inside) {  /* never step outside, whatever the estimate said */
         if (!mm->limited)
             edge_note(m, mm->s + ds);
         mm->limited = 1;
@@ -220,7 +247,7 @@ static void joints_step(struct motion *m, double dt)
         if (v < 0) {  /* moving away from the target: brake first */
             double dv = fmin(-v, j->max_acc_mm_s2 * dt);
             double vn = v + dv;
-            m->joint_cmd[i] += dir * 0.5 * (v + vn) * dt;
+            m->joint_cmd[i] += dir * vn * dt;
             mm->jv[i] = vn * dir;
             m->joint_vel[i] = mm->jv[i];
             any = 1;
@@ -421,7 +448,7 @@ void motion_joint_halt(struct motion *m, int i)
 {
     struct motion_manual *mm = &m->man;
     double v = mm->jv[i], a = m->cfg.joint[i].max_acc_mm_s2;
-    mm->jt[i] = m->joint_cmd[i] + (v >= 0 ? 1 : -1) * v * v / (2 * a);
+    mm->jt[i] = m->joint_cmd[i] + (v >= 0 ? 1 : -1) * stop_dist(v, a, m->cfg.servo_period_s);
 }
 
 /* Whether leg i's own move has ended. */

@@ -1,0 +1,293 @@
+/* test_motion_manual.c: jogs and homing on the motion core, period by period: every leg
+ * within its speed, acceleration and length limits (measured by differencing the leg
+ * commands), a jog that runs into the workspace edge stopping short of it with a note, an
+ * incremental jog landing exactly, and homing on home switches finding an offset the
+ * controller cannot see. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+
+/* A perfect drive: the feedback is the last motor command; the true leg is that plus a
+ * hidden offset, and each leg's switch closes at a true length of SW_AT and beyond. */
+struct rig {
+    struct tm_machine mc;
+    struct motion_out o, prev;
+    double hidden[KINS_MAX_JOINTS];
+    double sw_at;
+    int use_switches;
+    /* measured over the run: motor speed and acceleration, leg lengths */
+    double max_v[KINS_MAX_JOINTS], max_a[KINS_MAX_JOINTS];
+    double min_len[KINS_MAX_JOINTS], max_len[KINS_MAX_JOINTS];
+    int steps;
+};
+
+static void rig_step(struct rig *r, double plv[KINS_MAX_JOINTS])
+{
+    int nj = r->mc.kins->njoints;
+    if (r->use_switches) {
+        bool sw[KINS_MAX_JOINTS];
+        for (int i = 0; i < nj; i++)
+            sw[i] = r->prev.motor_pos[i] + r->hidden[i] >= r->sw_at;
+        motion_set_home_switches(r->mc.m, sw);
+    }
+    motion_feedback(r->mc.m, r->prev.motor_pos);
+    motion_step(r->mc.m, DT, &r->o);
+    for (int j = 0; j < nj; j++) {
+        /* the motor's command is the physical motion (a latch redefines the leg's length,
+         * not the motor's position) */
+        double lv = (r->o.motor_pos[j] - r->prev.motor_pos[j]) / DT;
+        r->max_v[j] = fmax(r->max_v[j], fabs(lv));
+        if (r->steps > 0)
+            r->max_a[j] = fmax(r->max_a[j], fabs(lv - plv[j]) / DT);
+        r->min_len[j] = fmin(r->min_len[j], r->o.joint_pos[j]);
+        r->max_len[j] = fmax(r->max_len[j], r->o.joint_pos[j]);
+        plv[j] = lv;
+    }
+    r->prev = r->o;
+    r->steps++;
+}
+
+/* Runs until manual motion ends (or max_s of machine time); stop_after_s > 0 sends a
+ * jog stop then. Returns the machine time taken. */
+static double rig_run(struct rig *r, double max_s, double stop_after_s)
+{
+    double plv[KINS_MAX_JOINTS] = {0};
+    int nj = r->mc.kins->njoints;
+    for (int j = 0; j < nj; j++) {
+        r->max_v[j] = r->max_a[j] = 0;
+        r->min_len[j] = r->max_len[j] = r->prev.joint_pos[j];
+    }
+    r->steps = 0;
+    int n = (int)(max_s / DT);
+    for (int k = 0; k < n; k++) {
+        if (stop_after_s > 0 && k == (int)(stop_after_s / DT))
+            motion_jog_stop(r->mc.m);
+        rig_step(r, plv);
+        if (motion_get_state(r->mc.m) != MOTION_MANUAL)
+            return (k + 1) * DT;
+    }
+    return max_s;
+}
+
+/* The TMU hexapod with legs of vmax mm/s and amax mm/s^2; joints homed at once (no
+ * switches) unless switches is set, and at its home pose. */
+static void rig_open(struct rig *r, double vmax, double amax, int switches)
+{
+    memset(r, 0, sizeof *r);
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c);
+    for (int i = 0; i < 6; i++) {
+        char sec[24], v[32], a[32];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        snprintf(v, sizeof v, "%g", vmax);
+        snprintf(a, sizeof a, "%g", amax);
+        tk_set(c, sec, "MAX_VELOCITY", v);
+        tk_set(c, sec, "MAX_ACCELERATION", a);
+        if (switches) {
+            char seq[8];
+            snprintf(seq, sizeof seq, "%d", i / 3);
+            tk_set(c, sec, "HOME_SEARCH_VEL", "20");
+            tk_set(c, sec, "HOME_LATCH_VEL", "-2");
+            tk_set(c, sec, "HOME_OFFSET", "760");
+            tk_set(c, sec, "HOME_SEQUENCE", seq);
+        }
+    }
+    ck_assert_int_eq(tm_open(&r->mc, c, &kins_hexapod_ops), 0);
+    r->use_switches = switches;
+    r->sw_at = 760;
+    motion_step(r->mc.m, DT, &r->prev);
+}
+
+/* Homes every leg; without switches that takes no motion beyond the move to HOME. */
+static void rig_home(struct rig *r)
+{
+    ck_assert_int_eq(motion_home(r->mc.m, -1), MOTION_OK);
+    rig_run(r, 120, 0);
+    ck_assert_msg(motion_all_homed(r->mc.m), "not homed: %s",
+                  motion_manual_note(r->mc.m, NULL));
+}
+
+static void assert_legs_within(const struct rig *r, double vmax, double amax, int lengths)
+{
+    for (int j = 0; j < r->mc.kins->njoints; j++) {
+        ck_assert_msg(r->max_v[j] <= vmax * (1 + 1e-6), "leg %d at %.5f mm/s (limit %g)",
+                      j + 1, r->max_v[j], vmax);
+        ck_assert_msg(r->max_a[j] <= amax * 1.001, "leg %d at %.3f mm/s^2 (limit %g)", j + 1,
+                      r->max_a[j], amax);
+        ck_assert_msg(!lengths || (r->min_len[j] >= r->mc.kins->joint_min[j] &&
+                      r->max_len[j] <= r->mc.kins->joint_max[j]),
+                      "leg %d went to %.4f..%.4f, limits %g..%g", j + 1, r->min_len[j],
+                      r->max_len[j], r->mc.kins->joint_min[j], r->mc.kins->joint_max[j]);
+    }
+}
+
+/* A world X jog asked for 100 mm/s with legs of 20 mm/s and 200 mm/s^2: every leg stays
+ * within its limits in every period, and the busiest one gets near its speed limit (the jog
+ * is slowed only as far as the legs need). */
+START_TEST(test_world_jog_within_leg_limits)
+{
+    struct rig r;
+    rig_open(&r, 20, 200, 0);
+    rig_home(&r);
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 0, 100, 0), MOTION_OK);
+    rig_run(&r, 10, 1.5);
+    ck_assert_int_eq(motion_get_state(r.mc.m), MOTION_IDLE);
+    assert_legs_within(&r, 20, 200, 1);
+    double busiest = 0;
+    for (int j = 0; j < 6; j++)
+        busiest = fmax(busiest, r.max_v[j]);
+    ck_assert_msg(busiest > 0.9 * 20, "legs held far below their limit: %.3f mm/s", busiest);
+    ck_assert_msg(r.o.pose[0] > 5, "the jog went nowhere: X %.3f", r.o.pose[0]);
+    for (int i = 1; i < 6; i++)
+        ck_assert_msg(fabs(r.o.pose[i] - r.mc.kins->home[i]) < 1e-9,
+                      "axis %d moved on an X jog: %.12f", i, r.o.pose[i]);
+    tm_close(&r.mc);
+}
+END_TEST
+
+/* An A (rotary) jog and a tool-frame jog keep the same limits. */
+START_TEST(test_rotary_and_tool_jog_within_leg_limits)
+{
+    struct rig r;
+    rig_open(&r, 20, 200, 0);
+    rig_home(&r);
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 3, 30, 8), MOTION_OK);
+    rig_run(&r, 20, 0);
+    assert_legs_within(&r, 20, 200, 1);
+    ck_assert_double_eq_tol(r.o.pose[3], r.mc.kins->home[3] + 8, 1e-9);
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_TOOL, 2, -50, 20), MOTION_OK);
+    rig_run(&r, 20, 0);
+    assert_legs_within(&r, 20, 200, 1);
+    /* 20 mm along the tool's axis, which A+8 tilted out of Z */
+    double dz = r.o.pose[2] - r.mc.kins->home[2], dy = r.o.pose[1] - r.mc.kins->home[1];
+    ck_assert_double_eq_tol(sqrt(dz * dz + dy * dy), 20, 1e-6);
+    ck_assert_msg(fabs(dy) > 1, "a tool jog along a tilted tool went straight down (dy %g)",
+                  dy);
+    tm_close(&r.mc);
+}
+END_TEST
+
+/* An incremental jog lands exactly where it was sent. */
+START_TEST(test_incremental_jog_exact)
+{
+    struct rig r;
+    rig_open(&r, 100, 1000, 0);
+    rig_home(&r);
+    double y0 = r.o.pose[1];
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 1, -25, 12.5), MOTION_OK);
+    rig_run(&r, 10, 0);
+    ck_assert_int_eq(motion_get_state(r.mc.m), MOTION_IDLE);
+    ck_assert_double_eq_tol(r.o.pose[1], y0 - 12.5, 1e-9);
+    tm_close(&r.mc);
+}
+END_TEST
+
+/* A continuous Z jog up runs into the workspace edge: it stops by itself, no leg ever
+ * passes its limit, it stops close to the edge (a leg within 1 mm of its limit), and the
+ * note says why. */
+START_TEST(test_jog_stops_at_workspace_edge)
+{
+    struct rig r;
+    rig_open(&r, 100, 1000, 0);
+    rig_home(&r);
+    unsigned seq0, seq1;
+    motion_manual_note(r.mc.m, &seq0);
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 2, 80, 0), MOTION_OK);
+    double t = rig_run(&r, 60, 0);
+    ck_assert_msg(t < 60, "the jog never stopped");
+    ck_assert_int_eq(motion_get_state(r.mc.m), MOTION_IDLE);
+    assert_legs_within(&r, 100, 1000, 1);
+    double closest = 1e9;
+    for (int j = 0; j < 6; j++)
+        closest = fmin(closest, fmin(r.max_len[j] - r.mc.kins->joint_min[j],
+                                     r.mc.kins->joint_max[j] - r.max_len[j]));
+    ck_assert_msg(closest < 1.0, "stopped %.3f mm short of the nearest limit", closest);
+    const char *note = motion_manual_note(r.mc.m, &seq1);
+    ck_assert_uint_ne(seq0, seq1);
+    ck_assert_msg(strstr(note, "edge of the reachable workspace"), "note: %s", note);
+    /* the way back is open */
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 2, -80, 10), MOTION_OK);
+    rig_run(&r, 10, 0);
+    ck_assert_int_eq(motion_get_state(r.mc.m), MOTION_IDLE);
+    tm_close(&r.mc);
+}
+END_TEST
+
+/* World jogs need homed legs; a leg jog does not. */
+START_TEST(test_world_jog_needs_homing)
+{
+    struct rig r;
+    rig_open(&r, 100, 1000, 1);
+    ck_assert_int_ne(motion_jog(r.mc.m, MOTION_JOG_WORLD, 0, 10, 0), MOTION_OK);
+    double l0 = r.prev.joint_pos[4];
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_JOINT, 4, -10, 5), MOTION_OK);
+    rig_run(&r, 10, 0);
+    ck_assert_double_eq_tol(r.o.joint_pos[4], l0 - 5, 1e-9);
+    tm_close(&r.mc);
+}
+END_TEST
+
+/* Homing on switches: the legs' true lengths are their motor positions plus offsets the
+ * controller cannot see; after homing each leg's length is its true length to within the
+ * distance the latch moves in one period, two groups of three legs moved in turn, and the
+ * platform ends at the kinematics' home pose, the legs within their limits throughout. */
+START_TEST(test_homing_with_switches_finds_offsets)
+{
+    static const double hidden[6] = {3.7, -5.2, 1.1, -0.4, 6.3, -2.9};
+    struct rig r;
+    rig_open(&r, 100, 1000, 1);
+    memcpy(r.hidden, hidden, sizeof hidden);
+    ck_assert(!motion_all_homed(r.mc.m));
+    ck_assert_int_eq(motion_home(r.mc.m, -1), MOTION_OK);
+    /* the second group waits while the first homes */
+    double plv[KINS_MAX_JOINTS] = {0};
+    for (int k = 0; k < 200; k++)
+        rig_step(&r, plv);
+    for (int j = 3; j < 6; j++)
+        ck_assert_msg(fabs(r.o.joint_pos[j] - r.prev.joint_pos[j]) < 1e-12 &&
+                      r.max_v[j] == 0, "leg %d of group 1 moved with group 0", j + 1);
+    ck_assert_msg(r.max_v[0] > 1, "group 0 did not start");
+    rig_run(&r, 200, 0);
+    ck_assert_msg(motion_all_homed(r.mc.m), "not homed: %s", motion_manual_note(r.mc.m, NULL));
+    /* speeds and accelerations of the motors; lengths are unknown until each latch */
+    assert_legs_within(&r, 100, 1000, 0);
+    for (int j = 0; j < 6; j++) {
+        double true_len = r.o.motor_pos[j] + hidden[j];
+        ck_assert_msg(fabs(true_len - r.o.joint_pos[j]) <= 2 * DT + 1e-9,
+                      "leg %d: thinks %.5f, is %.5f", j + 1, r.o.joint_pos[j], true_len);
+    }
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(r.o.pose[i], r.mc.kins->home[i], 1e-9);
+    tm_close(&r.mc);
+}
+END_TEST
+
+static Suite *motion_manual_suite(void)
+{
+    Suite *s = suite_create("motion_manual");
+    TCase *tc = tcase_create("manual");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, test_world_jog_within_leg_limits);
+    tcase_add_test(tc, test_rotary_and_tool_jog_within_leg_limits);
+    tcase_add_test(tc, test_incremental_jog_exact);
+    tcase_add_test(tc, test_jog_stops_at_workspace_edge);
+    tcase_add_test(tc, test_world_jog_needs_homing);
+    tcase_add_test(tc, test_homing_with_switches_finds_offsets);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(motion_manual_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
