@@ -86,7 +86,8 @@ static void motion_comp_commands(struct motion_comp *c)
     /* Off: the command follows the legs. Not in the first updates: until the drives'
      * functs have run once, their feedback pins hold nothing but the signals' zeros. */
     if (!*c->enable) {
-        c->start_pending = 0;  /* a start queued before the machine went off is dropped */
+        if (c->was_enabled)
+            c->start_pending = 0;  /* a start queued before the machine went off is dropped */
         if (c->updates > MOTION_FEEDBACK_SETTLE)
             motion_track_feedback(c->m);
     } else if (!c->was_enabled) {
