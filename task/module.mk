@@ -6,4 +6,4 @@ LIB_SRCS += task/session.c task/session_status.c task/session_server.c task/sess
 TESTS += test_e2e test_run_faults test_run_settings test_run_startup
 BENCHES += bench_servo
 SCRIPT_TESTS += tests/e2e/run_cli.sh
-SCRIPT_TESTS += tests/e2e/run_large.sh tests/e2e/machine_session.sh
+SCRIPT_TESTS += tests/e2e/run_large.sh tests/e2e/machine_session.sh tests/e2e/python_client.sh
