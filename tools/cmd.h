@@ -8,4 +8,8 @@
 #include "hexcnc_cmds.h"
 #undef HEXCNC_CMD
 
+/* `hexcnc halcmd --attach [SOCKET] COMMAND...` (in cmd_ctl.c): argv holds what follows
+ * --attach. */
+int ctl_halcmd_attach(int argc, char **argv);
+
 #endif

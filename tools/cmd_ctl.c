@@ -1,5 +1,6 @@
 /* cmd_ctl.c: `hexcnc ctl`: one call to the machine session's API, result as JSON. */
 #include <errno.h>
+#include <stdbool.h>
 #include <jansson.h>
 #include <math.h>
 #include <poll.h>
@@ -225,6 +226,77 @@ static int ctl_watch(struct ctl_conn *c, json_t *params)
         free(text);
         json_decref(j);
     }
+    return rc;
+}
+
+/* `hexcnc halcmd --attach [SOCKET] COMMAND...`: show, getp/gets, setp/sets on the running
+ * machine through hal.show, hal.get and hal.set. */
+int ctl_halcmd_attach(int argc, char **argv)
+{
+    static const char *const cmds[] = { "show", "getp", "gets", "setp", "sets" };
+    char path[256];
+    if (ctl_default_socket(path, sizeof path)) {
+        fprintf(stderr, "halcmd: the socket path is too long\n");
+        return 1;
+    }
+    int i = 0;
+    bool known = false;
+    for (size_t k = 0; argc > 0 && k < sizeof cmds / sizeof *cmds; k++)
+        known |= !strcmp(argv[0], cmds[k]);
+    if (argc > 1 && !known) {  /* the first word is the socket */
+        snprintf(path, sizeof path, "%s", argv[0]);
+        i = 1;
+    }
+    if (i >= argc) {
+        fprintf(stderr, "halcmd --attach: give a command: show [PATTERN], getp NAME, "
+                "gets NAME, setp NAME VALUE, sets NAME VALUE\n");
+        return 2;
+    }
+    const char *cmd = argv[i++];
+    int nargs = argc - i;
+    json_t *params = NULL;
+    const char *method = NULL;
+    if (!strcmp(cmd, "show") && nargs <= 2) {
+        /* `show [pin|param|sig|all] [PATTERN]`: the session shows everything matching */
+        const char *pat = nargs == 2 ? argv[i + 1] : nargs == 1 && strcmp(argv[i], "pin") &&
+                          strcmp(argv[i], "param") && strcmp(argv[i], "sig") &&
+                          strcmp(argv[i], "all") ? argv[i] : "";
+        method = "hal.show";
+        params = json_pack("{s:s}", "pattern", pat);
+    } else if ((!strcmp(cmd, "getp") || !strcmp(cmd, "gets")) && nargs == 1) {
+        method = "hal.get";
+        params = json_pack("{s:s}", "name", argv[i]);
+    } else if ((!strcmp(cmd, "setp") || !strcmp(cmd, "sets")) && nargs == 2) {
+        method = "hal.set";
+        params = json_pack("{s:s, s:s}", "name", argv[i], "value", argv[i + 1]);
+    } else {
+        fprintf(stderr, "halcmd --attach: '%s' with %d argument%s: on a running machine only "
+                "show [PATTERN], getp NAME, gets NAME, setp NAME VALUE and sets NAME VALUE "
+                "work\n", cmd, nargs, nargs == 1 ? "" : "s");
+        return 2;
+    }
+    static struct ctl_conn c;
+    if (!params || ctl_connect(&c, path) != 0) {
+        json_decref(params);
+        return 1;
+    }
+    json_t *resp = ctl_call(&c, method, params, 1);
+    json_decref(params);
+    close(c.fd);
+    json_t *res = json_object_get(resp, "result"), *e = json_object_get(resp, "error");
+    int rc = 0;
+    if (!resp) {
+        fprintf(stderr, "halcmd: %s: no answer from the session\n", path);
+        rc = 1;
+    } else if (e) {
+        fprintf(stderr, "halcmd: %s\n", json_string_value(json_object_get(e, "message")));
+        rc = 1;
+    } else if (!strcmp(method, "hal.show")) {
+        fputs(json_string_value(json_object_get(res, "text")), stdout);
+    } else if (!strcmp(method, "hal.get")) {
+        printf("%s\n", json_string_value(json_object_get(res, "value")));
+    }
+    json_decref(resp);
     return rc;
 }
 

@@ -8,7 +8,9 @@
 const char cmd_halcmd_usage[] =
     "halcmd [-i CONFIG.ini] [-s] [--run-ms N] [-f FILE.hal | COMMAND...]\n"
     "                                  run HAL commands (-s: simulated clock; --run-ms: run\n"
-    "                                  the threads N ms after each `start`)";
+    "                                  the threads N ms after each `start`)\n"
+    "  halcmd --attach [SOCKET] show [PATTERN] | getp NAME | setp NAME VALUE | sets NAME VALUE\n"
+    "                                  on the running machine session (docs/api.md)";
 
 /* Prints the components' messages (drive faults, warnings) that arrived so far. */
 static void halcmd_messages(struct hal *h)
@@ -61,6 +63,8 @@ int cmd_halcmd(int argc, char **argv)
     bool sim = false;
     long run_ms = 0;
     int i = 1;
+    if (argc > 1 && !strcmp(argv[1], "--attach"))
+        return ctl_halcmd_attach(argc - 2, argv + 2);
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "-s")) {
             sim = true;

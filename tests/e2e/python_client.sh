@@ -60,6 +60,20 @@ check "a tool step down (vertical tool): Z 642.5" \
 check "the MDI line reached its point" \
     sh -c "sed -n 4p '$tmp/out' | grep -q '^X 0.0000 Y 0.0000 Z 650.0000 A 0.0000 B 0.0000 C 0.0000$'"
 
+# halcmd on the running machine, through the same API
+"$bin" halcmd --attach "$sock" show 'motion.feed*' >"$tmp/show" 2>&1
+check "halcmd --attach show: the running machine's pins" has "$tmp/show" "motion.feed-override"
+"$bin" halcmd --attach "$sock" setp motion.feed-override 0.75 &&
+    "$bin" halcmd --attach "$sock" getp motion.feed-override >"$tmp/getp" 2>&1
+check "halcmd --attach setp, then getp: 0.75" [ "$(cat "$tmp/getp")" = "0.75" ]
+"$bin" halcmd --attach "$sock" loadrt stepgen >"$tmp/out2" 2>"$tmp/err2"
+check "halcmd --attach refuses what a running machine cannot do (exit 2)" [ $? -eq 2 ]
+check "... and says what it can" has "$tmp/err2" "only show"
+"$bin" halcmd --attach "$sock" getp no.such.pin >"$tmp/out2" 2>"$tmp/err2"
+rc=$?
+check "halcmd --attach getp of an unknown name: exit 1" [ $rc -eq 1 ]
+check "... naming it" has "$tmp/err2" "no.such.pin"
+
 "$py" - "$root/python" "$sock" >"$tmp/shut" 2>&1 <<'PY'
 import sys
 sys.path.insert(0, sys.argv[1])
