@@ -117,8 +117,16 @@ void session_message(struct session *s, const char *sev, const char *source,
  * command), so that the answer and any status read after it show its effect. */
 static void session_settle(struct session *s)
 {
-    for (int i = 0; i < SESSION_POWER_PERIODS && motion_hal_pending(s->hal); i++)
-        session_wait_periods(s, 1);
+    if (s->sim) {
+        for (int i = 0; i < SESSION_POWER_PERIODS && motion_hal_pending(s->hal); i++)
+            session_wait_periods(s, 1);
+        return;
+    }
+    /* on the wall clock: look every 50 us, so the answer follows the servo thread's next
+     * period rather than a whole period later */
+    double max_ms = SESSION_POWER_PERIODS * (double)s->period_ns * 1e-6;
+    for (double t = 0; t < max_ms && motion_hal_pending(s->hal); t += 0.05)
+        sleep_ms(0.05);
 }
 
 /* Queues a manual command for the servo thread. */

@@ -1,0 +1,319 @@
+/* bench_session.c: the machine session's API on the wall clock (configs/sim, realtime):
+ * the round trip of status.get against a bare Unix-socket echo of the same size (the
+ * baseline, measured side by side in this run), the time from a jog.move request to its
+ * answer (the servo thread has taken the jog) and to the first commanded motion seen in
+ * status, and the time from program.run to motion on the demo program. Wall-clock figures:
+ * median and 99th percentile of repeated trials. */
+#include <errno.h>
+#include <jansson.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "task/session.h"
+
+#define RT_TRIALS 2000     /* round trips per measurement */
+#define JOG_TRIALS 40      /* jogs */
+#define RUN_TRIALS 5       /* program starts */
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Median and 99th percentile of v (sorted in place), in microseconds. */
+static void stats_us(double *v, int n, double *med, double *p99)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    *med = v[n / 2] * 1e6;
+    *p99 = v[(int)(0.99 * (n - 1))] * 1e6;
+}
+
+/* ---- a line client */
+struct conn {
+    int fd;
+    char buf[1 << 20];
+    size_t len;
+    int id;
+};
+
+static int conn_open(struct conn *c, const char *path)
+{
+    struct sockaddr_un a = { .sun_family = AF_UNIX };
+    snprintf(a.sun_path, sizeof a.sun_path, "%s", path);
+    c->len = 0;
+    c->id = 0;
+    c->fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    for (int i = 0; i < 500; i++) {
+        if (connect(c->fd, (struct sockaddr *)&a, sizeof a) == 0)
+            return 0;
+        usleep(10000);
+    }
+    fprintf(stderr, "bench_session: %s: %s\n", path, strerror(errno));
+    return -1;
+}
+
+/* The next line (without its newline, NUL-terminated in c->buf); its length, -1 at EOF. */
+static long conn_line(struct conn *c, char *out, size_t cap)
+{
+    for (;;) {
+        char *nl = memchr(c->buf, '\n', c->len);
+        if (nl) {
+            size_t n = (size_t)(nl - c->buf);
+            size_t k = n < cap - 1 ? n : cap - 1;
+            memcpy(out, c->buf, k);
+            out[k] = 0;
+            memmove(c->buf, nl + 1, c->len - n - 1);
+            c->len -= n + 1;
+            return (long)n;
+        }
+        ssize_t r = read(c->fd, c->buf + c->len, sizeof c->buf - c->len);
+        if (r <= 0)
+            return -1;
+        c->len += (size_t)r;
+    }
+}
+
+/* One call; the result object (caller decrefs), NULL on an error (printed). */
+static json_t *call(struct conn *c, const char *method, const char *params)
+{
+    char req[1024], line[1 << 16];
+    int n = snprintf(req, sizeof req, "{\"jsonrpc\":\"2.0\",\"id\":%d,\"method\":\"%s\","
+                     "\"params\":%s}\n", ++c->id, method, params ? params : "{}");
+    if (write(c->fd, req, (size_t)n) != n)
+        return NULL;
+    for (;;) {
+        if (conn_line(c, line, sizeof line) < 0)
+            return NULL;
+        json_t *j = json_loads(line, 0, NULL);
+        json_t *id = json_object_get(j, "id");
+        if (json_is_integer(id) && json_integer_value(id) == c->id) {
+            json_t *res = json_incref(json_object_get(j, "result"));
+            if (!res)
+                fprintf(stderr, "bench_session: %s: %s\n", method,
+                        json_string_value(json_object_get(json_object_get(j, "error"),
+                                                          "message")));
+            json_decref(j);
+            return res;
+        }
+        json_decref(j);
+    }
+}
+
+static double pose_x(json_t *st)
+{
+    return json_real_value(json_array_get(json_object_get(json_object_get(st, "machine_pose"),
+                                                          "commanded"), 0));
+}
+
+static const char *str_of(json_t *st, const char *key)
+{
+    const char *v = json_string_value(json_object_get(st, key));
+    return v ? v : "";
+}
+
+static int at_rest(json_t *st)
+{
+    return !strcmp(str_of(st, "interp"), "idle") &&
+           !json_is_true(json_object_get(st, "homing")) &&
+           (!strcmp(str_of(st, "motion"), "idle") || !strcmp(str_of(st, "motion"), "done"));
+}
+
+static void wait_rest(struct conn *c)
+{
+    for (int i = 0; i < 200000; i++) {
+        json_t *st = call(c, "status.get", NULL);
+        int rest = st && at_rest(st);
+        json_decref(st);
+        if (rest)
+            return;
+        usleep(1000);
+    }
+}
+
+/* ---- the baseline: an echo server answering each line with a line of a given size */
+struct echo {
+    int lfd;
+    size_t reply_len;
+};
+
+static void *echo_main(void *arg)
+{
+    struct echo *e = arg;
+    int fd = accept(e->lfd, NULL, NULL);
+    char *reply = malloc(e->reply_len + 1);
+    memset(reply, 'x', e->reply_len);
+    reply[e->reply_len] = '\n';
+    static char buf[1 << 16];
+    size_t len = 0;
+    for (;;) {
+        ssize_t r = read(fd, buf + len, sizeof buf - len);
+        if (r <= 0)
+            break;
+        len += (size_t)r;
+        char *nl;
+        while ((nl = memchr(buf, '\n', len))) {
+            size_t n = (size_t)(nl - buf) + 1;
+            memmove(buf, buf + n, len - n);
+            len -= n;
+            if (write(fd, reply, e->reply_len + 1) < 0)
+                goto out;
+        }
+    }
+out:
+    free(reply);
+    close(fd);
+    return NULL;
+}
+
+static volatile sig_atomic_t session_stop;
+
+static void *session_main(void *arg)
+{
+    session_run(arg, &session_stop);
+    return NULL;
+}
+
+int main(void)
+{
+    char dir[] = "/tmp/hexcnc-bench-session.XXXXXX", sock[100], esock[100], err[1024];
+    if (!mkdtemp(dir))
+        return 1;
+    snprintf(sock, sizeof sock, "%s/m.sock", dir);
+    snprintf(esock, sizeof esock, "%s/echo.sock", dir);
+    signal(SIGPIPE, SIG_IGN);
+    struct session_opts o = { "configs/sim/tmu-hexapod.ini", RUNNER_CLOCK_REALTIME, sock, 1 };
+    struct session *s;
+    if (session_create(&o, &s, err, sizeof err) != 0) {
+        fprintf(stderr, "bench_session: %s\n", err);
+        return 1;
+    }
+    pthread_t th;
+    pthread_create(&th, NULL, session_main, s);
+    static struct conn c, e;
+    if (conn_open(&c, sock))
+        return 1;
+    json_decref(call(&c, "machine.estop", "{\"active\":false}"));
+    json_decref(call(&c, "machine.power", "{\"on\":true}"));
+    json_decref(call(&c, "machine.home", NULL));
+    wait_rest(&c);
+
+    /* status.get and its baseline, interleaved in blocks so both see the same machine */
+    json_t *st = call(&c, "status.get", NULL);
+    char *text = json_dumps(st, JSON_COMPACT);
+    size_t status_len = strlen(text);
+    free(text);
+    json_decref(st);
+    struct echo ec = { socket(AF_UNIX, SOCK_STREAM, 0), status_len };
+    struct sockaddr_un ea = { .sun_family = AF_UNIX };
+    snprintf(ea.sun_path, sizeof ea.sun_path, "%s", esock);
+    if (bind(ec.lfd, (struct sockaddr *)&ea, sizeof ea) || listen(ec.lfd, 1))
+        return 1;
+    pthread_t eth;
+    pthread_create(&eth, NULL, echo_main, &ec);
+    if (conn_open(&e, esock))
+        return 1;
+    static double rt[RT_TRIALS], base[RT_TRIALS];
+    static char line[1 << 16];
+    const char req[] = "{\"jsonrpc\":\"2.0\",\"id\":1,\"method\":\"status.get\"}\n";
+    for (int k = 0; k < RT_TRIALS; k++) {
+        double t0 = now_s();
+        json_decref(call(&c, "status.get", NULL));
+        rt[k] = now_s() - t0;
+        t0 = now_s();
+        if (write(e.fd, req, sizeof req - 1) < 0 || conn_line(&e, line, sizeof line) < 0)
+            return 1;
+        base[k] = now_s() - t0;
+    }
+    double rmed, rp99, bmed, bp99;
+    stats_us(rt, RT_TRIALS, &rmed, &rp99);
+    stats_us(base, RT_TRIALS, &bmed, &bp99);
+    printf("status.get round trip (%zu-byte status, %d calls): median %.1f us, p99 %.1f us\n",
+           status_len, RT_TRIALS, rmed, rp99);
+    printf("  baseline, bare Unix-socket echo of the same size: median %.1f us, p99 %.1f us"
+           "  -> ratio %.1fx\n", bmed, bp99, rmed / bmed);
+
+    /* jog: answer (the servo thread took it) and first motion in status */
+    static double jt_ans[JOG_TRIALS], jt_move[JOG_TRIALS];
+    for (int k = 0; k < JOG_TRIALS; k++) {
+        json_t *s0 = call(&c, "status.get", NULL);
+        double x0 = pose_x(s0);
+        json_decref(s0);
+        char p[128];
+        snprintf(p, sizeof p, "{\"frame\":\"world\",\"axis\":\"X\",\"velocity\":%d,"
+                 "\"distance\":0.5}", k % 2 ? -10 : 10);
+        double t0 = now_s();
+        json_decref(call(&c, "jog.move", p));
+        jt_ans[k] = now_s() - t0;
+        for (;;) {
+            json_t *s1 = call(&c, "status.get", NULL);
+            double x1 = pose_x(s1);
+            json_decref(s1);
+            if (fabs(x1 - x0) > 1e-9)
+                break;
+        }
+        jt_move[k] = now_s() - t0;
+        wait_rest(&c);
+    }
+    double am, ap, mm, mp;
+    stats_us(jt_ans, JOG_TRIALS, &am, &ap);
+    stats_us(jt_move, JOG_TRIALS, &mm, &mp);
+    printf("jog.move (%d jogs, 1 ms servo period): answer median %.0f us (p99 %.0f), "
+           "first motion in status median %.0f us (p99 %.0f)\n", JOG_TRIALS, am, ap, mm, mp);
+
+    /* program.run: reading, planning and checking the demo from the present pose, then
+     * motion */
+    json_decref(call(&c, "program.open", "{\"path\":\"tmu-hexapod-demo.ngc\"}"));
+    static double pr_ans[RUN_TRIALS], pr_move[RUN_TRIALS];
+    for (int k = 0; k < RUN_TRIALS; k++) {
+        json_t *s0 = call(&c, "status.get", NULL);
+        double x0 = pose_x(s0);
+        json_decref(s0);
+        double t0 = now_s();
+        json_decref(call(&c, "program.run", NULL));
+        pr_ans[k] = now_s() - t0;
+        for (;;) {
+            json_t *s1 = call(&c, "status.get", NULL);
+            double x1 = pose_x(s1);
+            json_decref(s1);
+            if (fabs(x1 - x0) > 1e-9)
+                break;
+        }
+        pr_move[k] = now_s() - t0;
+        json_decref(call(&c, "program.abort", NULL));
+        wait_rest(&c);
+        json_decref(call(&c, "mdi.execute", "{\"line\":\"G0 X0 Y0 Z645 A0 B0 C0\"}"));
+        wait_rest(&c);
+    }
+    stats_us(pr_ans, RUN_TRIALS, &am, &ap);
+    stats_us(pr_move, RUN_TRIALS, &mm, &mp);
+    printf("program.run (configs/sim demo, %d starts): answer median %.2f ms, first motion "
+           "median %.2f ms (max %.2f ms)\n", RUN_TRIALS, am / 1000, mm / 1000,
+           pr_move[RUN_TRIALS - 1] * 1000);
+
+    json_decref(call(&c, "machine.shutdown", NULL));
+    pthread_join(th, NULL);
+    session_destroy(s);
+    close(c.fd);
+    close(e.fd);
+    pthread_join(eth, NULL);
+    close(ec.lfd);
+    unlink(esock);
+    rmdir(dir);
+    return 0;
+}
