@@ -368,6 +368,8 @@ int runner_load_program_from(struct runner *r, const char *path, int from_line, 
     r->loaded = false;
     int st = runner_check_size(r, path, err, errlen);
     if (st == RUNNER_OK)
+        runner_feedback_settle(r);  /* planned from where the legs are */
+    if (st == RUNNER_OK)
         st = runner_interpret(r, path, &prog, err, errlen);
     if (st == RUNNER_OK && from_line > 1)
         st = runner_cut_before(&prog, from_line, &cut, err, errlen);

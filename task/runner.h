@@ -83,7 +83,8 @@ struct runner_summary {
     double machine_time_s;                   /* from start to the end of motion */
     double planned_time_s;                   /* what the planner said it would take */
     double distance_mm;                      /* XYZ path length covered */
-    long periods;                            /* servo periods run */
+    long periods;                            /* servo periods run, with those before the
+                                              * start (machine off, drives starting) */
     int njoints;
     double peak_rate_mm_s[KINS_MAX_JOINTS];  /* largest |commanded leg rate| per leg */
     double max_ferror_mm[KINS_MAX_JOINTS];   /* largest |command - feedback| per leg */

@@ -280,6 +280,46 @@ static enum drive_startup_state runner_drives_startup(struct runner *r, int64_t 
     return worst;
 }
 
+/* Periods the threads run, machine off, before a program is planned: the motion component
+ * takes the legs' feedback as its command after two (MOTION_FEEDBACK_SETTLE), and the
+ * forward kinematics of it as the pose. */
+#define RUNNER_FEEDBACK_PERIODS 4
+
+/* Before the first program of `hexcnc run`: starts the threads with the machine off and
+ * runs them until the drives have started (within their configured time-outs) and the
+ * motion component follows their feedback, so the program is planned from where the legs
+ * are, not from an assumed home pose. The session has its threads running already. */
+void runner_feedback_settle(struct runner *r)
+{
+    if (hal_running(r->hal))
+        return;
+    *r->user_enable_out = false;
+    if (hal_start(r->hal) != HAL_OK)
+        return;  /* runner_start reports it */
+    int64_t budget_ns;
+    const char *what;
+    long n = 0;
+    long max = RUNNER_START_PERIODS + RUNNER_FEEDBACK_PERIODS;
+    for (; n < max; n++) {
+        if (n >= RUNNER_FEEDBACK_PERIODS &&
+            runner_drives_startup(r, &budget_ns, &what) != DRIVE_STARTUP_STARTING)
+            break;
+        if (n == RUNNER_FEEDBACK_PERIODS)  /* starting: wait as long as they may take */
+            max += (long)(budget_ns / r->period_ns);
+        if (r->sim_clock) {
+            hal_sim_advance(r->hal, r->period_ns);
+        } else {
+            struct timespec ts = { 0, r->period_ns };
+            nanosleep(&ts, NULL);
+        }
+    }
+    if (!r->sim_clock) {  /* the thread's own periods, not the sleeps, count */
+        struct timespec ts = { 0, RUNNER_FEEDBACK_PERIODS * r->period_ns };
+        nanosleep(&ts, NULL);
+    }
+    r->pre_periods = atomic_load(&r->mon_periods);  /* the summary counts them too */
+}
+
 /* Says why a started program stays idle: a drive that failed to start (its own message),
  * drives still starting past the time their configuration allows, or, with every drive
  * ready, an e-stop chain that never released. Waits meanwhile. */
@@ -370,7 +410,7 @@ int runner_summary(struct runner *r, struct runner_summary *s)
     s->machine_time_s = (double)r->running_periods * (double)r->period_ns * 1e-9;
     s->planned_time_s = r->plan.time_s;
     s->distance_mm = r->last.distance_done_mm;
-    s->periods = atomic_load(&r->mon_periods);
+    s->periods = atomic_load(&r->mon_periods) + r->pre_periods;
     s->state = (enum motion_state)atomic_load(&r->mon_state);
     for (int i = 0; i < r->njoints; i++)
         s->final_legs_mm[i] = *r->fb_pin[i];

@@ -24,6 +24,8 @@ struct runner {
     long ready_since;                   /* monitor periods when the drives were first seen
                                          * ready after the start; -1 not yet */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */
+    long pre_periods;                   /* periods run before the first start, machine off
+                                         * (runner_feedback_settle) */
     bool block_delete;                  /* the block-delete switch for the next load */
     runner_message_fn msg_fn;           /* gets every component message (may be NULL) */
     void *msg_ctx;
@@ -87,5 +89,9 @@ int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *
 void runner_settings_apply(struct runner *r);
 void runner_settings_free(struct runner *r);
 
+
+/* Starts the threads with the machine off until the motion component follows the legs'
+ * feedback (runner_exec.c); nothing when they run already. */
+void runner_feedback_settle(struct runner *r);
 
 #endif

@@ -106,5 +106,19 @@ check "truncated program exits 1" [ $? -eq 1 ]
 check "truncated program names file:line" has "$tmp/err" "cut.ngc:4: error: the program opened with '%' on line 1 ends without its closing '%'"
 check "truncated program: no motion" has "$tmp/err" "did not move"
 
+# 10. A machine that is not at HOME (simulated legs started 5 mm short on leg 1 ... 0.4 mm
+#     on leg 6): the program is planned from where the legs are and runs to its end (it
+#     stopped on a following error of 5.4 mm in its first period while runs were planned
+#     from [KINS] HOME).
+mkdir -p "$tmp/away"
+cp -r "$root/configs/sim/." "$tmp/away/"
+for i in 0 1 2 3 4 5; do echo "setp stepgen.$i.sim-start $((720 + i))"; done \
+    >>"$tmp/away/tmu-hexapod.hal"
+"$bin" run --sim-clock "$tmp/away/tmu-hexapod.ini" >"$tmp/out" 2>"$tmp/err"
+check "away from HOME: the program runs to its end (exit 0)" [ $? -eq 0 ]
+check "away from HOME: no following error" sh -c "! grep -q 'following error' '$tmp/err'"
+check "away from HOME: finished at its end point" has "$tmp/out" \
+    "commanded end  X 0.000000  Y 0.000000  Z 645.000000"
+
 [ $fails -eq 0 ] || { echo "run_cli: $fails failed"; cat "$tmp/err"; exit 1; }
 echo "run_cli: all passed"

@@ -24,6 +24,7 @@ struct check {
     int64_t last_seq;
     int64_t last_grid_ns;           /* machine time of the last on-grid sample */
     int stop_state;                 /* state of the stop sample; -1 none yet */
+    int running;                    /* the start sample was seen */
     char error[200];
 };
 
@@ -129,11 +130,15 @@ static int listen_url(const char *url, int count, int ms, struct check *c)
     return 0;
 }
 
-/* A program run on the simulated machine: samples on the PERIOD_MS grid of machine time,
- * numbered 0, 1, 2, ...; running (state 1) on a program line; feedback within 0.01 mm (and
- * deg) of the command, which moves; and last, the stop: one sample off the grid, after the
- * last one on it, in state done (5, MOTION_DONE), at the end of the program's time. Returns the number of
- * status messages, or -1. */
+/* A program run on the simulated machine, as `hexcnc run` makes it: first the machine at
+ * rest while it is switched on (the threads run a few periods before the program starts, so
+ * that it is planned from where the legs are): samples not running, on line 0, and the
+ * e-stop's fault raised and cleared as the machine comes out of e-stop, nothing else. Then
+ * the run: a start sample (the state change), samples every PERIOD_MS of machine time,
+ * numbered without gaps, running (state 1) on a program line, feedback within 0.01 mm (and
+ * deg) of the command, which moves; and last the stop: one sample off the grid in state
+ * done (5, MOTION_DONE), at the end of the program's time. Returns the number of status
+ * messages, or -1. */
 static int check_run(const char *path, int period_ms, struct check *c)
 {
     lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
@@ -153,39 +158,51 @@ static int check_run(const char *path, int period_ms, struct check *c)
                 c->events = 1;
             else if (!strcmp(e.source, "task") && e.code == 101 && c->events == 1)
                 c->events = 2;
-            else if (e.severity == HEXCNC_EVENT_T_FAULT)
+            else if (e.severity == HEXCNC_EVENT_T_FAULT &&
+                     !(c->events == 0 && !strcmp(e.source, "estop") && e.line == 0))
                 snprintf(c->error, sizeof c->error, "fault event from %s: %s", e.source,
                          e.text);
             hexcnc_event_t_decode_cleanup(&e);
         }
         if (!strcmp(ev->channel, "HEXCNC_STATUS") &&
             hexcnc_status_t_decode(ev->data, 0, (int)ev->datalen, &m) >= 0) {
-            int64_t want_ms = m.seq == 0 ? 1 : (int64_t)period_ms * m.seq;
+            int64_t grid_ns = (int64_t)period_ms * 1000000;
+            bool on_grid = m.machine_time_ns == 1000000 || m.machine_time_ns % grid_ns == 0;
             double worst = 0;
             for (int i = 0; i < 6; i++) {
                 worst = fmax(worst, fabs(m.pose_cmd[i] - m.pose_fb[i]));
                 worst = fmax(worst, fabs(m.leg_cmd_mm[i] - m.leg_fb_mm[i]));
                 worst = fmax(worst, fabs(m.ferror_mm[i]));
             }
-            if (isnan(first_x))
+            if (m.state == 1 && isnan(first_x))
                 first_x = m.pose_cmd[0];
-            moved = fmax(moved, fabs(m.pose_cmd[0] - first_x));
-            bool stop = m.state != 1 && m.seq == c->last_seq + 1 &&
-                        m.machine_time_ns > c->last_grid_ns &&
-                        m.machine_time_ns < want_ms * 1000000;
-            if (c->stop_state >= 0)
+            if (m.state == 1)
+                moved = fmax(moved, fabs(m.pose_cmd[0] - first_x));
+            if (m.seq != c->last_seq + 1)
+                snprintf(c->error, sizeof c->error, "sample %lld after %lld", (long long)m.seq,
+                         (long long)c->last_seq);
+            else if (c->stop_state >= 0)
                 snprintf(c->error, sizeof c->error, "sample %lld after the stop sample",
                          (long long)m.seq);
-            else if (stop)
+            else if (!c->running && m.state != 1) {
+                if (m.line != 0)  /* the prelude: at rest, before any line */
+                    snprintf(c->error, sizeof c->error, "sample %lld before the start: "
+                             "state %d line %d", (long long)m.seq, (int)m.state, (int)m.line);
+            } else if (!c->running) {
+                c->running = 1;  /* the start sample (a state change: on the grid or not) */
+            } else if (m.state != 1) {
+                if (on_grid)
+                    snprintf(c->error, sizeof c->error, "sample %lld: the stop sample on the "
+                             "grid (%lld ns)", (long long)m.seq, (long long)m.machine_time_ns);
                 c->stop_state = m.state;
-            else if (m.seq != c->last_seq + 1 || m.machine_time_ns != want_ms * 1000000)
-                snprintf(c->error, sizeof c->error, "sample %lld at %lld ns after %lld",
-                         (long long)m.seq, (long long)m.machine_time_ns, (long long)c->last_seq);
-            else
+            } else if (!on_grid || m.machine_time_ns <= c->last_grid_ns) {
+                snprintf(c->error, sizeof c->error, "sample %lld at %lld ns, off the %d ms grid",
+                         (long long)m.seq, (long long)m.machine_time_ns, period_ms);
+            } else {
                 c->last_grid_ns = m.machine_time_ns;
-            if (c->error[0] || stop)
-                ;
-            else if (m.state != 1 || m.line <= 0 || worst > 0.01 || m.fault_flags)
+            }
+            if (!c->error[0] && c->running && c->stop_state < 0 &&
+                (m.state != 1 || m.line <= 0 || worst > 0.01 || m.fault_flags))
                 snprintf(c->error, sizeof c->error, "sample %lld: state %d line %d, feedback "
                          "%g from command, faults '%s'", (long long)m.seq, (int)m.state,
                          (int)m.line, worst, m.fault_text);
