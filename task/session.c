@@ -66,6 +66,10 @@ bool session_busy(const struct session *s)
 /* Whether programs and MDI may run: every leg homed, or [TRAJ] NO_FORCE_HOMING. */
 static int need_homed(struct session *s, const char *what, char *err, size_t len)
 {
+    if (!motion_pose_known(s->m))
+        return fail(RPC_STATE, err, len, "%s refused: the legs' lengths give no pose of the "
+                    "platform (the forward kinematics has no answer): jog the legs (frame "
+                    "joint) into the workspace, or home them", what);
     if (s->no_force_homing || motion_all_homed(s->m))
         return 0;
     return fail(RPC_STATE, err, len, "%s refused: the machine is not homed (machine.home "

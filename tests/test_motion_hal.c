@@ -143,6 +143,30 @@ START_TEST(test_hal_runner_calls)
 }
 END_TEST
 
+/* Once the servo thread runs, a program planned from somewhere the machine is not is
+ * refused at load, naming the leg and the distance (it would jump there in one period); one
+ * planned from where the machine is loads. */
+START_TEST(test_hal_load_from_elsewhere_refused)
+{
+    struct canon_prog p;
+    struct hal *h = make_machine(&p);
+    advance(h, 200000);
+    ck_assert_int_eq(*(int32_t *)test_pin(h, "motion.state", HAL_S32), MOTION_DONE);
+    canon_prog_free(&p);
+    canon_prog_init(&p);
+    memcpy(p.start, GOAL, sizeof GOAL);  /* the machine is back at HOME */
+    tm_add(&p, CANON_FEED, 9, HOME, 1200, 0);
+    char err[512] = "";
+    ck_assert_int_eq(motion_hal_load(h, &p, err, sizeof err), MOTION_ERR_STATE);
+    ck_assert_msg(strstr(err, "planned from a pose the machine is not at: leg ") &&
+                  strstr(err, "mm from the program's start"), "%s", err);
+    motion_hal_pose(h, p.start);
+    ck_assert_msg(motion_hal_load(h, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    hal_destroy(h);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* motion.pause / motion.resume edges: pauses on the path, resumes, finishes. */
 START_TEST(test_hal_pause)
 {
@@ -172,6 +196,7 @@ static Suite *hal_suite(void)
     tcase_add_test(tc, test_hal_estop);
     tcase_add_test(tc, test_hal_pause);
     tcase_add_test(tc, test_hal_runner_calls);
+    tcase_add_test(tc, test_hal_load_from_elsewhere_refused);
     suite_add_tcase(s, tc);
     return s;
 }

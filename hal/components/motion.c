@@ -1,4 +1,5 @@
 /* motion.c: the `motion` HAL component: planner and interpolator of motion/ on the servo thread. */
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -53,6 +54,9 @@ struct motion_comp {
 
 /* Updates before the feedback is believed (see motion_comp_commands). */
 #define MOTION_FEEDBACK_SETTLE 2
+
+/* How far the legs at a program's start may be from the command when it is loaded, mm. */
+#define MOTION_START_TOL_MM 0.01
 
 /* Applies the manual-motion commands the task queued (motion_hal_command). */
 static void motion_comp_manual(struct motion_comp *c)
@@ -279,6 +283,24 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
         return MOTION_ERR_STATE;
     }
     pthread_mutex_lock(&c->plan_lock);
+    /* Once the servo thread has run, the command is where the legs are: a program planned
+     * from elsewhere would jump there in one period. (Legs whose lengths give no pose, such
+     * as drives that never answered, leave it to the start-up checks to say why.) */
+    double L[KINS_MAX_JOINTS];
+    if (c->updates > MOTION_FEEDBACK_SETTLE && motion_pose_known(c->m) &&
+        kins_inverse(hal_get_object(h, "kins"), prog->start, L) == KINS_OK) {
+        for (int i = 0; i < c->nj; i++) {
+            double off = L[i] - c->last.joint_pos[i];
+            if (fabs(off) > MOTION_START_TOL_MM) {
+                pthread_mutex_unlock(&c->plan_lock);
+                if (err && errlen)
+                    snprintf(err, errlen, "the program was planned from a pose the machine is "
+                             "not at: leg %d ([JOINT_%d]) is %.4f mm from the program's start; "
+                             "plan it again from where the machine is", i + 1, i, -off);
+                return MOTION_ERR_STATE;
+            }
+        }
+    }
     int st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK && c->autostart;
     pthread_mutex_unlock(&c->plan_lock);
