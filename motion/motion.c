@@ -86,6 +86,9 @@ static void rewind_plan(struct motion *m)
     m->paused_at_seg = 0;
     m->step_until_seg = 0;
     m->marks_done = 0;
+    m->ios_done = 0;
+    m->waiting = 0;
+    m->waited_at_seg = 0;
     m->path_vel = 0;
     memset(m->pose_vel, 0, sizeof m->pose_vel);
     memset(m->joint_vel, 0, sizeof m->joint_vel);

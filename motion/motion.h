@@ -143,6 +143,13 @@ struct motion_plan_info {
 };
 int motion_plan_info(const struct motion *m, struct motion_plan_info *out);
 
+/* The spindle and coolant as the program commands them at the point the path has reached. */
+struct motion_spindle {
+    int dir;                 /* 1 (M3), -1 (M4), 0 (stopped) */
+    double rpm;              /* S in force (>= 0) */
+    int mist, flood;         /* M7, M8 */
+};
+
 /* What one servo period produces. */
 struct motion_out {
     double pose[KINS_POSE_DIM];        /* commanded pose: mm, deg */
@@ -163,6 +170,8 @@ struct motion_out {
     double distance_done_mm;           /* XYZ path length covered, mm */
     double distance_total_mm;          /* XYZ path length of the program, mm */
     double feed_override;              /* override in effect now (ramps to the requested) */
+    struct motion_spindle spindle;     /* spindle and coolant commands in force */
+    int waiting;                       /* holding on the path until the spindle is at speed */
     size_t settings_done;              /* CANON_SETTING commands of the program the machine has
                                         * passed since motion_start, in program order: the
                                         * path reached their place (never decreases) */
@@ -232,6 +241,10 @@ void motion_track_feedback(struct motion *m);
 int motion_reset(struct motion *m);
 /* Whether the commanded pose is known (the forward kinematics of the legs has an answer). */
 bool motion_pose_known(const struct motion *m);
+/* Spindle (motion_step.c): whether programs planned from now on stop after M3/M4 and S
+ * changes until the spindle reports it is at speed, and that report, each period. */
+void motion_set_wait_at_speed(struct motion *m, bool on);
+void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
 /* Homed status of all legs. */
 bool motion_all_homed(const struct motion *m);
 

@@ -322,7 +322,8 @@ static void set_speed(const struct motion *m, struct motion_seg *sg, const struc
                       double blend_tol_mm)
 {
     sg->blend_tol_mm = blend_tol_mm;
-    if (c->type == CANON_TRAVERSE || sg->kind == SEG_DWELL || sg->kind == SEG_PAUSE)
+    if (c->type == CANON_TRAVERSE || sg->kind == SEG_DWELL || sg->kind == SEG_PAUSE ||
+        sg->kind == SEG_WAIT)
         sg->feed = 0;
     else if (c->inverse_time_min > 0)
         sg->feed = sg->len / (c->inverse_time_min * 60.0);
@@ -345,6 +346,20 @@ static void blend_abc(struct motion_plan *p, const struct motion_blend_abc *b)
     }
 }
 
+/* A spindle or coolant command before the segment that comes next. */
+static int add_io(struct motion_plan *p, enum motion_io_kind kind, double value, int ivalue)
+{
+    if (p->nios == p->capios) {
+        size_t cap = p->capios ? 2 * p->capios : 16;
+        struct motion_io *n = realloc(p->ios, cap * sizeof *n);
+        if (!n)
+            return -1;
+        p->ios = n, p->capios = cap;
+    }
+    p->ios[p->nios++] = (struct motion_io){ p->nseg, kind, value, ivalue };
+    return 0;
+}
+
 /* Builds the segment list from the program (geometry only; speeds come later). */
 int motion_path_build(struct motion *m, const struct canon_prog *prog,
                       const struct motion_blend_abc *abc, char *err, size_t errlen)
@@ -352,6 +367,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     struct motion_plan *p = &m->plan;
     double at[KINS_POSE_DIM];
     double blend = 0;          /* G61 exact stop until the program says G64 */
+    int sp_dir = m->io.dir;    /* the spindle as the program leaves it so far */
+    double sp_rpm = m->io.rpm;
     memcpy(at, prog->start, sizeof at);
     for (size_t i = 0; i < prog->count; i++) {
         const struct canon_cmd *c = &prog->cmds[i];
@@ -368,6 +385,21 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             break;
         case CANON_DWELL: rc = c->value > 0 ? add_stop(p, c, at, SEG_DWELL, c->value) : 0; break;
         case CANON_SETTING: rc = add_mark(p); break;
+        case CANON_SPINDLE_SPEED: case CANON_SPINDLE_ON: case CANON_SPINDLE_STOP: {
+            enum motion_io_kind k = c->type == CANON_SPINDLE_SPEED ? IO_SPINDLE_SPEED :
+                                    c->type == CANON_SPINDLE_ON ? IO_SPINDLE_ON
+                                                                : IO_SPINDLE_STOP;
+            rc = add_io(p, k, c->value, 0);
+            int dir = k == IO_SPINDLE_ON ? (c->value < 0 ? -1 : 1) : k == IO_SPINDLE_STOP
+                      ? 0 : sp_dir;
+            double rpm = k == IO_SPINDLE_SPEED ? fabs(c->value) : sp_rpm;
+            /* started, reversed or a new speed while turning: wait until it is at speed */
+            if (rc == 0 && m->wait_at_speed && dir != 0 && (dir != sp_dir || rpm != sp_rpm))
+                rc = add_stop(p, c, at, SEG_WAIT, 0);
+            sp_dir = dir, sp_rpm = rpm;
+            break;
+        }
+        case CANON_COOLANT: rc = add_io(p, IO_COOLANT, 0, c->ivalue); break;
         case CANON_PAUSE:
             if (c->ivalue == 0 || m->cfg.optional_stop)
                 rc = add_stop(p, c, at, SEG_PAUSE, 0);
@@ -418,5 +450,6 @@ void motion_plan_free(struct motion_plan *p)
         free(p->files[i]);
     free(p->files);
     free(p->marks);
+    free(p->ios);
     memset(p, 0, sizeof *p);
 }

@@ -222,7 +222,7 @@ static double stop_rest_s(const struct motion *m, size_t j)
     double rested = 0, u0[KINS_POSE_DIM], u1[KINS_POSE_DIM], du = 0;
     size_t k = j + 1;
     for (; k < p->nseg && p->segs[k].kind > SEG_ARC; k++) {
-        if (p->segs[k].kind == SEG_PAUSE)
+        if (p->segs[k].kind == SEG_PAUSE || p->segs[k].kind == SEG_WAIT)
             return 0;
         rested += p->segs[k].dwell_s;
     }

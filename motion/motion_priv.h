@@ -8,7 +8,18 @@
 #include "motion/motion.h"
 
 /* What a segment does. */
-enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE };
+enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE,
+                       SEG_WAIT /* stop, then wait until the spindle is at speed */ };
+
+/* A spindle or coolant command on the path (CANON_SPINDLE_*, CANON_COOLANT): applied when
+ * the path reaches the segment it lies before, as a setting point is. */
+enum motion_io_kind { IO_SPINDLE_SPEED, IO_SPINDLE_ON, IO_SPINDLE_STOP, IO_COOLANT };
+struct motion_io {
+    size_t at;               /* the segment it lies before (nseg: after the last) */
+    enum motion_io_kind kind;
+    double value;            /* rpm, or the direction (+1 M3, -1 M4) */
+    int ivalue;              /* M7, M8, M9 */
+};
 
 /* Arc geometry: position(u) = center + (r0 + dr u)(cos(th u) e1 + sin(th u) e2) + (h0 + dh u) n,
  * u in [0, 1]: a planar arc, a helix, or (dr != 0) the small spiral of an arc whose end
@@ -71,6 +82,8 @@ struct motion_plan {
     size_t *marks;           /* CANON_SETTING points in program order: the segment each lies
                               * before (nseg: after the last); passed, not planned */
     size_t nmarks, capmarks;
+    struct motion_io *ios;   /* spindle and coolant commands in program order */
+    size_t nios, capios;
     char **files;            /* interned file names */
     size_t nfiles;
     double total_time_s;
@@ -128,6 +141,15 @@ struct motion {
     size_t cs;               /* segment holding knot ci */
     size_t paused_at_seg;    /* pause segment already honoured (+1), 0 = none */
     size_t marks_done;       /* setting points passed since motion_start (never goes back) */
+    size_t ios_done;         /* spindle and coolant commands applied since motion_start */
+    struct motion_spindle io; /* the spindle and coolant as commanded now (kept from one
+                              * program to the next; off after an abort or a fault) */
+    int wait_at_speed;       /* plan a wait for the spindle after M3/M4/S (motion_hal: the
+                              * at-speed input is wired) */
+    int at_speed;            /* the spindle's at-speed input this period */
+    int waiting;             /* holding at a SEG_WAIT for the spindle */
+    long io_age;             /* periods since a spindle or coolant command last changed */
+    size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];
     double pose_vel[KINS_POSE_DIM];

@@ -75,9 +75,43 @@ static double next_rate(const struct motion *m, double target, double vp, double
     return rn;
 }
 
+/* Periods a spindle command must have been out before an at-speed report counts: one for
+ * the spindle's drive to see it, one for its report to come back. */
+#define MOTION_AT_SPEED_LAG 2
+
+/* The spindle commands that lie before the present segment (those the wait is for). */
+static size_t wait_ios(const struct motion *m)
+{
+    size_t n = 0;
+    while (n < m->plan.nios && m->plan.ios[n].at <= m->cs)
+        n++;
+    return n;
+}
+
+/* At the start of a wait for the spindle: hold there until it is at speed. */
+static int wait_here(struct motion *m)
+{
+    const struct motion_seg *sg = &m->plan.segs[m->cs];
+    m->waiting = 0;
+    if (sg->kind != SEG_WAIT || m->ci != sg->k0 || m->waited_at_seg == m->cs + 1)
+        return 0;
+    /* the report counts once the spindle has had the command for MOTION_AT_SPEED_LAG
+     * periods: an at-speed that was true for the old speed says nothing of the new */
+    if (m->at_speed && m->io_age >= MOTION_AT_SPEED_LAG && m->ios_done >= wait_ios(m)) {
+        m->waited_at_seg = m->cs + 1;
+        return 0;
+    }
+    m->waiting = 1;
+    m->tau_s = m->plan.kt[m->ci];
+    m->rate = 0;
+    return 1;
+}
+
 /* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
 static int pause_here(struct motion *m)
 {
+    if (wait_here(m))
+        return 1;
     const struct motion_seg *sg = &m->plan.segs[m->cs];
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
         return 0;
@@ -121,6 +155,20 @@ static void advance(struct motion *m, double dt)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap;
     m->elapsed_s += dt;
+    if (m->waiting) {  /* held for the spindle: pause and abort end the wait at rest */
+        if (m->state == MOTION_RUNNING)
+            follow_knots(m);
+        if (m->waiting) {
+            if (m->state == MOTION_PAUSING)
+                m->state = MOTION_PAUSED;
+            if (m->state == MOTION_STOPPING) {
+                m->state = MOTION_IDLE;
+                m->loaded = 0;
+                m->waiting = 0;
+            }
+            return;
+        }
+    }
     if (resting(p, m->ci, sg)) {
         if (m->state == MOTION_RUNNING)
             m->tau_s += dt;             /* a rest lasts its time whatever the override */
@@ -139,7 +187,7 @@ static void advance(struct motion *m, double dt)
         m->step_until_seg = 0;   /* the block is done: pause on the path */
         m->state = MOTION_PAUSING;
     }
-    if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED) {
+    if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED && !m->waiting) {
         m->tau_s = p->total_time_s;
         m->state = MOTION_DONE;
         m->rate = 0;
@@ -194,6 +242,42 @@ static void pass_marks(struct motion *m)
         m->marks_done++;
 }
 
+/* Applies the spindle and coolant commands the path has reached (as pass_marks counts). */
+static void pass_ios(struct motion *m)
+{
+    const struct motion_plan *p = &m->plan;
+    size_t reached = m->state == MOTION_DONE ? p->nseg : m->cs;
+    while (m->ios_done < p->nios && p->ios[m->ios_done].at <= reached) {
+        const struct motion_io *io = &p->ios[m->ios_done++];
+        m->io_age = 0;
+        switch (io->kind) {
+        case IO_SPINDLE_SPEED: m->io.rpm = fabs(io->value); break;
+        case IO_SPINDLE_ON: m->io.dir = io->value < 0 ? -1 : 1; break;
+        case IO_SPINDLE_STOP: m->io.dir = 0; break;
+        case IO_COOLANT:
+            if (io->ivalue == 7)
+                m->io.mist = 1;
+            else if (io->ivalue == 8)
+                m->io.flood = 1;
+            else
+                m->io.mist = m->io.flood = 0;
+            break;
+        }
+    }
+}
+
+void motion_set_wait_at_speed(struct motion *m, bool on)
+{
+    if (m)
+        m->wait_at_speed = on;
+}
+
+void motion_set_spindle_at_speed(struct motion *m, bool at_speed)
+{
+    if (m)
+        m->at_speed = at_speed;
+}
+
 /* One servo period (see motion.h). */
 int motion_step(struct motion *m, double period_s, struct motion_out *out)
 {
@@ -207,8 +291,11 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     if (m->state == MOTION_MANUAL) {
         motion_manual_step(m, period_s);
     } else if (moving && m->loaded && m->plan.nseg) {
-        advance(m, period_s);
+        m->io_age++;
+        pass_ios(m);           /* the commands at the present place first: a wait there */
+        advance(m, period_s);  /* must see its own spindle command out */
         pass_marks(m);
+        pass_ios(m);
         int st = evaluate(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
@@ -218,8 +305,12 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
             m->fault_status = ret = MOTION_ERR_KINS;
         }
     } else {
-        if (m->loaded && m->state == MOTION_DONE)
+        if (m->loaded && m->state == MOTION_DONE) {
             pass_marks(m);     /* a program without moves is done at once */
+            pass_ios(m);
+        }
+        if (m->state == MOTION_FAULT || (m->state == MOTION_IDLE && !m->loaded))
+            memset(&m->io, 0, sizeof m->io);  /* a fault or an abort stops the spindle */
         m->path_vel = 0;
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         memset(m->joint_vel, 0, sizeof m->joint_vel);
@@ -245,5 +336,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->distance_total_mm = m->plan.total_len_mm;
     out->feed_override = m->rate;
     out->settings_done = m->marks_done;
+    out->spindle = m->io;
+    out->waiting = m->waiting;
     return ret;
 }

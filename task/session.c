@@ -498,8 +498,13 @@ int session_overrides(struct session *s, const double *feed, const double *rapid
             motion_set_rapid_override(s->m, *rapid);
         }
     }
-    if (spindle)
+    if (spindle) {
         s->spindle_ovr = *spindle;
+        if (s->spindle_ovr_pin)
+            *s->spindle_ovr_pin = *spindle;
+        if (s->state == SESS_ON)
+            session_wait_periods(s, 1);  /* in effect when the answer goes out */
+    }
     return 0;
 }
 
@@ -659,6 +664,9 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     s->feed_ovr_pin = hal_data_ptr(s->hal, "motion.feed-override", &t);
     if (s->feed_ovr_pin && t != HAL_FLOAT)
         s->feed_ovr_pin = NULL;
+    s->spindle_ovr_pin = hal_data_ptr(s->hal, "spindle.0.override", &t);
+    if (s->spindle_ovr_pin && t != HAL_FLOAT)
+        s->spindle_ovr_pin = NULL;
     motion_hal_set_autostart(s->hal, false);  /* only program.run starts a program */
     s->mdi = interp_create();
     tooltable_init(&s->mdi_tt);

@@ -61,6 +61,7 @@ struct session {
     double feed_ovr, rapid_ovr, spindle_ovr;
     bool optional_stop, block_delete;
     double *feed_ovr_pin;        /* motion.feed-override (NULL when wired by the HAL files) */
+    double *spindle_ovr_pin;     /* spindle.0.override (likewise) */
     unsigned note_seq;           /* last manual-motion note reported */
     int last_mstate;             /* motion state at the last tick */
     /* the socket */

@@ -27,13 +27,13 @@ static json_t *vec(const double *v, int n)
 }
 
 /* What the interpreter is doing, as LinuxCNC names it. */
-static const char *interp_name(const struct session *s, enum motion_state st)
+static const char *interp_name(const struct session *s, enum motion_state st, bool waiting)
 {
     if (!s->running)
         return "idle";
     if (st == MOTION_PAUSED || st == MOTION_PAUSING)
         return "paused";
-    return "reading";
+    return waiting ? "waiting" : "reading";
 }
 
 /* The modal G codes of the MDI interpreter (the program's are its own while it runs). */
@@ -121,7 +121,7 @@ json_t *session_status(struct session *s)
         "mode", session_mode_name(s->mode),
         "homed", homed,
         "homing", motion_homing(s->m),
-        "interp", interp_name(s, st),
+        "interp", interp_name(s, st, o.waiting),
         "motion", motion_state_name(st),
         "program", s->program[0] ? s->program : NULL,
         "line", s->running ? o.line : 0,
@@ -136,9 +136,9 @@ json_t *session_status(struct session *s)
         "tool", "number", v.current_tool, "selected", v.selected_tool, "length",
         v.tool_mm[2],
         "feed", v.feed_mm_min,
-        "spindle", "speed", v.spindle_rpm, "direction", v.spindle_dir, "override",
+        "spindle", "speed", o.spindle.rpm, "direction", o.spindle.dir, "override",
         s->spindle_ovr,
-        "coolant", "mist", v.mist != 0, "flood", v.flood != 0,
+        "coolant", "mist", o.spindle.mist != 0, "flood", o.spindle.flood != 0,
         "overrides", "feed", s->feed_ovr, "rapid", s->rapid_ovr, "spindle", s->spindle_ovr,
         "switches", "optional_stop", s->optional_stop, "block_delete", s->block_delete,
         "error", s->last_error[0] ? s->last_error : NULL);

@@ -49,6 +49,15 @@ struct motion_comp {
     bool *amp_enable;                        /* out: drives may move (enabled, no fault) */
     bool *estop;                             /* in: true = stop now */
     bool *pause, *resume, *abort;            /* in: edge triggered */
+    /* spindle and coolant, LinuxCNC's names (docs/machine.md) */
+    bool *sp_on, *sp_fwd, *sp_rev;           /* out: spindle.0.on, .forward, .reverse */
+    double *sp_speed, *sp_rps;               /* out: .speed-out (rpm, signed, with the
+                                              * override), .speed-out-rps */
+    double *sp_override;                     /* in: spindle.0.override 0..2 (default 1) */
+    bool *sp_at_speed;                       /* in: spindle.0.at-speed (default TRUE) */
+    bool *sp_at_speed_own;                   /* the pin's own storage: another address
+                                              * means `net` linked it (then programs wait) */
+    bool *mist, *flood;                      /* out: iocontrol.0.coolant-mist, -flood */
     bool last_pause, last_resume, last_abort;/* previous values, for the edges */
 };
 
@@ -114,6 +123,21 @@ static void motion_comp_commands(struct motion_comp *c)
     c->last_pause = *c->pause, c->last_resume = *c->resume, c->last_abort = *c->abort;
     motion_comp_manual(c);  /* after a start, so that a step can follow it at once */
     motion_set_feed_override(c->m, *c->feed_override);
+    motion_set_spindle_at_speed(c->m, *c->sp_at_speed);
+}
+
+/* Spindle and coolant pins from the commands in force; off while the drives are off. */
+static void motion_comp_spindle(struct motion_comp *c, const struct motion_out *o)
+{
+    bool on = *c->amp_enable && o->spindle.dir != 0;
+    double ovr = *c->sp_override < 0 ? 0 : *c->sp_override > 2 ? 2 : *c->sp_override;
+    *c->sp_on = on;
+    *c->sp_fwd = on && o->spindle.dir > 0;
+    *c->sp_rev = on && o->spindle.dir < 0;
+    *c->sp_speed = on ? o->spindle.dir * o->spindle.rpm * ovr : 0;
+    *c->sp_rps = *c->sp_speed / 60.0;
+    *c->mist = *c->amp_enable && o->spindle.mist;
+    *c->flood = *c->amp_enable && o->spindle.flood;
 }
 
 /* One servo period: feedback check, commands, then the next set point. */
@@ -151,6 +175,7 @@ static void motion_comp_update(void *arg, long period_ns)
     *c->done = o.state == MOTION_DONE;
     *c->fault = o.state == MOTION_FAULT;
     *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
+    motion_comp_spindle(c, &o);
     pthread_mutex_unlock(&c->plan_lock);
 }
 
@@ -205,8 +230,18 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->pause, "motion.pause");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->resume, "motion.resume");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->abort, "motion.abort");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->sp_on, "spindle.0.on");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->sp_fwd, "spindle.0.forward");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->sp_rev, "spindle.0.reverse");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_OUT, &c->sp_speed, "spindle.0.speed-out");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_OUT, &c->sp_rps, "spindle.0.speed-out-rps");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_IN, &c->sp_override, "spindle.0.override");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->sp_at_speed, "spindle.0.at-speed");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->mist, "iocontrol.0.coolant-mist");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->flood, "iocontrol.0.coolant-flood");
     return st;
 }
+
 
 /* Reads the configuration, creates the motion core on the machine's kinematics, the pins and
  * motion.update; registers the core as the object "motion". */
@@ -260,6 +295,9 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     for (int i = 0; i < KINS_POSE_DIM; i++)
         *c->pose_cmd[i] = o.pose[i];
     *c->feed_override = 1;
+    *c->sp_override = 1;
+    *c->sp_at_speed = true;   /* unwired: the spindle is taken to be at speed */
+    c->sp_at_speed_own = c->sp_at_speed;
     c->autostart = true;
     return HAL_OK;
 }
@@ -301,6 +339,7 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
             }
         }
     }
+    motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
     int st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK && c->autostart;
     pthread_mutex_unlock(&c->plan_lock);

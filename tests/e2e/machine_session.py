@@ -357,6 +357,11 @@ def homing_ini(tmp):
                 "net leg-%d-fb => sim-home.%d.motor-pos" % (i, i),
                 "net home-sw-%d sim-home.%d.home-sw => motion.joint-home-sw-in-%d" % (i, i, i)]
     hal.append("addf sim-home.update servo-thread")
+    # a spindle that takes 0.5 s to reach 1000 rpm, its at-speed wired back to motion
+    hal += ["loadrt sim-spindle",
+            "net spindle-cmd spindle.0.speed-out => sim-spindle.speed-in",
+            "net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed",
+            "addf sim-spindle.update servo-thread"]
     open(os.path.join(tmp, "homing.hal"), "w").write("\n".join(hal) + "\n")
     return os.path.join(tmp, "homing.ini"), offsets
 
@@ -391,6 +396,33 @@ def homing_session(tmp):
     check("actual pose (FK of the true legs) at HOME within 0.01 mm",
           max(abs(a - b) for a, b in zip(st["machine_pose"]["actual"][:3], [0, 0, 645]))
           < 0.01, st["machine_pose"]["actual"])
+    # the spindle: MDI S1000 M3 waits until it is at speed (interp "waiting"), then M5
+    t0 = c.status()["time"]
+    c.ok("mdi.execute", line="S1000 M3")
+    seen = set()
+    for _ in range(100000):
+        st = c.status()
+        seen.add(st["interp"])
+        if st["interp"] == "idle":
+            break
+    check("S1000 M3 waits for the spindle (interp waiting), then ends", "waiting" in seen and
+          st["interp"] == "idle", seen)
+    check("... for as long as it takes to get to speed (0.49 s at 2000 rpm/s)",
+          0.48 <= st["time"] - t0 < 0.7, st["time"] - t0)
+    spd = float(c.ok("hal.get", name="sim-spindle.speed")["value"])
+    on = c.ok("hal.get", name="spindle.0.on")["value"]
+    check("spindle.0.on and the spindle at 1000 rpm", on in ("TRUE", "1", "true") and
+          abs(spd - 1000) <= 20, (on, spd))
+    check("status: spindle 1000 rpm forward", st["spindle"]["speed"] == 1000 and
+          st["spindle"]["direction"] == 1, st["spindle"])
+    c.ok("override.set", spindle=0.5)
+    out = float(c.ok("hal.get", name="spindle.0.speed-out")["value"])
+    check("spindle override 50 %: speed-out 500 rpm", abs(out - 500) < 1e-9, out)
+    c.ok("override.set", spindle=1.0)
+    c.ok("mdi.execute", line="M5")
+    c.wait()
+    on = c.ok("hal.get", name="spindle.0.on")["value"]
+    check("M5: spindle.0.on false", on in ("FALSE", "0", "false"), on)
     c.ok("program.open", path=os.path.join(SIM, "tmu-hexapod-demo.ngc"))
     c.ok("program.run")
     st = c.wait()
