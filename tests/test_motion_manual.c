@@ -90,7 +90,7 @@ static void rig_open(struct rig *r, double vmax, double amax, int switches)
         tk_set(c, sec, "MAX_VELOCITY", v);
         tk_set(c, sec, "MAX_ACCELERATION", a);
         if (switches) {
-            char seq[8];
+            char seq[16];
             snprintf(seq, sizeof seq, "%d", i / 3);
             tk_set(c, sec, "HOME_SEARCH_VEL", "20");
             tk_set(c, sec, "HOME_LATCH_VEL", "-2");
