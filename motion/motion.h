@@ -150,6 +150,14 @@ struct motion_spindle {
     int mist, flood;         /* M7, M8 */
 };
 
+/* Tool changes (M6) as the path reaches them: a request the machine's tool changer (the
+ * motion component's iocontrol pins) carries out, and the tool in the spindle. */
+struct motion_tool {
+    int number;              /* the tool in the spindle */
+    int request;             /* the tool of the last M6 */
+    unsigned seq;            /* counts M6 requests; motion_tool_changed(seq) answers one */
+};
+
 /* What one servo period produces. */
 struct motion_out {
     double pose[KINS_POSE_DIM];        /* commanded pose: mm, deg */
@@ -171,7 +179,9 @@ struct motion_out {
     double distance_total_mm;          /* XYZ path length of the program, mm */
     double feed_override;              /* override in effect now (ramps to the requested) */
     struct motion_spindle spindle;     /* spindle and coolant commands in force */
-    int waiting;                       /* holding on the path until the spindle is at speed */
+    int waiting;                       /* holding on the path: 1 for the spindle to be at
+                                        * speed, 2 for a tool change */
+    struct motion_tool tool;           /* tool change requests, the tool in the spindle */
     size_t settings_done;              /* CANON_SETTING commands of the program the machine has
                                         * passed since motion_start, in program order: the
                                         * path reached their place (never decreases) */
@@ -245,6 +255,10 @@ bool motion_pose_known(const struct motion *m);
  * changes until the spindle reports it is at speed, and that report, each period. */
 void motion_set_wait_at_speed(struct motion *m, bool on);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
+/* Tool changes: whether programs planned from now on stop at M6 until the changer is done,
+ * and the changer's answer to request seq (the tool is then in the spindle). */
+void motion_set_wait_tool(struct motion *m, bool on);
+void motion_tool_changed(struct motion *m, unsigned seq);
 /* Homed status of all legs. */
 bool motion_all_homed(const struct motion *m);
 

@@ -34,6 +34,12 @@ int motion_hal_abort(struct hal *h);
  * thread (the task waits for it before answering, so that what it reports has happened). */
 bool motion_hal_pending(const struct hal *h);
 
+/* Manual tool changes (the session): with iocontrol.0.tool-changed unconnected, programs
+ * planned from now on stop at M6 until motion_hal_command(MOTION_CMD_TOOL_CHANGED). Whether
+ * such a change waits for the operator now. */
+int motion_hal_set_manual_toolchange(struct hal *h, bool on);
+bool motion_hal_manual_toolchange_waiting(const struct hal *h);
+
 /* The component's output of its last motion.update (pose, legs, state, line, progress);
  * before the first one, the pose it holds. MOTION_ERR_STATE without `loadrt motion`. */
 int motion_hal_out(const struct hal *h, struct motion_out *out);
@@ -45,7 +51,8 @@ int motion_hal_pose(const struct hal *h, double pose[KINS_POSE_DIM]);
  * motion.update while the machine is on; dropped when it is off). */
 enum motion_hal_cmd_kind { MOTION_CMD_JOG, MOTION_CMD_JOG_STOP, MOTION_CMD_MOVE_TO,
                            MOTION_CMD_HOME, MOTION_CMD_UNHOME, MOTION_CMD_PAUSE,
-                           MOTION_CMD_RESUME, MOTION_CMD_STEP, MOTION_CMD_RAPID };
+                           MOTION_CMD_RESUME, MOTION_CMD_STEP, MOTION_CMD_RAPID,
+                           MOTION_CMD_TOOL_CHANGED /* the operator confirms a tool change */ };
 struct motion_hal_cmd {
     enum motion_hal_cmd_kind kind;
     enum motion_jog_frame frame;

@@ -400,6 +400,12 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             break;
         }
         case CANON_COOLANT: rc = add_io(p, IO_COOLANT, 0, c->ivalue); break;
+        case CANON_TOOL_CHANGE:
+            rc = add_io(p, c->value == 0 ? IO_TOOL_CHANGE : IO_TOOL_SET, 0, c->ivalue);
+            if (rc == 0 && c->value == 0 && m->wait_tool && (rc = add_stop(p, c, at, SEG_WAIT,
+                                                                           0)) == 0)
+                p->segs[p->nseg - 1].wait_tool = 1;
+            break;
         case CANON_PAUSE:
             if (c->ivalue == 0 || m->cfg.optional_stop)
                 rc = add_stop(p, c, at, SEG_PAUSE, 0);

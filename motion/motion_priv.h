@@ -13,7 +13,9 @@ enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE,
 
 /* A spindle or coolant command on the path (CANON_SPINDLE_*, CANON_COOLANT): applied when
  * the path reaches the segment it lies before, as a setting point is. */
-enum motion_io_kind { IO_SPINDLE_SPEED, IO_SPINDLE_ON, IO_SPINDLE_STOP, IO_COOLANT };
+enum motion_io_kind { IO_SPINDLE_SPEED, IO_SPINDLE_ON, IO_SPINDLE_STOP, IO_COOLANT,
+                      IO_TOOL_CHANGE /* M6: ivalue the tool */,
+                      IO_TOOL_SET /* M61 Q: the tool in the spindle, no change */ };
 struct motion_io {
     size_t at;               /* the segment it lies before (nseg: after the last) */
     enum motion_io_kind kind;
@@ -56,6 +58,7 @@ struct motion_seg {
                               * close but on very long moves (MAX_INTERVALS), where the checks
                               * sample between them at this spacing */
     int arc;                 /* index into arcs for SEG_ARC, else -1 */
+    int wait_tool;           /* SEG_WAIT: for a tool change (else for the spindle) */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
      * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
@@ -149,6 +152,9 @@ struct motion {
     int at_speed;            /* the spindle's at-speed input this period */
     int waiting;             /* holding at a SEG_WAIT for the spindle */
     long io_age;             /* periods since a spindle or coolant command last changed */
+    int wait_tool;           /* plan a wait at M6 (motion_hal: tool-changed is wired) */
+    struct motion_tool tool; /* tool change requests and the tool in the spindle */
+    unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];

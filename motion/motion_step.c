@@ -97,11 +97,13 @@ static int wait_here(struct motion *m)
         return 0;
     /* the report counts once the spindle has had the command for MOTION_AT_SPEED_LAG
      * periods: an at-speed that was true for the old speed says nothing of the new */
-    if (m->at_speed && m->io_age >= MOTION_AT_SPEED_LAG && m->ios_done >= wait_ios(m)) {
+    bool done = sg->wait_tool ? m->tool_done_seq == m->tool.seq
+                              : m->at_speed && m->io_age >= MOTION_AT_SPEED_LAG;
+    if (done && m->ios_done >= wait_ios(m)) {
         m->waited_at_seg = m->cs + 1;
         return 0;
     }
-    m->waiting = 1;
+    m->waiting = sg->wait_tool ? 2 : 1;
     m->tau_s = m->plan.kt[m->ci];
     m->rate = 0;
     return 1;
@@ -254,6 +256,11 @@ static void pass_ios(struct motion *m)
         case IO_SPINDLE_SPEED: m->io.rpm = fabs(io->value); break;
         case IO_SPINDLE_ON: m->io.dir = io->value < 0 ? -1 : 1; break;
         case IO_SPINDLE_STOP: m->io.dir = 0; break;
+        case IO_TOOL_CHANGE:
+            m->tool.request = io->ivalue;
+            m->tool.seq++;
+            break;
+        case IO_TOOL_SET: m->tool.number = m->tool.request = io->ivalue; break;
         case IO_COOLANT:
             if (io->ivalue == 7)
                 m->io.mist = 1;
@@ -264,6 +271,20 @@ static void pass_ios(struct motion *m)
             break;
         }
     }
+}
+
+void motion_set_wait_tool(struct motion *m, bool on)
+{
+    if (m)
+        m->wait_tool = on;
+}
+
+void motion_tool_changed(struct motion *m, unsigned seq)
+{
+    if (!m || seq != m->tool.seq)
+        return;
+    m->tool_done_seq = seq;
+    m->tool.number = m->tool.request;
 }
 
 void motion_set_wait_at_speed(struct motion *m, bool on)
@@ -338,5 +359,6 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->settings_done = m->marks_done;
     out->spindle = m->io;
     out->waiting = m->waiting;
+    out->tool = m->tool;
     return ret;
 }

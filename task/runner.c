@@ -260,6 +260,9 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     memcpy(prog->start, start, sizeof start);
     if ((st = runner_setup_interp(r, in, tt, err, errlen)))
         goto out;
+    struct motion_out mo;
+    if (motion_hal_out(r->hal, &mo) == MOTION_OK)
+        interp_set_current_tool(in, mo.tool.number);  /* the tool the machine has */
     interp_set_cancel(in, r->cancel);
     interp_set_block_delete(in, r->block_delete);
     if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {

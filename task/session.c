@@ -274,6 +274,15 @@ int session_jog(struct session *s, int frame, int axis, double vel, double dist,
     return push(s, &c, err, len);
 }
 
+/* The operator has put the tool M6 asked for in the spindle. */
+int session_tool_changed(struct session *s, char *err, size_t len)
+{
+    if (!motion_hal_manual_toolchange_waiting(s->hal))
+        return fail(RPC_STATE, err, len, "tool.changed: no manual tool change is waiting");
+    struct motion_hal_cmd c = { .kind = MOTION_CMD_TOOL_CHANGED };
+    return push(s, &c, err, len);
+}
+
 int session_jog_stop(struct session *s, char *err, size_t len)
 {
     struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG_STOP };
@@ -524,12 +533,12 @@ static void drain_hal_messages(struct session *s)
 
 /* After a program: the MDI interpreter starts afresh from the INI and the saved parameters,
  * so that offsets the program set (G10, saved in the parameter file) are the ones MDI and the
- * status show, and its modal state is the default one, as after LinuxCNC's M2. The tool MDI
- * put in the spindle stays there. */
+ * status show, and its modal state is the default one, as after LinuxCNC's M2. The tool in
+ * the spindle is the one the machine has. */
 static void mdi_renew(struct session *s)
 {
-    struct interp_view v;
-    interp_get_view(s->mdi, &v);
+    struct motion_out o;
+    motion_hal_out(s->hal, &o);
     struct interp *in = interp_create();
     struct tooltable *tt = malloc(sizeof *tt);
     char err[1024];
@@ -543,7 +552,7 @@ static void mdi_renew(struct session *s)
             s->mdi_tt = *tt;
             interp_set_tooltable(in, &s->mdi_tt);
             interp_set_mdi(in, 1);
-            interp_set_current_tool(in, v.current_tool);
+            interp_set_current_tool(in, o.tool.number);  /* the tool the machine has */
             interp_destroy(s->mdi);
             s->mdi = in;
             in = NULL;
@@ -668,6 +677,8 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     if (s->spindle_ovr_pin && t != HAL_FLOAT)
         s->spindle_ovr_pin = NULL;
     motion_hal_set_autostart(s->hal, false);  /* only program.run starts a program */
+    /* no tool changer wired: M6 waits for the operator's tool.changed */
+    motion_hal_set_manual_toolchange(s->hal, true);
     s->mdi = interp_create();
     tooltable_init(&s->mdi_tt);
     if (!s->mdi || runner_setup_interp(s->r, s->mdi, &s->mdi_tt, err, errlen) != RUNNER_OK)

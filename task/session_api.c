@@ -305,6 +305,12 @@ static int m_abort(struct session *s, struct session_client *c, json_t *p, json_
     return session_abort(s, err, len);
 }
 
+static int m_tool_changed(struct session *s, struct session_client *c, json_t *p, json_t **r,
+                          char *err, size_t len)
+{
+    return session_tool_changed(s, err, len);
+}
+
 static int m_override(struct session *s, struct session_client *c, json_t *p, json_t **r,
                       char *err, size_t len)
 {
@@ -448,6 +454,7 @@ static const struct method methods[] = {
     { "program.abort", false, m_abort }, /* as jog.stop: anyone may stop the machine */
     { "override.set", true, m_override },
     { "switch.set", true, m_switch },
+    { "tool.changed", true, m_tool_changed },
     { "tooltable.get", false, m_tooltable_get },
     { "hal.show", false, m_hal_show },
     { "hal.get", false, m_hal_get },

@@ -81,6 +81,7 @@ int session_set_mode(struct session *s, enum session_mode mode, char *err, size_
 int session_jog(struct session *s, int frame, int axis, double vel, double dist, char *err,
                 size_t len);
 int session_jog_stop(struct session *s, char *err, size_t len);
+int session_tool_changed(struct session *s, char *err, size_t len);
 int session_mdi(struct session *s, const char *line, char *err, size_t len);
 int session_open(struct session *s, const char *path, char *err, size_t len);
 int session_check(struct session *s, json_t **result, char *err, size_t len);

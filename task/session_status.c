@@ -133,7 +133,7 @@ json_t *session_status(struct session *s)
         "legs", legs,
         "gcodes", gcodes(s),
         "mcodes", mcodes(&v),
-        "tool", "number", v.current_tool, "selected", v.selected_tool, "length",
+        "tool", "number", o.tool.number, "selected", v.selected_tool, "length",
         v.tool_mm[2],
         "feed", v.feed_mm_min,
         "spindle", "speed", o.spindle.rpm, "direction", o.spindle.dir, "override",

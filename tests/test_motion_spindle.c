@@ -72,7 +72,7 @@ START_TEST(test_commands_where_the_path_reaches_them)
     ck_assert_uint_eq(with.segments, without.segments);
     ck_assert_double_eq_tol(with.time_s, without.time_s, 1e-12);
     ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-    struct motion_out o;
+    struct motion_out o = { 0 };
     double flood_at[6] = {0}, off_at[6] = {0};
     int had_flood = 0, had_off = 0, first = 1;
     for (int k = 0; k < 100000; k++) {
@@ -117,7 +117,7 @@ START_TEST(test_spindle_kept_then_stopped_by_abort)
     char err[256];
     ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
     ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-    struct motion_out o;
+    struct motion_out o = { 0 };
     for (int k = 0; k < 3; k++)
         motion_step(mc.m, DT, &o);
     ck_assert_int_eq(o.state, MOTION_DONE);
@@ -162,7 +162,7 @@ START_TEST(test_wait_for_spindle_at_speed)
     char err[256];
     ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
     ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-    struct motion_out o;
+    struct motion_out o = { 0 };
     int k = 0;
     for (; k < 100000 && !(o.waiting); k++)
         motion_step(mc.m, DT, &o);
@@ -209,7 +209,7 @@ START_TEST(test_abort_while_waiting)
     char err[256];
     ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
     ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-    struct motion_out o;
+    struct motion_out o = { 0 };
     for (int k = 0; k < 100; k++)
         motion_step(mc.m, DT, &o);
     ck_assert_int_eq(o.waiting, 1);
@@ -241,7 +241,7 @@ START_TEST(test_lone_spindle_start_waits)
     char err[256];
     ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
     ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-    struct motion_out o;
+    struct motion_out o = { 0 };
     motion_step(mc.m, DT, &o);
     ck_assert_int_eq(o.state, MOTION_RUNNING);
     ck_assert_int_eq(o.waiting, 1);
@@ -260,6 +260,51 @@ START_TEST(test_lone_spindle_start_waits)
 }
 END_TEST
 
+/* M6 with a tool changer: the path stops at the M6 and holds (waiting 2) with the request
+ * out until the changer answers that request; then the tool is in the spindle and the path
+ * goes on. M61 Q sets the tool without a change or a stop. */
+START_TEST(test_tool_change_waits_for_the_changer)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    motion_set_wait_tool(mc.m, true);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, P0, sizeof P0);
+    add_simple(&p, CANON_TOOL_CHANGE, 1, 1, 7);     /* M61 Q7 */
+    tm_add(&p, CANON_FEED, 2, P1, 1200, 0);
+    add_simple(&p, CANON_TOOL_CHANGE, 3, 0, 3);     /* T3 M6 */
+    tm_add(&p, CANON_FEED, 4, P2, 1200, 0);
+    char err[256];
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+    struct motion_out o = { 0 };
+    motion_step(mc.m, DT, &o);
+    ck_assert_int_eq(o.tool.number, 7);
+    ck_assert_int_eq(o.waiting, 0);
+    for (int k = 0; k < 100000 && !o.waiting; k++)
+        motion_step(mc.m, DT, &o);
+    ck_assert_int_eq(o.waiting, 2);
+    ck_assert_msg(dist2(o.pose, P1) < 1e-9, "waits %.6f mm from P1", dist2(o.pose, P1));
+    ck_assert_int_eq(o.tool.request, 3);
+    ck_assert_int_eq(o.tool.number, 7);
+    unsigned seq = o.tool.seq;
+    motion_tool_changed(mc.m, seq + 1);              /* not this request: ignored */
+    for (int k = 0; k < 1000; k++) {
+        motion_step(mc.m, DT, &o);
+        ck_assert_int_eq(o.waiting, 2);
+    }
+    motion_tool_changed(mc.m, seq);
+    for (int k = 0; k < 100000 && o.state != MOTION_DONE; k++)
+        motion_step(mc.m, DT, &o);
+    ck_assert_int_eq(o.state, MOTION_DONE);
+    ck_assert_int_eq(o.tool.number, 3);
+    ck_assert_msg(dist2(o.pose, P2) < 1e-9, "did not reach P2");
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *spindle_suite(void)
 {
     Suite *s = suite_create("motion_spindle");
@@ -269,6 +314,7 @@ static Suite *spindle_suite(void)
     tcase_add_test(tc, test_wait_for_spindle_at_speed);
     tcase_add_test(tc, test_abort_while_waiting);
     tcase_add_test(tc, test_lone_spindle_start_waits);
+    tcase_add_test(tc, test_tool_change_waits_for_the_changer);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -17,6 +17,7 @@ static const char motion_axis_names[KINS_POSE_DIM] = { 'x', 'y', 'z', 'a', 'b', 
 /* The instance: the motion core and its pins. */
 struct motion_comp {
     struct motion *m;                        /* the planner/interpolator (object "motion") */
+    struct hal *h;                           /* for messages */
     int nj;                                  /* joints */
     atomic_int start_pending;                /* a program waits to start (motion_hal_start) */
     atomic_int abort_pending;                /* motion_hal_abort was called */
@@ -58,6 +59,15 @@ struct motion_comp {
     bool *sp_at_speed_own;                   /* the pin's own storage: another address
                                               * means `net` linked it (then programs wait) */
     bool *mist, *flood;                      /* out: iocontrol.0.coolant-mist, -flood */
+    /* the tool changer's handshake, LinuxCNC's iocontrol pins */
+    int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
+    bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
+    bool *tc_prepared, *tc_changed;          /* in: tool-prepared, tool-changed */
+    bool *tc_prepared_own, *tc_changed_own;  /* their own storage (see sp_at_speed_own) */
+    int tc_phase;                            /* 0 idle, 1 preparing, 2 changing */
+    unsigned tc_done_seq;                    /* the last M6 request handled */
+    bool manual_tc;                          /* no changer wired: the operator confirms */
+    atomic_int manual_ack;                   /* the operator confirmed (MOTION_CMD_TOOL_CHANGED) */
     bool last_pause, last_resume, last_abort;/* previous values, for the edges */
 };
 
@@ -84,6 +94,7 @@ static void motion_comp_manual(struct motion_comp *c)
         case MOTION_CMD_RESUME: motion_resume(c->m); break;
         case MOTION_CMD_STEP: motion_step_block(c->m); break;
         case MOTION_CMD_RAPID: motion_set_rapid_override(c->m, cmd.vel); break;
+        case MOTION_CMD_TOOL_CHANGED: atomic_store(&c->manual_ack, 1); break;
         }
     }
 }
@@ -124,6 +135,55 @@ static void motion_comp_commands(struct motion_comp *c)
     motion_comp_manual(c);  /* after a start, so that a step can follow it at once */
     motion_set_feed_override(c->m, *c->feed_override);
     motion_set_spindle_at_speed(c->m, *c->sp_at_speed);
+}
+
+/* The tool changer's handshake for the last M6 the path reached (LinuxCNC's order):
+ * tool-prep-number and tool-prepare until tool-prepared, then tool-change until
+ * tool-changed; then tool-number is the new tool and the path goes on. An input left
+ * unconnected answers at once; with tool-changed unconnected and manual_tc, the operator's
+ * confirmation (tool.changed) answers it. An abort or fault drops the request. */
+static void motion_comp_toolchange(struct motion_comp *c, struct hal *h,
+                                   const struct motion_out *o)
+{
+    bool gone = o->state == MOTION_IDLE || o->state == MOTION_FAULT || !*c->enable;
+    if (o->tool.seq == c->tc_done_seq || gone) {
+        if (o->tool.seq != c->tc_done_seq)
+            c->tc_done_seq = o->tool.seq;  /* dropped with its program */
+        *c->tc_prepare = *c->tc_change = false;
+        c->tc_phase = 0;
+        atomic_store(&c->manual_ack, 0);
+        *c->tc_number = o->tool.number;
+        return;
+    }
+    bool prepared_wired = c->tc_prepared != c->tc_prepared_own;
+    bool changed_wired = c->tc_changed != c->tc_changed_own;
+    switch (c->tc_phase) {
+    case 0:
+        *c->tc_prep_number = o->tool.request;
+        *c->tc_prepare = true;
+        c->tc_phase = 1;
+        __attribute__((fallthrough));  /* an unwired tool-prepared answers at once */
+    case 1:
+        if (prepared_wired && !*c->tc_prepared)
+            break;
+        *c->tc_prepare = false;
+        *c->tc_change = true;
+        c->tc_phase = 2;
+        if (!changed_wired && c->manual_tc)
+            hal_msg_post(h, HAL_MSG_WARNING, "iocontrol", "tool change: put tool %d in the "
+                         "spindle, then confirm it (tool.changed)", o->tool.request);
+        break;
+    case 2:
+        if (changed_wired ? !*c->tc_changed
+                          : c->manual_tc && !atomic_exchange(&c->manual_ack, 0))
+            break;
+        *c->tc_change = false;
+        motion_tool_changed(c->m, o->tool.seq);
+        *c->tc_number = o->tool.request;
+        c->tc_done_seq = o->tool.seq;
+        c->tc_phase = 0;
+        break;
+    }
 }
 
 /* Spindle and coolant pins from the commands in force; off while the drives are off. */
@@ -176,6 +236,7 @@ static void motion_comp_update(void *arg, long period_ns)
     *c->fault = o.state == MOTION_FAULT;
     *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
     motion_comp_spindle(c, &o);
+    motion_comp_toolchange(c, c->h, &o);
     pthread_mutex_unlock(&c->plan_lock);
 }
 
@@ -239,8 +300,15 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->sp_at_speed, "spindle.0.at-speed");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->mist, "iocontrol.0.coolant-mist");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->flood, "iocontrol.0.coolant-flood");
+    if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_change, "iocontrol.0.tool-change");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_changed, "iocontrol.0.tool-changed");
+    if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_number, "iocontrol.0.tool-number");
     return st;
 }
+
 
 
 /* Reads the configuration, creates the motion core on the machine's kinematics, the pins and
@@ -296,8 +364,11 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
         *c->pose_cmd[i] = o.pose[i];
     *c->feed_override = 1;
     *c->sp_override = 1;
+    c->h = h;
     *c->sp_at_speed = true;   /* unwired: the spindle is taken to be at speed */
     c->sp_at_speed_own = c->sp_at_speed;
+    c->tc_prepared_own = c->tc_prepared;
+    c->tc_changed_own = c->tc_changed;
     c->autostart = true;
     return HAL_OK;
 }
@@ -340,6 +411,7 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
         }
     }
     motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
+    motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
     int st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK && c->autostart;
     pthread_mutex_unlock(&c->plan_lock);
@@ -357,6 +429,21 @@ int motion_hal_start(struct hal *h)
         return MOTION_ERR_STATE;           /* running, done, faulted or nothing loaded */
     c->start_pending = 1;
     return MOTION_OK;
+}
+
+int motion_hal_set_manual_toolchange(struct hal *h, bool on)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (!c)
+        return MOTION_ERR_STATE;
+    c->manual_tc = on;
+    return MOTION_OK;
+}
+
+bool motion_hal_manual_toolchange_waiting(const struct hal *h)
+{
+    const struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    return c && c->manual_tc && c->tc_phase == 2 && c->tc_changed == c->tc_changed_own;
 }
 
 /* Whether a start, an abort or a manual command waits for the servo thread to take it. */

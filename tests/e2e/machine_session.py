@@ -196,6 +196,24 @@ def plain_session(tmp):
     check("... and its changes: G90, M5, M9", "G90" in st["gcodes"] and "M5" in st["mcodes"]
           and "M9" in st["mcodes"] and st["spindle"]["direction"] == 0, (st["gcodes"],
                                                                          st["mcodes"]))
+    # a manual tool change (no changer wired): M6 waits for the operator's tool.changed
+    r = c.call("tool.changed")
+    check("tool.changed with no change waiting: refused", err_code(r) == -32001, r)
+    c.notes.clear()
+    c.ok("mdi.execute", line="T3 M6")
+    st = c.status()
+    tc = c.ok("hal.get", name="iocontrol.0.tool-change")["value"]
+    check("T3 M6 waits for the operator, iocontrol.0.tool-change on", st["interp"] ==
+          "waiting" and tc in ("TRUE", "1"), (st["interp"], tc))
+    time.sleep(0.2)
+    c.status()
+    check("... and asks for tool 3", any("put tool 3 in the spindle" in m
+                                         for m in c.messages()), c.messages())
+    c.ok("tool.changed")
+    st = c.wait()
+    num = c.ok("hal.get", name="iocontrol.0.tool-number")["value"]
+    check("after tool.changed: tool 3 in the spindle (status, iocontrol.0.tool-number)",
+          st["tool"]["number"] == 3 and num == "3", (st["tool"], num))
     r = c.call("mdi.execute", line="G1 X10 Q")
     check("a bad MDI line: -32003 naming MDI:1", err_code(r) == -32003 and
           r["error"]["message"].startswith("MDI:1"), r)
