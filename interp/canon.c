@@ -15,7 +15,8 @@ static const char *const canon_names[CANON_TYPE_COUNT] = {
     [CANON_TOOL_CHANGE] = "TOOL_CHANGE", [CANON_COOLANT] = "COOLANT",
     [CANON_COMMENT] = "COMMENT",         [CANON_PAUSE] = "PAUSE",
     [CANON_PROGRAM_END] = "PROGRAM_END", [CANON_OFFSETS] = "OFFSETS",
-    [CANON_SETTING] = "SETTING",
+    [CANON_SETTING] = "SETTING",        [CANON_DIGITAL_OUT] = "DIGITAL_OUT",
+    [CANON_ANALOG_OUT] = "ANALOG_OUT",
 };
 
 const char *canon_type_name(enum canon_type t)

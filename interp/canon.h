@@ -35,6 +35,9 @@ enum canon_type {
                             * G28.1/G30.1, G92, G54..G59.3, #n=) changed by this line. It
                             * takes effect, and is saved, when execution reaches it: motion
                             * passes it in order as a point of zero length */
+    CANON_DIGITAL_OUT,     /* M62/M63 (synchronised with motion) and M64/M65 (immediate):
+                            * output ivalue set (value 1) or cleared (0) */
+    CANON_ANALOG_OUT,      /* M67 (synchronised) / M68 (immediate): output ivalue = value */
     CANON_TYPE_COUNT
 };
 
@@ -76,6 +79,7 @@ struct canon_cmd {
     double value;          /* DWELL s, PATH_MODE tol, SPINDLE_* rpm/dir, FEED_MODE */
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
+    int immediate;         /* DIGITAL_OUT, ANALOG_OUT: M64/M65/M68 (else M62/M63/M67) */
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */

@@ -1,4 +1,5 @@
 /* exec.c: runs one checked block in LinuxCNC's order of execution, emitting canon commands. */
+#include <stdbool.h>
 #include <math.h>
 #include <string.h>
 
@@ -35,6 +36,33 @@ static int emit_simple(struct interp *in, enum canon_type t, double value, int i
     interp_cmd_init(in, &c, t);
     c.value = value;
     c.ivalue = ivalue;
+    c.feed_mm_min = in->feed_mm_min;
+    return interp_emit(in, &c);
+}
+
+/* M62..M65 P: a digital output; M67/M68 E Q: an analog output (docs/gcode.md). */
+static int exec_io(struct interp *in, const struct interp_block *b)
+{
+    int code = b->m[5], n;
+    struct canon_cmd c;
+    bool digital = code <= 65;
+    char w = digital ? 'p' : 'e';
+    if (!W(w))
+        return interp_fail(in, INTERP_ERR_WORD, b->mcol[5], "M%d needs %s", code, digital
+                           ? "a P word: the digital output's number" : "an E word (the analog "
+                           "output's number) and a Q word (its value)");
+    CHP(interp_to_int(in, V(w), W(w), digital ? "P (digital output)" : "E (analog output)",
+                      &n));
+    if (n < 0)
+        return interp_fail(in, INTERP_ERR_WORD, W(w), "M%d: output %d: outputs are numbered "
+                           "from 0", code, n);
+    if (!digital && !W('q'))
+        return interp_fail(in, INTERP_ERR_WORD, b->mcol[5], "M%d needs a Q word: the value "
+                           "of analog output %d", code, n);
+    interp_cmd_init(in, &c, digital ? CANON_DIGITAL_OUT : CANON_ANALOG_OUT);
+    c.ivalue = n;
+    c.value = digital ? (code == 62 || code == 64) : V('q');
+    c.immediate = code == 64 || code == 65 || code == 68;
     c.feed_mm_min = in->feed_mm_min;
     return interp_emit(in, &c);
 }
@@ -129,6 +157,8 @@ static int exec_machine_words(struct interp *in)
                                in->tt ? in->tt->path : "");
         in->selected_tool = t;
     }
+    if (b->m[5] >= 0)  /* M62..M68 after the tool selection, before M6 (LinuxCNC's order) */
+        CHP(exec_io(in, b));
     if (b->m[6] == 6) {
         in->current_tool = in->selected_tool;
         CHP(emit_simple(in, CANON_TOOL_CHANGE, 0, in->current_tool));

@@ -133,7 +133,7 @@ static int read_word(struct interp *in, int *pos)
     if ((c < ' ' || c > '~') && c != 0)  /* control or non-ASCII byte: shown as a code */
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "byte 0x%02X is not G-code text (G-code "
                            "is ASCII)", (unsigned)(unsigned char)c);
-    if (c == 'e' || (c < 'a' || c > 'z'))
+    if (c < 'a' || c > 'z')
         return interp_fail(in, INTERP_ERR_SYNTAX, col,
                            c >= '0' && c <= '9' ? "a number without a word letter before it"
                                                 : "'%c' is not a G-code word",

@@ -221,6 +221,14 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
         snprintf(tmp, sizeof tmp, "%s\n", c->ivalue == 7 ? "MIST_ON()" : c->ivalue == 8 ?
                  "FLOOD_ON()" : "FLOOD_OFF()");
         break;
+    case CANON_DIGITAL_OUT:
+        snprintf(tmp, sizeof tmp, "%s_%s_OUTPUT_BIT(%d)\n", c->value != 0 ? "SET" : "CLEAR",
+                 c->immediate ? "AUX" : "MOTION", c->ivalue);
+        break;
+    case CANON_ANALOG_OUT:
+        snprintf(tmp, sizeof tmp, "SET_%s_OUTPUT_VALUE(%d,%f)\n", c->immediate ? "AUX" :
+                 "MOTION", c->ivalue, c->value);
+        break;
     case CANON_COMMENT:
         if (c->text && strncasecmp(c->text, "msg,", 4) == 0)
             snprintf(tmp, sizeof tmp, "MESSAGE(\"%s\")\n", c->text + 4);

@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "interp/canon.h"
 #include "kins/kins.h"
@@ -95,6 +96,7 @@ struct motion_config {
     double blend_tol_mm;            /* [TRAJ] BLEND_TOLERANCE, mm: G64 tolerance used when the
                                      * program gives G64 without P (canon value 0) */
     int optional_stop;              /* [TRAJ] OPTIONAL_STOP: 1 = M1 pauses like M0 (default) */
+    int num_dio, num_aio;           /* [EMCMOT] NUM_DIO, NUM_AIO: outputs M62..M68 may set */
     int njoints;                    /* joints configured (the kinematics' count) */
     struct motion_joint_config joint[KINS_MAX_JOINTS]; /* [JOINT_0..] */
 };
@@ -150,6 +152,14 @@ struct motion_spindle {
     int mist, flood;         /* M7, M8 */
 };
 
+/* Digital and analog outputs (M62..M68) as the path reaches them. */
+#define MOTION_MAX_DIO 64
+#define MOTION_MAX_AIO 16
+struct motion_outputs {
+    uint64_t dout;                   /* bit n: motion.digital-out-n */
+    double aout[MOTION_MAX_AIO];     /* motion.analog-out-n */
+};
+
 /* Tool changes (M6) as the path reaches them: a request the machine's tool changer (the
  * motion component's iocontrol pins) carries out, and the tool in the spindle. */
 struct motion_tool {
@@ -182,6 +192,7 @@ struct motion_out {
     int waiting;                       /* holding on the path: 1 for the spindle to be at
                                         * speed, 2 for a tool change */
     struct motion_tool tool;           /* tool change requests, the tool in the spindle */
+    struct motion_outputs outputs;     /* M62..M68 in force (kept from program to program) */
     size_t settings_done;              /* CANON_SETTING commands of the program the machine has
                                         * passed since motion_start, in program order: the
                                         * path reached their place (never decreases) */

@@ -55,6 +55,7 @@ void motion_config_default(struct motion_config *c)
     c->kin_tol_deg = 0.001;
     c->blend_tol_mm = 0.01;
     c->optional_stop = 1;
+    c->num_dio = c->num_aio = 4;
     c->njoints = 6;
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         c->joint[i].max_vel_mm_s = 100;
@@ -211,6 +212,22 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
     if (!st && opt_text && config_parse_bool(opt_text, &opt, NULL, 0) != 0) {
         snprintf(err, errlen, "[TRAJ] OPTIONAL_STOP = %s: expected 0 or 1", opt_text);
         st = MOTION_ERR_CONFIG;
+    }
+    static const struct { const char *key; int max; size_t off; } io_counts[] = {
+        { "NUM_DIO", MOTION_MAX_DIO, offsetof(struct motion_config, num_dio) },
+        { "NUM_AIO", MOTION_MAX_AIO, offsetof(struct motion_config, num_aio) },
+    };
+    for (size_t k = 0; k < 2 && !st; k++) {
+        const char *t = cfg->get(cfg->ctx, "EMCMOT", io_counts[k].key);
+        char *end;
+        long v = t ? strtol(t, &end, 10) : 0;
+        if (t && (end == t || *end || v < 0 || v > io_counts[k].max)) {
+            snprintf(err, errlen, "[EMCMOT] %s = %s: expected a whole number 0..%d",
+                     io_counts[k].key, t, io_counts[k].max);
+            st = MOTION_ERR_CONFIG;
+        } else if (t) {
+            *(int *)(void *)((char *)c + io_counts[k].off) = (int)v;
+        }
     }
     for (int i = 0; i < njoints && !st; i++) {
         char sec[24];

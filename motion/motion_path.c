@@ -400,6 +400,20 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             break;
         }
         case CANON_COOLANT: rc = add_io(p, IO_COOLANT, 0, c->ivalue); break;
+        case CANON_DIGITAL_OUT: case CANON_ANALOG_OUT: {
+            bool dig = c->type == CANON_DIGITAL_OUT;
+            int n = dig ? m->cfg.num_dio : m->cfg.num_aio;
+            if (c->ivalue >= n) {
+                snprintf(err, errlen, "%s:%d: M%d: %s output %d does not exist: the machine "
+                         "has %d ([EMCMOT] %s)", c->file ? c->file : "program", c->line,
+                         dig ? (c->immediate ? 64 : 62) + (c->value == 0) : c->immediate ?
+                         68 : 67, dig ? "digital" : "analog", c->ivalue, n,
+                         dig ? "NUM_DIO" : "NUM_AIO");
+                return MOTION_ERR_PROGRAM;
+            }
+            rc = add_io(p, dig ? IO_DOUT : IO_AOUT, c->value, c->ivalue);
+            break;
+        }
         case CANON_TOOL_CHANGE:
             rc = add_io(p, c->value == 0 ? IO_TOOL_CHANGE : IO_TOOL_SET, 0, c->ivalue);
             if (rc == 0 && c->value == 0 && m->wait_tool && (rc = add_stop(p, c, at, SEG_WAIT,

@@ -15,7 +15,9 @@ enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE,
  * the path reaches the segment it lies before, as a setting point is. */
 enum motion_io_kind { IO_SPINDLE_SPEED, IO_SPINDLE_ON, IO_SPINDLE_STOP, IO_COOLANT,
                       IO_TOOL_CHANGE /* M6: ivalue the tool */,
-                      IO_TOOL_SET /* M61 Q: the tool in the spindle, no change */ };
+                      IO_TOOL_SET /* M61 Q: the tool in the spindle, no change */,
+                      IO_DOUT /* M62..M65: ivalue the output, value 0/1 */,
+                      IO_AOUT /* M67, M68: ivalue the output, value */ };
 struct motion_io {
     size_t at;               /* the segment it lies before (nseg: after the last) */
     enum motion_io_kind kind;
@@ -154,6 +156,7 @@ struct motion {
     long io_age;             /* periods since a spindle or coolant command last changed */
     int wait_tool;           /* plan a wait at M6 (motion_hal: tool-changed is wired) */
     struct motion_tool tool; /* tool change requests and the tool in the spindle */
+    struct motion_outputs outputs; /* M62..M68 in force */
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     int have_cmd;            /* joint_cmd holds a command */

@@ -256,6 +256,13 @@ static void pass_ios(struct motion *m)
         case IO_SPINDLE_SPEED: m->io.rpm = fabs(io->value); break;
         case IO_SPINDLE_ON: m->io.dir = io->value < 0 ? -1 : 1; break;
         case IO_SPINDLE_STOP: m->io.dir = 0; break;
+        case IO_DOUT:
+            if (io->value != 0)
+                m->outputs.dout |= UINT64_C(1) << io->ivalue;
+            else
+                m->outputs.dout &= ~(UINT64_C(1) << io->ivalue);
+            break;
+        case IO_AOUT: m->outputs.aout[io->ivalue] = io->value; break;
         case IO_TOOL_CHANGE:
             m->tool.request = io->ivalue;
             m->tool.seq++;
@@ -360,5 +367,6 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->spindle = m->io;
     out->waiting = m->waiting;
     out->tool = m->tool;
+    out->outputs = m->outputs;
     return ret;
 }

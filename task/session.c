@@ -697,7 +697,9 @@ int session_create(const struct session_opts *opts, struct session **out, char *
         fail(1, err, errlen, "%s", hal_last_error(s->hal));
         goto fail;
     }
-    session_wait_periods(s, 3);  /* motion takes the legs' feedback as its command */
+    /* motion takes the legs' feedback as its command once the drives have run a few periods
+     * (MOTION_FEEDBACK_SETTLE): the machine must not be switched on before */
+    session_wait_periods(s, 8);
     s->last_mstate = mstate(s);
     motion_manual_note(s->m, &s->note_seq);
     *out = s;

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Runs `hexcnc interp` on tests/interp_expected/*.ngc and compares its motion lines
-# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL) with those in NAME.out, which LinuxCNC's
+# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL) and outputs (M62..M68) with those in NAME.out, which LinuxCNC's
 # `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists). The first column
 # (rs274's output line counter) is left out: the two print different non-motion lines.
 # With rs274 installed and REGEN=1 the .out files are made again. sub_NAME.ngc files hold
@@ -11,7 +11,7 @@ dir=$root/tests/interp_expected
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 pass=0; fail=0
-motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL' | cut -c7-; }
+motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL|_OUTPUT_(BIT|VALUE)' | cut -c7-; }
 for ngc in "$dir"/*.ngc; do
     name=$(basename "$ngc" .ngc)
     case $name in sub_*) continue ;; esac  # subroutine files that programs here call

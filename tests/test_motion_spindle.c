@@ -1,6 +1,7 @@
-/* test_motion_spindle.c: spindle and coolant commands on the path: applied where the path
- * reaches them, kept after the program, off after an abort; with the at-speed input wired,
- * programs stop after M3/M4/S and wait for the spindle, and only then. */
+/* test_motion_spindle.c: machine I/O on the path: spindle and coolant commands applied where
+ * the path reaches them, kept after the program, off after an abort; with the at-speed input
+ * wired, programs stop after M3/M4/S and wait for the spindle, and only then; tool changes
+ * wait for the changer; M62..M68 outputs switch where the path reaches them. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -305,6 +306,79 @@ START_TEST(test_tool_change_waits_for_the_changer)
 }
 END_TEST
 
+static void add_out(struct canon_prog *p, enum canon_type t, int line, int n, double v,
+                    int immediate)
+{
+    struct canon_cmd c;
+    memset(&c, 0, sizeof c);
+    c.type = t;
+    c.line = line;
+    c.file = "test.ngc";
+    c.ivalue = n;
+    c.value = v;
+    c.immediate = immediate;
+    if (canon_prog_sink(p, &c))
+        abort();
+}
+
+/* M62 P1 before the move to P1 (on as it starts), M63 P1 and M67 E2 Q3.5 before the move to
+ * P2 (at P1), M64 P3 and M68 E0 Q-2 before the move to P3 (at P2): each where the path
+ * reaches it, and all kept after the program. An output the machine does not have
+ * ([EMCMOT] NUM_DIO) is refused at planning, naming the line. */
+START_TEST(test_outputs_where_the_path_reaches_them)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_trivial_cfg(), &kins_trivial_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, P0, sizeof P0);
+    add_out(&p, CANON_DIGITAL_OUT, 1, 1, 1, 0);
+    tm_add(&p, CANON_FEED, 2, P1, 1200, 0);
+    add_out(&p, CANON_DIGITAL_OUT, 3, 1, 0, 0);
+    add_out(&p, CANON_ANALOG_OUT, 3, 2, 3.5, 0);
+    tm_add(&p, CANON_FEED, 4, P2, 1200, 0);
+    add_out(&p, CANON_DIGITAL_OUT, 5, 3, 1, 1);
+    add_out(&p, CANON_ANALOG_OUT, 5, 0, -2, 1);
+    tm_add(&p, CANON_FEED, 6, P3, 1200, 0);
+    char err[256];
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+    struct motion_out o = { 0 };
+    double off_at[6] = {0}, d3_at[6] = {0};
+    int off = 0, d3 = 0;
+    motion_step(mc.m, DT, &o);
+    ck_assert_uint_eq(o.outputs.dout, 1u << 1);
+    for (int k = 0; k < 100000 && o.state != MOTION_DONE; k++) {
+        motion_step(mc.m, DT, &o);
+        if (!off && !(o.outputs.dout & 2u)) {
+            off = 1;
+            memcpy(off_at, o.pose, sizeof off_at);
+            ck_assert_double_eq(o.outputs.aout[2], 3.5);
+        }
+        if (!d3 && (o.outputs.dout & 8u)) {
+            d3 = 1;
+            memcpy(d3_at, o.pose, sizeof d3_at);
+            ck_assert_double_eq(o.outputs.aout[0], -2);
+        }
+    }
+    ck_assert_int_eq(o.state, MOTION_DONE);
+    ck_assert(off && d3);
+    ck_assert_msg(dist2(off_at, P1) <= 20 * DT + 1e-9, "M63 %.4f mm from P1",
+                  dist2(off_at, P1));
+    ck_assert_msg(dist2(d3_at, P2) <= 20 * DT + 1e-9, "M64 %.4f mm from P2", dist2(d3_at, P2));
+    ck_assert_uint_eq(o.outputs.dout, 1u << 3);
+    canon_prog_free(&p);
+    canon_prog_init(&p);
+    memcpy(p.start, P0, sizeof P0);
+    add_out(&p, CANON_DIGITAL_OUT, 9, 4, 1, 0);   /* 4 outputs by default: 0..3 */
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_ERR_PROGRAM);
+    ck_assert_msg(strstr(err, "test.ngc:9: M62: digital output 4 does not exist: the machine "
+                         "has 4 ([EMCMOT] NUM_DIO)"), "%s", err);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *spindle_suite(void)
 {
     Suite *s = suite_create("motion_spindle");
@@ -315,6 +389,7 @@ static Suite *spindle_suite(void)
     tcase_add_test(tc, test_abort_while_waiting);
     tcase_add_test(tc, test_lone_spindle_start_waits);
     tcase_add_test(tc, test_tool_change_waits_for_the_changer);
+    tcase_add_test(tc, test_outputs_where_the_path_reaches_them);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -59,6 +59,9 @@ struct motion_comp {
     bool *sp_at_speed_own;                   /* the pin's own storage: another address
                                               * means `net` linked it (then programs wait) */
     bool *mist, *flood;                      /* out: iocontrol.0.coolant-mist, -flood */
+    int ndio, naio;                          /* [EMCMOT] NUM_DIO, NUM_AIO */
+    bool *dout[MOTION_MAX_DIO];              /* out: motion.digital-out-NN (M62..M65) */
+    double *aout[MOTION_MAX_AIO];            /* out: motion.analog-out-NN (M67, M68) */
     /* the tool changer's handshake, LinuxCNC's iocontrol pins */
     int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
     bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
@@ -236,6 +239,10 @@ static void motion_comp_update(void *arg, long period_ns)
     *c->fault = o.state == MOTION_FAULT;
     *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
     motion_comp_spindle(c, &o);
+    for (int i = 0; i < c->ndio; i++)
+        *c->dout[i] = (o.outputs.dout >> i) & 1u;
+    for (int i = 0; i < c->naio; i++)
+        *c->aout[i] = o.outputs.aout[i];
     motion_comp_toolchange(c, c->h, &o);
     pthread_mutex_unlock(&c->plan_lock);
 }
@@ -300,6 +307,10 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->sp_at_speed, "spindle.0.at-speed");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->mist, "iocontrol.0.coolant-mist");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->flood, "iocontrol.0.coolant-flood");
+    for (int i = 0; st == HAL_OK && i < c->ndio; i++)
+        st = hal_pin_bit_newf(h, HAL_OUT, &c->dout[i], "motion.digital-out-%02d", i);
+    for (int i = 0; st == HAL_OK && i < c->naio; i++)
+        st = hal_pin_float_newf(h, HAL_OUT, &c->aout[i], "motion.analog-out-%02d", i);
     if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");
@@ -346,6 +357,8 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
         return st;
     }
     c->nj = k->njoints;
+    c->ndio = cfg.num_dio;
+    c->naio = cfg.num_aio;
     if ((st = hal_set_object(h, "motion", c->m)) != HAL_OK)
         return hal_error(h, st, "loadrt motion: a motion component is loaded already");
     if ((st = motion_comp_joint_pins(h, c)) != HAL_OK || (st = motion_comp_state_pins(h, c)) != HAL_OK)

@@ -196,6 +196,17 @@ def plain_session(tmp):
     check("... and its changes: G90, M5, M9", "G90" in st["gcodes"] and "M5" in st["mcodes"]
           and "M9" in st["mcodes"] and st["spindle"]["direction"] == 0, (st["gcodes"],
                                                                          st["mcodes"]))
+    # outputs: M64 (immediate) and M67 (with motion) reach the pins; M62 P9 does not exist
+    c.ok("mdi.execute", line="M64 P1")
+    c.ok("mdi.execute", line="M67 E2 Q1.25")
+    c.wait()
+    d1 = c.ok("hal.get", name="motion.digital-out-01")["value"]
+    a2 = c.ok("hal.get", name="motion.analog-out-02")["value"]
+    check("M64 P1, M67 E2 Q1.25: motion.digital-out-01 on, analog-out-02 1.25",
+          d1 in ("TRUE", "1") and float(a2) == 1.25, (d1, a2))
+    r = c.call("mdi.execute", line="M62 P9")
+    check("M62 P9 on a machine with 4 outputs: refused, naming NUM_DIO", err_code(r) == -32003
+          and "NUM_DIO" in r["error"]["message"], r)
     # a manual tool change (no changer wired): M6 waits for the operator's tool.changed
     r = c.call("tool.changed")
     check("tool.changed with no change waiting: refused", err_code(r) == -32001, r)
@@ -416,13 +427,12 @@ def homing_session(tmp):
           < 0.01, st["machine_pose"]["actual"])
     # the spindle: MDI S1000 M3 waits until it is at speed (interp "waiting"), then M5
     t0 = c.status()["time"]
+    c.notes.clear()
+    c.ok("status.subscribe", rate_hz=100)  # every 10 ms of machine time, whatever the load
     c.ok("mdi.execute", line="S1000 M3")
-    seen = set()
-    for _ in range(100000):
-        st = c.status()
-        seen.add(st["interp"])
-        if st["interp"] == "idle":
-            break
+    st = c.wait()
+    c.ok("status.subscribe", rate_hz=0)
+    seen = set(n["params"]["interp"] for n in c.notes if n.get("method") == "status")
     check("S1000 M3 waits for the spindle (interp waiting), then ends", "waiting" in seen and
           st["interp"] == "idle", seen)
     check("... for as long as it takes to get to speed (0.49 s at 2000 rpm/s)",
