@@ -34,6 +34,9 @@ int motion_hal_abort(struct hal *h);
  * thread (the task waits for it before answering, so that what it reports has happened). */
 bool motion_hal_pending(const struct hal *h);
 
+/* Whether motion.enable was true in the last servo period (the drives may move). */
+bool motion_hal_enabled(const struct hal *h);
+
 /* Manual tool changes (the session): with iocontrol.0.tool-changed unconnected, programs
  * planned from now on stop at M6 until motion_hal_command(MOTION_CMD_TOOL_CHANGED). Whether
  * such a change waits for the operator now. */

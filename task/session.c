@@ -17,6 +17,8 @@
 
 /* Periods the e-stop chain gets to close after machine.power {on: true}. */
 #define SESSION_POWER_PERIODS 20
+/* Servo periods the drives have to report ready after the e-stop chain closed. */
+#define SESSION_ENABLE_PERIODS 2000
 
 /* Formats an RPC error into err and returns its code. */
 static int fail(int code, char *err, size_t len, const char *fmt, ...)
@@ -206,13 +208,25 @@ int session_power(struct session *s, bool on, char *err, size_t len)
         return 0;
     *s->r->user_enable_out = true;
     *s->r->user_request_enable = true;
-    for (int i = 0; i < SESSION_POWER_PERIODS && !*s->r->emc_enable_in; i++)
+    /* a drive that faulted clears its fault on the reset edge before the chain closes:
+     * CiA 402 drives take tens of periods for it */
+    for (int i = 0; i < SESSION_ENABLE_PERIODS && !*s->r->emc_enable_in; i++)
         session_wait_periods(s, 1);
     if (!*s->r->emc_enable_in) {
         *s->r->user_enable_out = false;
         return fail(RPC_FAILED, err, len, "machine on failed: the e-stop chain did not close "
                     "(task.emc-enable-in stayed false; check the e-stop wiring in the HAL "
                     "files)");
+    }
+    /* the drives may need longer than the e-stop chain to be ready (CiA 402 drives switch
+     * on through their state machine): motion.enable says when they are */
+    for (int i = 0; i < SESSION_ENABLE_PERIODS && !motion_hal_enabled(s->hal); i++)
+        session_wait_periods(s, 1);
+    if (!motion_hal_enabled(s->hal)) {
+        *s->r->user_enable_out = false;
+        return fail(RPC_FAILED, err, len, "machine on failed: motion.enable stayed false "
+                    "for %d servo periods after the e-stop chain closed (the drives did not "
+                    "report ready; see the messages)", SESSION_ENABLE_PERIODS);
     }
     session_wait_periods(s, 2);  /* motion has seen enable: the command is the legs' */
     s->state = SESS_ON;

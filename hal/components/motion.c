@@ -444,6 +444,12 @@ int motion_hal_start(struct hal *h)
     return MOTION_OK;
 }
 
+bool motion_hal_enabled(const struct hal *h)
+{
+    const struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    return c && c->was_enabled;
+}
+
 int motion_hal_set_manual_toolchange(struct hal *h, bool on)
 {
     struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;

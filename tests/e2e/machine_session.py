@@ -359,6 +359,54 @@ def hostile(sock, c):
     check("the session still answers after all that", c.status()["state"] == "on")
 
 
+def fault_session(tmp):
+    """The CAN machine (configs/can-sim): a drive faults in the middle of the paper's program;
+    the machine goes to e-stop, the program ends and the message names the drive; after a
+    reset the program runs again to its end."""
+    sock = os.path.join(tmp, "f.sock")
+    p = start(os.path.join(ROOT, "configs", "can-sim", "tmu-hexapod-can.ini"), sock)
+    c = Conn(sock)
+    c.ok("messages.subscribe")
+    c.ok("machine.estop", active=False)
+    c.ok("machine.power", on=True)
+    c.ok("machine.home")
+    c.wait()
+    prog = os.path.join(ROOT, "examples", "paper", "prog10_g141_d20.ngc")
+    c.ok("program.open", path=prog)
+    c.ok("program.run")
+    st = c.status()
+    while st["interp"] != "idle" and st["progress"] < 0.3:
+        st = c.status()
+    check("CAN machine: the program is under way", st["interp"] == "reading" and
+          st["line"] > 0, (st["interp"], st["line"]))
+    c.ok("hal.set", name="cia402-sim.2.inject-fault", value="1")
+    end = time.time() + 30
+    while time.time() < end and st["state"] != "estop":
+        st = c.status()
+    check("a drive fault mid-run: e-stop, the program ended, motion stopped",
+          st["state"] == "estop" and st["interp"] == "idle" and st["motion"] in ("fault", "idle"),
+          (st["state"], st["interp"], st["motion"]))
+    time.sleep(0.2)
+    c.status()
+    msgs = c.messages()
+    check("... and the messages name the drive and the line the program stopped at",
+          any("cia402.2" in m for m in msgs) and any("program stopped at line" in m
+                                                     for m in msgs), msgs)
+    c.ok("hal.set", name="cia402-sim.2.inject-fault", value="0")
+    # the config's recovery (configs/can-sim/tmu-hexapod-can.hal): reset the faulted drive,
+    # then the e-stop
+    c.ok("hal.set", name="drive-reset", value="1")
+    time.sleep(0.1)
+    c.ok("hal.set", name="drive-reset", value="0")
+    c.ok("machine.estop", active=False)
+    c.ok("machine.power", on=True)
+    c.ok("program.run")
+    st = c.wait(timeout=120)
+    check("after the reset the program runs to its end", st["motion"] == "done" and
+          st["state"] == "on", (st["motion"], st["state"], st["error"]))
+    check("fault session exits 0", stop(p, c) == 0)
+
+
 def homing_ini(tmp):
     """configs/sim with home switches on its legs, an offset the controller cannot see, and
     legs that are not at HOME when the machine starts."""
@@ -463,6 +511,7 @@ def main():
     try:
         plain_session(tmp)
         homing_session(tmp)
+        fault_session(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("machine session: %d failed" % len(FAILS))
