@@ -288,6 +288,55 @@ int session_jog(struct session *s, int frame, int axis, double vel, double dist,
     return push(s, &c, err, len);
 }
 
+/* Changes one tool's entry and saves the table (atomically, common/atomicfile); the MDI
+ * interpreter sees it at once, programs when they are next read. Refused while a program
+ * runs: its G10 L1 lines save the same file. */
+int session_tooltable_set(struct session *s, const struct session_tool_edit *e, char *err,
+                          size_t len)
+{
+    int rc;
+    if ((rc = need_idle(s, "tooltable.set", err, len)))
+        return rc;
+    if (!s->mdi_tt.path[0])
+        return fail(RPC_STATE, err, len, "tooltable.set: this machine has no tool table file "
+                    "([EMCIO] TOOL_TABLE)");
+    struct tooltable *tt = malloc(sizeof *tt);
+    if (!tt)
+        return fail(RPC_FAILED, err, len, "out of memory");
+    *tt = s->mdi_tt;
+    struct tool_entry ent, *old = tooltable_find(tt, e->tool);
+    if (old) {
+        ent = *old;
+    } else {
+        memset(&ent, 0, sizeof ent);
+        ent.tool = e->tool;
+        ent.pocket = e->tool;
+    }
+    if (e->pocket >= 0)
+        ent.pocket = e->pocket;
+    if (e->has_length) {
+        ent.z_offset_mm = e->length;
+        ent.present |= TOOLTABLE_F_Z;
+    }
+    if (e->has_diameter)
+        ent.diameter_mm = e->diameter;
+    if (e->comment)
+        snprintf(ent.comment, sizeof ent.comment, "%s", e->comment);
+    char msg[600];
+    int st = tooltable_set(tt, &ent);
+    if (st == TOOLTABLE_OK)
+        st = tooltable_save(tt, tt->path, msg, sizeof msg);
+    else
+        snprintf(msg, sizeof msg, "tool %d: %s", e->tool, tooltable_strerror(st));
+    if (st == TOOLTABLE_OK)
+        s->mdi_tt = *tt;  /* the interpreter holds a pointer to mdi_tt: same place */
+    free(tt);
+    if (st != TOOLTABLE_OK)
+        return fail(RPC_FAILED, err, len, "tooltable.set: %s", msg);
+    session_message(s, "info", "task", "tool %d changed in %s", e->tool, s->mdi_tt.path);
+    return 0;
+}
+
 /* The operator has put the tool M6 asked for in the spindle. */
 int session_tool_changed(struct session *s, char *err, size_t len)
 {

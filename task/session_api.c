@@ -362,6 +362,28 @@ static int m_tooltable_get(struct session *s, struct session_client *c, json_t *
     return 0;
 }
 
+static int m_tooltable_set(struct session *s, struct session_client *c, json_t *p,
+                           json_t **r, char *err, size_t len)
+{
+    struct session_tool_edit e = { 0 };
+    long tool, pocket;
+    bool hp, hc = json_object_get(p, "comment") != NULL;
+    int rc;
+    if ((rc = get_int(p, "tool", true, 1, TOOLTABLE_WEAR_BASE - 1, &tool, NULL, err, len)) ||
+        (rc = get_int(p, "pocket", false, 0, 99999, &pocket, &hp, err, len)) ||
+        (rc = get_num(p, "length", false, &e.length, &e.has_length, err, len)) ||
+        (rc = get_num(p, "diameter", false, &e.diameter, &e.has_diameter, err, len)) ||
+        (hc && (rc = get_str(p, "comment", &e.comment, err, len))))
+        return rc;
+    if (e.has_diameter && e.diameter < 0)
+        return perr(err, len, "diameter", "must not be negative");
+    if (e.comment && strpbrk(e.comment, "\r\n"))
+        return perr(err, len, "comment", "one line of text");
+    e.tool = (int)tool;
+    e.pocket = hp ? (int)pocket : -1;
+    return session_tooltable_set(s, &e, err, len);
+}
+
 static int m_hal_show(struct session *s, struct session_client *c, json_t *p, json_t **r,
                       char *err, size_t len)
 {
@@ -456,6 +478,7 @@ static const struct method methods[] = {
     { "switch.set", true, m_switch },
     { "tool.changed", true, m_tool_changed },
     { "tooltable.get", false, m_tooltable_get },
+    { "tooltable.set", true, m_tooltable_set },
     { "hal.show", false, m_hal_show },
     { "hal.get", false, m_hal_get },
     { "hal.set", true, m_hal_set },

@@ -82,6 +82,16 @@ int session_jog(struct session *s, int frame, int axis, double vel, double dist,
                 size_t len);
 int session_jog_stop(struct session *s, char *err, size_t len);
 int session_tool_changed(struct session *s, char *err, size_t len);
+/* tooltable.set: what to change in one tool's entry. */
+struct session_tool_edit {
+    int tool;
+    int pocket;                  /* -1: keep (a new tool: its number) */
+    bool has_length, has_diameter;
+    double length, diameter;     /* mm */
+    const char *comment;         /* NULL: keep */
+};
+int session_tooltable_set(struct session *s, const struct session_tool_edit *e, char *err,
+                          size_t len);
 int session_mdi(struct session *s, const char *line, char *err, size_t len);
 int session_open(struct session *s, const char *path, char *err, size_t len);
 int session_check(struct session *s, json_t **result, char *err, size_t len);
