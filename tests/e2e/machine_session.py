@@ -417,6 +417,9 @@ def homing_ini(tmp):
     for name in ("tmu-hexapod.hal", "tmu-hexapod-task.hal", "tmu-hexapod-demo.ngc"):
         text = text.replace("= " + name, "= " + os.path.join(SIM, name))
     shutil.copy(os.path.join(SIM, "tmu-hexapod.tbl"), tmp)  # tooltable.set writes it
+    text = text.replace("TOOL_TABLE = tmu-hexapod.tbl",
+                        "TOOL_TABLE = tmu-hexapod.tbl\nPARAMETER_FILE = hexcnc.var")
+    open(os.path.join(tmp, "hexcnc.var"), "w").write("5221\t0.000000\n")
     text = text.replace("HALFILE = " + os.path.join(SIM, "tmu-hexapod.hal"),
                         "HALFILE = " + os.path.join(SIM, "tmu-hexapod.hal") +
                         "\nHALFILE = homing.hal")
@@ -518,6 +521,31 @@ def homing_session(tmp):
     check("... and MDI uses it at once (G43 H2: tool length 12.5)",
           st["tool"]["length"] == 12.5, st["tool"])
     c.ok("mdi.execute", line="G49")
+    # G10 settings are saved only for the lines the machine executed: check writes nothing,
+    # a run stopped between two G10 lines keeps the first only
+    var = os.path.join(tmp, "hexcnc.var")
+    g10 = os.path.join(tmp, "g10.ngc")
+    open(g10, "w").write("G0 X0 Y0 Z645\nG10 L2 P1 X0.5\nG1 X40 F600\nG1 X0\n"
+                         "G10 L2 P1 X0.75\nM2\n")
+    before = open(var).read()
+    c.ok("program.open", path=g10)
+    c.ok("program.check")
+    check("program.check of a G10 program leaves the parameter file as it was",
+          open(var).read() == before)
+    c.ok("program.run")
+    st = c.status()
+    while st["interp"] != "idle" and not (st["line"] == 3 and st["progress"] > 0.2):
+        st = c.status()
+    c.ok("program.abort")
+    c.wait()
+    saved = [l.split() for l in open(var) if l.startswith("5221")]
+    check("stopped at line 3: line 2's G10 saved (#5221 0.5), line 5's not",
+          saved and float(saved[0][1]) == 0.5, saved)
+    st = c.status()
+    check("... and MDI and status use the new G54 X offset",
+          abs(st["machine_pose"]["commanded"][0] - st["pose"]["commanded"][0] - 0.5) < 1e-9,
+          (st["machine_pose"]["commanded"][0], st["pose"]["commanded"][0]))
+    c.ok("mdi.execute", line="G10 L2 P1 X0")
     c.ok("program.open", path=os.path.join(SIM, "tmu-hexapod-demo.ngc"))
     c.ok("program.run")
     st = c.wait()
