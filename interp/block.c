@@ -78,12 +78,12 @@ int interp_add_m(struct interp *in, double v, int column)
     case 3: case 4: case 5: grp = 7; break;
     case 7: case 8: case 9: grp = 8; break;
     case 62: case 63: case 64: case 65: case 67: case 68: grp = 5; break;
+    case 70: case 71: case 72: case 73: grp = 9; break;
     case 66:
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "M66 (wait for an input) is not "
                            "supported yet: its result #5399 would have to reach the lines "
                            "after it while the program runs");
-    case 48: case 49: case 50: case 51: case 52: case 53: case 60: case 70: case 71:
-    case 72: case 73:
+    case 48: case 49: case 50: case 51: case 52: case 53: case 60:
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "M%d is not supported yet", c);
     default:
         return interp_fail(in, INTERP_ERR_WORD, column, "M%d is not an M code this interpreter "

@@ -40,6 +40,94 @@ static int emit_simple(struct interp *in, enum canon_type t, double value, int i
     return interp_emit(in, &c);
 }
 
+void interp_modal_save(const struct interp *in, struct modal_save *m)
+{
+    m->valid = 1;
+    m->inch = in->inch, m->plane = in->plane, m->incremental = in->incremental;
+    m->arc_absolute = in->arc_absolute, m->inverse_time = in->inverse_time;
+    m->coord_system = in->coord_system, m->retract_old_z = in->retract_old_z;
+    m->path_mode = in->path_mode, m->path_tol_mm = in->path_tol_mm;
+    m->naive_cam_tol_mm = in->naive_cam_tol_mm;
+    m->feed_mm_min = in->feed_mm_min, m->f_word = in->f_word;
+    m->spindle_rpm = in->spindle_rpm, m->spindle_dir = in->spindle_dir;
+    m->mist = in->mist, m->flood = in->flood;
+    memcpy(m->tool, in->tool, sizeof m->tool);
+}
+
+/* Puts a saved state back; what the machine must know of (feed, feed mode, path mode,
+ * spindle, coolant, offsets) is sent on as it is when programmed. */
+int interp_modal_restore(struct interp *in, const struct modal_save *m)
+{
+    in->inch = m->inch, in->plane = m->plane, in->incremental = m->incremental;
+    in->arc_absolute = m->arc_absolute, in->retract_old_z = m->retract_old_z;
+    in->f_word = m->f_word;
+    if (in->inverse_time != m->inverse_time) {
+        in->inverse_time = m->inverse_time;
+        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+    }
+    if (in->feed_mm_min != m->feed_mm_min) {
+        in->feed_mm_min = m->feed_mm_min;
+        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+    }
+    if (in->path_mode != m->path_mode || in->path_tol_mm != m->path_tol_mm) {
+        in->path_mode = m->path_mode, in->path_tol_mm = m->path_tol_mm;
+        CHP(emit_simple(in, CANON_PATH_MODE, in->path_mode == 640 ? in->path_tol_mm : 0.0,
+                        in->path_mode));
+    }
+    in->naive_cam_tol_mm = m->naive_cam_tol_mm;
+    if (in->spindle_rpm != m->spindle_rpm) {
+        in->spindle_rpm = m->spindle_rpm;
+        CHP(emit_simple(in, CANON_SPINDLE_SPEED, in->spindle_rpm, 0));
+    }
+    if (in->spindle_dir != m->spindle_dir) {
+        in->spindle_dir = m->spindle_dir;
+        CHP(emit_simple(in, in->spindle_dir ? CANON_SPINDLE_ON : CANON_SPINDLE_STOP,
+                        in->spindle_dir, 0));
+    }
+    if (in->mist != m->mist || in->flood != m->flood) {
+        in->mist = m->mist, in->flood = m->flood;
+        CHP(emit_simple(in, CANON_COOLANT, 0, 9));
+        if (in->mist)
+            CHP(emit_simple(in, CANON_COOLANT, 0, 7));
+        if (in->flood)
+            CHP(emit_simple(in, CANON_COOLANT, 0, 8));
+    }
+    bool offsets = memcmp(in->tool, m->tool, sizeof m->tool) != 0;
+    memcpy(in->tool, m->tool, sizeof in->tool);
+    if (in->coord_system != m->coord_system) {
+        interp_select_coord(in, m->coord_system);
+        offsets = true;
+    }
+    return offsets ? interp_emit_offsets(in) : 0;
+}
+
+/* M70 save, M71 forget, M72 restore the modal state; M73 save it for the return of the
+ * subroutine it is in (docs/gcode.md). */
+static int exec_modal_state(struct interp *in, const struct interp_block *b)
+{
+    struct oword *ow = &in->ow;
+    switch (b->m[9]) {
+    case 70:
+        interp_modal_save(in, &in->m70);
+        return 0;
+    case 71:
+        in->m70.valid = 0;
+        if (ow->ncalls > 0)
+            ow->calls[ow->ncalls - 1].m73.valid = 0;
+        return 0;
+    case 72:
+        if (!in->m70.valid)
+            return interp_fail(in, INTERP_ERR_MODAL, b->mcol[9], "M72: no modal state to "
+                               "restore (M70 saves it; M71 forgot it)");
+        return interp_modal_restore(in, &in->m70);
+    default:
+        /* outside a subroutine there is no return to restore at: nothing, as in LinuxCNC */
+        if (ow->ncalls > 0)
+            interp_modal_save(in, &ow->calls[ow->ncalls - 1].m73);
+        return 0;
+    }
+}
+
 /* M62..M65 P: a digital output; M67/M68 E Q: an analog output (docs/gcode.md). */
 static int exec_io(struct interp *in, const struct interp_block *b)
 {
@@ -182,6 +270,8 @@ static int exec_machine_words(struct interp *in)
         in->spindle_dir = 0;
         CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
     }
+    if (b->m[9] >= 0)  /* M70..M73 after the spindle, before coolant (LinuxCNC's order) */
+        CHP(exec_modal_state(in, b));
     if (b->m[8] >= 0) {
         in->mist = b->m[8] == 7 || (b->m[8] == 8 && in->mist);
         in->flood = b->m[8] == 8 || (b->m[8] == 7 && in->flood);

@@ -88,6 +88,18 @@ struct ow_sub {                  /* a subroutine: where its `sub` line is */
     char label[OWORD_LABEL_MAX];
     int text, idx;
 };
+/* The modal state M70/M73 save and M72 restores (LinuxCNC's list, as far as this machine
+ * has it): units, plane, distance modes, feed mode, work offset system, tool length offset,
+ * retract mode, path mode, F, S, spindle direction, coolant. */
+struct modal_save {
+    int valid;
+    int inch, plane, incremental, arc_absolute, inverse_time, coord_system, retract_old_z;
+    int path_mode;
+    double path_tol_mm, naive_cam_tol_mm, feed_mm_min, f_word, spindle_rpm;
+    int spindle_dir, mist, flood;
+    double tool[6];
+};
+
 struct ow_call {                 /* a call in progress */
     char label[OWORD_LABEL_MAX];
     int text, idx;               /* where to go on when it returns */
@@ -95,6 +107,7 @@ struct ow_call {                 /* a call in progress */
     double args[30];             /* the caller's #1..#30 */
     struct named_entry *locals;  /* the caller's local named parameters */
     size_t nlocals;
+    struct modal_save m73;       /* M73 in this call: the state its return restores */
 };
 struct oword {
     struct ow_text *texts;       /* [0] is the program */
@@ -171,11 +184,16 @@ struct interp {
     double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
 
     struct oword ow;             /* O-word control flow */
+    struct modal_save m70;       /* the state M70 saved, for M72 */
     struct comp5 comp;           /* G141/G142 run in progress */
     struct interp_block blk;     /* the block being worked on */
     char norm[INTERP_LINE_MAX];  /* the line lowercased without spaces and comments */
     int normcol[INTERP_LINE_MAX];/* original column of each norm char */
 };
+
+/* exec.c: M70..M73 state: fills a save; restores one (emitting what changed). */
+void interp_modal_save(const struct interp *in, struct modal_save *m);
+int interp_modal_restore(struct interp *in, const struct modal_save *m);
 
 /* Records the first error (printf-style message) and returns status. */
 int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)

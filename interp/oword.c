@@ -380,6 +380,7 @@ static int do_call(struct interp *in, const char *label, int pos)
     c->text = ow->text;
     c->idx = ow->idx;
     c->nctl = ow->nctl;
+    c->m73.valid = 0;
     memcpy(c->args, &in->params[1], sizeof c->args);
     if (interp_named_push_locals(in, &c->locals, &c->nlocals))
         return interp_fail(in, INTERP_ERR_NOMEM, 1, "out of memory");
@@ -409,7 +410,12 @@ static int do_return(struct interp *in, const char *label, const char *kw, int p
     if (!strcmp(kw, "endsub") && strcmp(ow->calls[ow->ncalls - 1].label, label))
         return interp_fail(in, INTERP_ERR_SYNTAX, 1, "o%s endsub inside a call of o%s", label,
                            ow->calls[ow->ncalls - 1].label);
-    struct ow_call *c = &ow->calls[--ow->ncalls];
+    struct ow_call *c = &ow->calls[ow->ncalls - 1];
+    if (c->m73.valid) {  /* M73 in this call: the caller's state comes back */
+        c->m73.valid = 0;
+        CHP(interp_modal_restore(in, &c->m73));
+    }
+    ow->ncalls--;
     memcpy(&in->params[1], c->args, sizeof c->args);
     int rc = interp_named_pop_locals(in, c->locals, c->nlocals);
     c->locals = NULL;

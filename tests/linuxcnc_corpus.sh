@@ -9,8 +9,8 @@
 # where rs274 or the programs are not installed.
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
-MIN_ACCEPTED=150     # of the programs rs274 accepts (measured: 150 of 169)
-MIN_IDENTICAL=148    # of those, motion identical to rs274's (measured: 148)
+MIN_ACCEPTED=153     # of the programs rs274 accepts (measured: 153 of 169)
+MIN_IDENTICAL=151    # of those, motion identical to rs274's (measured: 151)
 if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ]; then
     echo "SKIP linuxcnc_corpus: rs274 or LinuxCNC's programs are not installed (linuxcnc-uspace)"
     exit 0
