@@ -79,13 +79,11 @@ static double next_rate(const struct motion *m, double target, double vp, double
  * the spindle's drive to see it, one for its report to come back. */
 #define MOTION_AT_SPEED_LAG 2
 
-/* The spindle commands that lie before the present segment (those the wait is for). */
-static size_t wait_ios(const struct motion *m)
+/* Whether every spindle or tool command before the present segment has been applied (the
+ * commands are in path order: the next one not applied lies further on). */
+static bool ios_reached(const struct motion *m)
 {
-    size_t n = 0;
-    while (n < m->plan.nios && m->plan.ios[n].at <= m->cs)
-        n++;
-    return n;
+    return m->ios_done == m->plan.nios || m->plan.ios[m->ios_done].at > m->cs;
 }
 
 /* At the start of a wait for the spindle: hold there until it is at speed. */
@@ -99,7 +97,7 @@ static int wait_here(struct motion *m)
      * periods: an at-speed that was true for the old speed says nothing of the new */
     bool done = sg->wait_tool ? m->tool_done_seq == m->tool.seq
                               : m->at_speed && m->io_age >= MOTION_AT_SPEED_LAG;
-    if (done && m->ios_done >= wait_ios(m)) {
+    if (done && ios_reached(m)) {
         m->waited_at_seg = m->cs + 1;
         return 0;
     }

@@ -199,6 +199,16 @@ static void accept_clients(struct session *s)
     }
 }
 
+/* A line longer than SESSION_MAX_LINE: answered with an error, then the client is dropped. */
+static void refuse_long_line(struct session *s, struct session_client *c)
+{
+    json_t *e = json_pack("{s:s, s:n, s:{s:i, s:s}}", "jsonrpc", "2.0", "id", "error", "code",
+                          RPC_INVALID, "message", "request longer than 1 MiB: connection closed");
+    session_server_send(s, c, e);
+    json_decref(e);
+    c->closing = true;
+}
+
 /* Reads what the client sent and answers each whole line (at most SESSION_MAX_REQUESTS). */
 static void read_client(struct session *s, struct session_client *c)
 {
@@ -249,12 +259,7 @@ static void read_client(struct session *s, struct session_client *c)
            (nl = memchr(c->in + start, '\n', c->inlen - start))) {
         size_t len = (size_t)(nl - (c->in + start));
         if (len > SESSION_MAX_LINE) {
-            json_t *e = json_pack("{s:s, s:n, s:{s:i, s:s}}", "jsonrpc", "2.0", "id", "error",
-                                  "code", RPC_INVALID, "message",
-                                  "request longer than 1 MiB: connection closed");
-            session_server_send(s, c, e);
-            json_decref(e);
-            c->closing = true;
+            refuse_long_line(s, c);
             break;
         }
         if (len > 0) {
@@ -268,12 +273,7 @@ static void read_client(struct session *s, struct session_client *c)
         answered++;
     }
     if (!c->closing && c->inlen - start > SESSION_MAX_LINE) {
-        json_t *e = json_pack("{s:s, s:n, s:{s:i, s:s}}", "jsonrpc", "2.0", "id", "error",
-                              "code", RPC_INVALID, "message",
-                              "request longer than 1 MiB: connection closed");
-        session_server_send(s, c, e);
-        json_decref(e);
-        c->closing = true;
+        refuse_long_line(s, c);
     }
     memmove(c->in, c->in + start, c->inlen - start);
     c->inlen -= start;
