@@ -1,4 +1,7 @@
-/* session.c: the machine session's state machine and commands (LinuxCNC's task, for hexcnc). */
+/* session.c: the machine session's core (LinuxCNC's task, for hexcnc): the state checks and
+ * the hand-over to the servo thread the commands share, the end of a run, the tick, and the
+ * session's life (create, the loop, destroy). The commands are in session_machine.c and
+ * session_prog.c. */
 #include "task/session_priv.h"
 
 #include <errno.h>
@@ -15,22 +18,6 @@
 #include "interp/interp.h"
 #include "motion/motion_hal.h"
 
-/* Periods the e-stop chain gets to close after machine.power {on: true}. */
-#define SESSION_POWER_PERIODS 20
-/* Servo periods the drives have to report ready after the e-stop chain closed. */
-#define SESSION_ENABLE_PERIODS 2000
-
-/* Formats an RPC error into err and returns its code. */
-static int fail(int code, char *err, size_t len, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static int fail(int code, char *err, size_t len, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, len, fmt, ap);
-    va_end(ap);
-    return code;
-}
 
 static void sleep_ms(double ms)
 {
@@ -39,7 +26,7 @@ static void sleep_ms(double ms)
 }
 
 /* Runs the machine for n servo periods (simulated clock) or waits as long (real time). */
-static void session_wait_periods(struct session *s, int n)
+void session_wait_periods(struct session *s, int n)
 {
     if (s->sim)
         hal_sim_advance(s->hal, (long)n * s->period_ns);
@@ -47,54 +34,54 @@ static void session_wait_periods(struct session *s, int n)
         sleep_ms((double)n * (double)s->period_ns * 1e-6);
 }
 
-static enum motion_state mstate(const struct session *s)
+enum motion_state session_mstate(const struct session *s)
 {
     return motion_get_state(s->m);
 }
 
 /* Nothing moves: no program, no jog, no homing. */
-static bool at_rest(const struct session *s)
+bool session_at_rest(const struct session *s)
 {
-    enum motion_state st = mstate(s);
+    enum motion_state st = session_mstate(s);
     return !s->running && (st == MOTION_IDLE || st == MOTION_DONE || st == MOTION_FAULT);
 }
 
 bool session_busy(const struct session *s)
 {
-    enum motion_state st = mstate(s);
+    enum motion_state st = session_mstate(s);
     return s->running || st == MOTION_MANUAL || motion_homing(s->m);
 }
 
 /* Whether programs and MDI may run: every leg homed, or [TRAJ] NO_FORCE_HOMING. */
-static int need_homed(struct session *s, const char *what, char *err, size_t len)
+int session_need_homed(struct session *s, const char *what, char *err, size_t len)
 {
     if (!motion_pose_known(s->m))
-        return fail(RPC_STATE, err, len, "%s refused: the legs' lengths give no pose of the "
+        return errbuf_set(err, len, RPC_STATE, "%s refused: the legs' lengths give no pose of the "
                     "platform (the forward kinematics has no answer): jog the legs (frame "
                     "joint) into the workspace, or home them", what);
     if (s->no_force_homing || motion_all_homed(s->m))
         return 0;
-    return fail(RPC_STATE, err, len, "%s refused: the machine is not homed (machine.home "
+    return errbuf_set(err, len, RPC_STATE, "%s refused: the machine is not homed (machine.home "
                 "first, or [TRAJ] NO_FORCE_HOMING = 1)", what);
 }
 
-static int need_on(struct session *s, const char *what, char *err, size_t len)
+int session_need_on(struct session *s, const char *what, char *err, size_t len)
 {
     if (s->state == SESS_ON)
         return 0;
-    return fail(RPC_STATE, err, len, "%s refused: the machine is %s (%s)", what,
+    return errbuf_set(err, len, RPC_STATE, "%s refused: the machine is %s (%s)", what,
                 s->state == SESS_ESTOP ? "in e-stop" : "off",
                 s->state == SESS_ESTOP ? "machine.estop {active: false}, then machine.power "
                 "{on: true}" : "machine.power {on: true} first");
 }
 
-static int need_idle(struct session *s, const char *what, char *err, size_t len)
+int session_need_idle(struct session *s, const char *what, char *err, size_t len)
 {
     if (s->running)
-        return fail(RPC_STATE, err, len, "%s refused: %s is running (program.abort first)",
+        return errbuf_set(err, len, RPC_STATE, "%s refused: %s is running (program.abort first)",
                     what, s->run_is_mdi ? "an MDI line" : "a program");
-    if (!at_rest(s))
-        return fail(RPC_STATE, err, len, "%s refused: the machine is %s (jog.stop first)",
+    if (!session_at_rest(s))
+        return errbuf_set(err, len, RPC_STATE, "%s refused: the machine is %s (jog.stop first)",
                     what, motion_homing(s->m) ? "homing" : "moving");
     return 0;
 }
@@ -121,7 +108,7 @@ void session_message(struct session *s, const char *sev, const char *source,
 
 /* Waits until the servo thread has taken what the task queued (a start, an abort, a manual
  * command), so that the answer and any status read after it show its effect. */
-static void session_settle(struct session *s)
+void session_settle(struct session *s)
 {
     if (s->sim) {
         for (int i = 0; i < SESSION_POWER_PERIODS && motion_hal_pending(s->hal); i++)
@@ -136,10 +123,10 @@ static void session_settle(struct session *s)
 }
 
 /* Queues a manual command for the servo thread. */
-static int push(struct session *s, const struct motion_hal_cmd *c, char *err, size_t len)
+int session_push(struct session *s, const struct motion_hal_cmd *c, char *err, size_t len)
 {
     if (motion_hal_command(s->hal, c) != MOTION_OK)
-        return fail(RPC_FAILED, err, len, "the motion command queue is full; try again");
+        return errbuf_set(err, len, RPC_FAILED, "the motion command queue is full; try again");
     session_settle(s);
     return 0;
 }
@@ -147,7 +134,7 @@ static int push(struct session *s, const struct motion_hal_cmd *c, char *err, si
 static void mdi_renew(struct session *s);
 
 /* The machine went off under a program or MDI line: the run ends where the legs stopped. */
-static void run_cut(struct session *s, const char *why)
+void session_run_cut(struct session *s, const char *why)
 {
     if (!s->running)
         return;
@@ -159,425 +146,6 @@ static void run_cut(struct session *s, const char *why)
                     "MDI line" : "program", line, why);
     if (!s->run_is_mdi)
         mdi_renew(s);
-}
-
-/* Waits until the e-stop chain is open and motion has stopped: the answer to an e-stop or
- * a switch-off goes out once the machine is off, never before. */
-static void wait_off(struct session *s)
-{
-    for (int i = 0; i < SESSION_POWER_PERIODS; i++) {
-        enum motion_state st = mstate(s);
-        bool moving = st == MOTION_RUNNING || st == MOTION_PAUSING || st == MOTION_STOPPING ||
-                      st == MOTION_MANUAL;
-        if (!*s->r->emc_enable_in && !moving)
-            return;
-        session_wait_periods(s, 1);
-    }
-}
-
-int session_estop(struct session *s, bool active, char *err, size_t len)
-{
-    if (active) {
-        *s->r->user_enable_out = false;
-        wait_off(s);
-        run_cut(s, "e-stop");
-        if (s->state != SESS_ESTOP)
-            session_message(s, "warning", "task", "e-stop: the machine stopped at once");
-        s->state = SESS_ESTOP;
-        return 0;
-    }
-    if (s->state == SESS_ESTOP)
-        s->state = SESS_OFF;
-    return 0;
-}
-
-int session_power(struct session *s, bool on, char *err, size_t len)
-{
-    if (!on) {
-        *s->r->user_enable_out = false;
-        wait_off(s);
-        run_cut(s, "the machine was switched off");
-        if (s->state == SESS_ON)
-            s->state = SESS_OFF;
-        return 0;
-    }
-    if (s->state == SESS_ESTOP)
-        return fail(RPC_STATE, err, len, "machine on refused: the machine is in e-stop "
-                    "(machine.estop {active: false} first)");
-    if (s->state == SESS_ON)
-        return 0;
-    *s->r->user_enable_out = true;
-    *s->r->user_request_enable = true;
-    /* a drive that faulted clears its fault on the reset edge before the chain closes:
-     * CiA 402 drives take tens of periods for it */
-    for (int i = 0; i < SESSION_ENABLE_PERIODS && !*s->r->emc_enable_in; i++)
-        session_wait_periods(s, 1);
-    if (!*s->r->emc_enable_in) {
-        *s->r->user_enable_out = false;
-        return fail(RPC_FAILED, err, len, "machine on failed: the e-stop chain did not close "
-                    "(task.emc-enable-in stayed false; check the e-stop wiring in the HAL "
-                    "files)");
-    }
-    /* the drives may need longer than the e-stop chain to be ready (CiA 402 drives switch
-     * on through their state machine): motion.enable says when they are */
-    for (int i = 0; i < SESSION_ENABLE_PERIODS && !motion_hal_enabled(s->hal); i++)
-        session_wait_periods(s, 1);
-    if (!motion_hal_enabled(s->hal)) {
-        *s->r->user_enable_out = false;
-        return fail(RPC_FAILED, err, len, "machine on failed: motion.enable stayed false "
-                    "for %d servo periods after the e-stop chain closed (the drives did not "
-                    "report ready; see the messages)", SESSION_ENABLE_PERIODS);
-    }
-    session_wait_periods(s, 2);  /* motion has seen enable: the command is the legs' */
-    s->state = SESS_ON;
-    session_message(s, "info", "task", "machine on");
-    return 0;
-}
-
-int session_set_mode(struct session *s, enum session_mode mode, char *err, size_t len)
-{
-    if (mode == s->mode)
-        return 0;
-    if (s->running || !at_rest(s))
-        return fail(RPC_STATE, err, len, "mode change refused: the machine is %s",
-                    s->running ? "running a program" : "moving");
-    s->mode = mode;
-    return 0;
-}
-
-int session_home(struct session *s, int joint, char *err, size_t len)
-{
-    int rc;
-    if ((rc = need_on(s, "homing", err, len)) || (rc = need_idle(s, "homing", err, len)))
-        return rc;
-    s->mode = SESS_MANUAL;
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_HOME, .axis = joint };
-    return push(s, &c, err, len);
-}
-
-int session_unhome(struct session *s, int joint, char *err, size_t len)
-{
-    int rc;
-    if ((rc = need_idle(s, "unhoming", err, len)))
-        return rc;
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_UNHOME, .axis = joint };
-    if (s->state != SESS_ON) {  /* the queue only runs while on: the legs are at rest */
-        motion_unhome(s->m, joint);
-        return 0;
-    }
-    return push(s, &c, err, len);
-}
-
-int session_jog(struct session *s, int frame, int axis, double vel, double dist, char *err,
-                size_t len)
-{
-    int rc;
-    if ((rc = need_on(s, "jog", err, len)))
-        return rc;
-    if (s->running)
-        return fail(RPC_STATE, err, len, "jog refused: %s is running",
-                    s->run_is_mdi ? "an MDI line" : "a program");
-    if (motion_homing(s->m))
-        return fail(RPC_STATE, err, len, "jog refused: the machine is homing");
-    if (frame != MOTION_JOG_JOINT && !motion_all_homed(s->m))
-        return fail(RPC_STATE, err, len, "%s jog refused: the machine is not homed (home it, "
-                    "or jog a leg: frame joint)", frame == MOTION_JOG_TOOL ? "tool" : "world");
-    s->mode = SESS_MANUAL;
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG, .frame = frame, .axis = axis,
-                                .vel = vel, .dist = dist };
-    return push(s, &c, err, len);
-}
-
-/* Changes one tool's entry and saves the table (atomically, common/atomicfile); the MDI
- * interpreter sees it at once, programs when they are next read. Refused while a program
- * runs: its G10 L1 lines save the same file. */
-int session_tooltable_set(struct session *s, const struct session_tool_edit *e, char *err,
-                          size_t len)
-{
-    int rc;
-    if ((rc = need_idle(s, "tooltable.set", err, len)))
-        return rc;
-    if (!s->mdi_tt.path[0])
-        return fail(RPC_STATE, err, len, "tooltable.set: this machine has no tool table file "
-                    "([EMCIO] TOOL_TABLE)");
-    struct tooltable *tt = malloc(sizeof *tt);
-    if (!tt)
-        return fail(RPC_FAILED, err, len, "out of memory");
-    *tt = s->mdi_tt;
-    struct tool_entry ent, *old = tooltable_find(tt, e->tool);
-    if (old) {
-        ent = *old;
-    } else {
-        memset(&ent, 0, sizeof ent);
-        ent.tool = e->tool;
-        ent.pocket = e->tool;
-    }
-    if (e->pocket >= 0)
-        ent.pocket = e->pocket;
-    if (e->has_length) {
-        ent.z_offset_mm = e->length;
-        ent.present |= TOOLTABLE_F_Z;
-    }
-    if (e->has_diameter)
-        ent.diameter_mm = e->diameter;
-    if (e->comment)
-        snprintf(ent.comment, sizeof ent.comment, "%s", e->comment);
-    char msg[600];
-    int st = tooltable_set(tt, &ent);
-    if (st == TOOLTABLE_OK)
-        st = tooltable_save(tt, tt->path, msg, sizeof msg);
-    else
-        snprintf(msg, sizeof msg, "tool %d: %s", e->tool, tooltable_strerror(st));
-    if (st == TOOLTABLE_OK)
-        s->mdi_tt = *tt;  /* the interpreter holds a pointer to mdi_tt: same place */
-    free(tt);
-    if (st != TOOLTABLE_OK)
-        return fail(RPC_FAILED, err, len, "tooltable.set: %s", msg);
-    session_message(s, "info", "task", "tool %d changed in %s", e->tool, s->mdi_tt.path);
-    return 0;
-}
-
-/* The operator has put the tool M6 asked for in the spindle. */
-int session_tool_changed(struct session *s, char *err, size_t len)
-{
-    if (!motion_hal_manual_toolchange_waiting(s->hal))
-        return fail(RPC_STATE, err, len, "tool.changed: no manual tool change is waiting");
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_TOOL_CHANGED };
-    return push(s, &c, err, len);
-}
-
-int session_jog_stop(struct session *s, char *err, size_t len)
-{
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG_STOP };
-    if (s->state != SESS_ON)
-        return 0;
-    return push(s, &c, err, len);
-}
-
-/* Starts what runner_load_* loaded. */
-static int start_loaded(struct session *s, bool mdi, char *err, size_t len)
-{
-    char msg[600];
-    if (runner_start(s->r, msg, sizeof msg) != RUNNER_OK)
-        return fail(RPC_FAILED, err, len, "%s", msg);
-    s->running = true;
-    s->run_is_mdi = mdi;
-    s->stopping = false;
-    session_settle(s);
-    return 0;
-}
-
-int session_mdi(struct session *s, const char *line, char *err, size_t len)
-{
-    int rc;
-    if ((rc = need_on(s, "MDI", err, len)) || (rc = need_idle(s, "MDI", err, len)) ||
-        (rc = need_homed(s, "MDI", err, len)))
-        return rc;
-    if (strchr(line, '\n'))
-        return fail(RPC_PARAMS, err, len, "line: one line of G-code, without a newline");
-    struct canon_prog prog;
-    canon_prog_init(&prog);
-    double pose[KINS_POSE_DIM];
-    motion_hal_pose(s->hal, pose);
-    interp_set_start(s->mdi, pose);
-    memcpy(prog.start, pose, sizeof pose);
-    if (interp_run_text(s->mdi, "MDI", line, strlen(line), canon_prog_sink, &prog) !=
-        INTERP_OK) {
-        char msg[600];
-        interp_error_format(interp_last_error(s->mdi), msg, sizeof msg);
-        canon_prog_free(&prog);
-        return fail(RPC_PROGRAM, err, len, "%s", msg);
-    }
-    struct interp_view v;
-    interp_get_view(s->mdi, &v);
-    if (v.comp5_active) {
-        canon_prog_free(&prog);
-        /* the interpreter keeps the open run: drop it with a fresh interpreter state */
-        return fail(RPC_PROGRAM, err, len, "MDI:1: a G141/G142 run cannot span MDI lines: "
-                    "give the whole run, to its G140, in one line (or run it from a "
-                    "program)");
-    }
-    s->mode = SESS_MDI;
-    char msg[600];
-    int st = runner_load_canon(s->r, &prog, msg, sizeof msg);
-    canon_prog_free(&prog);
-    if (st != RUNNER_OK)
-        return fail(RPC_PROGRAM, err, len, "%s", msg);
-    if ((rc = start_loaded(s, true, err, len)))
-        return rc;
-    struct motion_plan_info pi;
-    runner_plan_info(s->r, &pi);
-    if (pi.segments == 0) {
-        /* nothing moves (G90, G10, M-codes without motion): done when the answer goes out,
-         * so that the next line is not refused */
-        for (int i = 0; i < SESSION_POWER_PERIODS && s->running; i++) {
-            session_wait_periods(s, 1);
-            session_tick(s);
-        }
-    }
-    return 0;
-}
-
-/* A program path from the API: relative ones from [DISPLAY] PROGRAM_PREFIX or the INI's
- * folder. */
-static void resolve_program(struct session *s, const char *path, char *out, size_t len)
-{
-    const char *prefix = hal_ini_get(s->hal, "DISPLAY", "PROGRAM_PREFIX");
-    const char *dir = hal_ini_dir(s->hal);
-    if (path[0] == '/')
-        snprintf(out, len, "%s", path);
-    else if (prefix && prefix[0] == '/')
-        snprintf(out, len, "%s/%s", prefix, path);
-    else if (prefix && prefix[0])
-        snprintf(out, len, "%s/%s/%s", dir ? dir : ".", prefix, path);
-    else
-        snprintf(out, len, "%s/%s", dir && dir[0] ? dir : ".", path);
-}
-
-int session_open(struct session *s, const char *path, char *err, size_t len)
-{
-    if (s->running)
-        return fail(RPC_STATE, err, len, "program.open refused: a program is running");
-    char full[1024];
-    resolve_program(s, path, full, sizeof full);
-    struct stat st;
-    if (stat(full, &st) != 0)
-        return fail(RPC_NOT_FOUND, err, len, "%s: %s", full, strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        return fail(RPC_NOT_FOUND, err, len, "%s: not a regular file", full);
-    FILE *f = fopen(full, "r");
-    if (!f)
-        return fail(RPC_NOT_FOUND, err, len, "%s: %s", full, strerror(errno));
-    long lines = 0;
-    int ch, last = '\n';
-    while ((ch = getc(f)) != EOF) {
-        if (ch == '\n')
-            lines++;
-        last = ch;
-    }
-    if (last != '\n')
-        lines++;
-    fclose(f);
-    snprintf(s->program, sizeof s->program, "%s", full);
-    s->program_lines = lines;
-    return 0;
-}
-
-int session_check(struct session *s, json_t **result, char *err, size_t len)
-{
-    int rc;
-    if (!s->program[0])
-        return fail(RPC_STATE, err, len, "program.check: no program is open (program.open)");
-    if ((rc = need_idle(s, "program.check", err, len)))
-        return rc;
-    char msg[800];
-    int st = runner_load_program(s->r, s->program, msg, sizeof msg);
-    if (st != RUNNER_OK) {
-        *result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line", 0, "text",
-                            msg);
-        return 0;
-    }
-    struct motion_plan_info pi;
-    runner_plan_info(s->r, &pi);
-    *result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
-                        pi.time_s, "length_mm", pi.length_mm, "segments",
-                        (json_int_t)pi.segments);
-    return 0;
-}
-
-int session_run_program(struct session *s, int from_line, char *err, size_t len)
-{
-    int rc;
-    if (!s->program[0])
-        return fail(RPC_STATE, err, len, "program.run refused: no program is open "
-                    "(program.open)");
-    if ((rc = need_on(s, "program.run", err, len)) ||
-        (rc = need_idle(s, "program.run", err, len)) ||
-        (rc = need_homed(s, "program.run", err, len)))
-        return rc;
-    s->mode = SESS_AUTO;
-    char msg[800];
-    /* checked again from where the machine is now, whatever an earlier check said */
-    if (runner_load_program_from(s->r, s->program, from_line > 1 ? from_line : 1, msg,
-                                 sizeof msg) != RUNNER_OK)
-        return fail(RPC_PROGRAM, err, len, "%s", msg);
-    if ((rc = start_loaded(s, false, err, len)))
-        return rc;
-    struct motion_plan_info pi;
-    runner_plan_info(s->r, &pi);
-    session_message(s, "info", "task", "program started%s: %s (%.3f s, %.3f mm planned)",
-                    from_line > 1 ? " from a line" : "", s->program, pi.time_s, pi.length_mm);
-    return 0;
-}
-
-int session_pause(struct session *s, char *err, size_t len)
-{
-    if (!s->running)
-        return fail(RPC_STATE, err, len, "program.pause: nothing is running");
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_PAUSE };
-    return push(s, &c, err, len);
-}
-
-int session_resume(struct session *s, char *err, size_t len)
-{
-    if (!s->running)
-        return fail(RPC_STATE, err, len, "program.resume: nothing is running");
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_RESUME };
-    return push(s, &c, err, len);
-}
-
-int session_step(struct session *s, char *err, size_t len)
-{
-    int rc;
-    if (!s->running && (rc = session_run_program(s, 1, err, len)))
-        return rc;
-    struct motion_hal_cmd c = { .kind = MOTION_CMD_STEP };
-    return push(s, &c, err, len);
-}
-
-int session_abort(struct session *s, char *err, size_t len)
-{
-    if (!s->running) {
-        struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG_STOP };
-        return s->state == SESS_ON ? push(s, &c, err, len) : 0;
-    }
-    s->stopping = true;
-    runner_abort(s->r);
-    session_settle(s);  /* the tick must not take "at rest" before motion saw the abort */
-    return 0;
-}
-
-int session_overrides(struct session *s, const double *feed, const double *rapid,
-                      const double *spindle, char *err, size_t len)
-{
-    if ((feed && !(*feed >= 0 && *feed <= 2)) || (rapid && !(*rapid >= 0 && *rapid <= 1)) ||
-        (spindle && !(*spindle >= 0 && *spindle <= 2)))
-        return fail(RPC_PARAMS, err, len, "override out of range: feed 0..2, rapid 0..1, "
-                    "spindle 0..2");
-    if (feed) {
-        s->feed_ovr = *feed;
-        if (s->feed_ovr_pin)
-            *s->feed_ovr_pin = *feed;
-    }
-    if (rapid) {
-        s->rapid_ovr = *rapid;
-        struct motion_hal_cmd c = { .kind = MOTION_CMD_RAPID, .vel = *rapid };
-        if (s->state == SESS_ON) {
-            int rc = push(s, &c, err, len);
-            if (rc)
-                return rc;
-        } else {
-            motion_set_rapid_override(s->m, *rapid);
-        }
-    }
-    if (spindle) {
-        s->spindle_ovr = *spindle;
-        if (s->spindle_ovr_pin)
-            *s->spindle_ovr_pin = *spindle;
-        if (s->state == SESS_ON)
-            session_wait_periods(s, 1);  /* in effect when the answer goes out */
-    }
-    return 0;
 }
 
 /* Components' messages (drive faults, warnings) to the subscribers. */
@@ -651,10 +219,10 @@ static void run_outcome(struct session *s, enum motion_state st)
 void session_tick(struct session *s)
 {
     drain_hal_messages(s);
-    enum motion_state st = mstate(s);
+    enum motion_state st = session_mstate(s);
     if (s->state == SESS_ON && !*s->r->emc_enable_in) {
         s->state = SESS_ESTOP;
-        run_cut(s, "the e-stop chain opened");
+        session_run_cut(s, "the e-stop chain opened");
         session_message(s, "error", "task", "the e-stop chain opened: the machine is in "
                         "e-stop%s%s", s->r->first_fault[0] ? "; cause: " : "",
                         s->r->first_fault);
@@ -694,10 +262,10 @@ static int default_socket(struct session *s, char *out, size_t len, char *err, s
         char dir[64];
         snprintf(dir, sizeof dir, "/tmp/hexcnc-%u", (unsigned)getuid());
         if (mkdir(dir, 0700) != 0 && errno != EEXIST)
-            return fail(1, err, errlen, "%s: %s", dir, strerror(errno));
+            return errbuf_set(err, errlen, 1, "%s: %s", dir, strerror(errno));
         struct stat st;
         if (lstat(dir, &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid())
-            return fail(1, err, errlen, "%s: not a folder of this user; set [API] SOCKET "
+            return errbuf_set(err, errlen, 1, "%s: not a folder of this user; set [API] SOCKET "
                         "or XDG_RUNTIME_DIR", dir);
         snprintf(out, len, "%s/hexcnc.sock", dir);
     }
@@ -710,7 +278,7 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     *out = NULL;
     struct session *s = calloc(1, sizeof *s);
     if (!s)
-        return fail(1, err, errlen, "out of memory");
+        return errbuf_set(err, errlen, 1, "out of memory");
     s->lfd = -1;
     s->quiet = opts->quiet;
     s->feed_ovr = s->rapid_ovr = s->spindle_ovr = 1;
@@ -728,7 +296,7 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     s->period_ns = s->r->period_ns;
     long nfh = 0;
     if (hal_ini_int(s->hal, "TRAJ", "NO_FORCE_HOMING", 0, &nfh) == HAL_ERR_SYNTAX) {
-        fail(1, err, errlen, "%s", hal_last_error(s->hal));
+        errbuf_set(err, errlen, 1, "%s", hal_last_error(s->hal));
         goto fail;
     }
     s->no_force_homing = nfh != 0;
@@ -757,13 +325,13 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     s->state = SESS_ESTOP;
     *s->r->user_enable_out = false;
     if (hal_start(s->hal) != HAL_OK) {  /* on the simulated clock: ready to advance */
-        fail(1, err, errlen, "%s", hal_last_error(s->hal));
+        errbuf_set(err, errlen, 1, "%s", hal_last_error(s->hal));
         goto fail;
     }
     /* motion takes the legs' feedback as its command once the drives have run a few periods
      * (MOTION_FEEDBACK_SETTLE): the machine must not be switched on before */
     session_wait_periods(s, 8);
-    s->last_mstate = mstate(s);
+    s->last_mstate = session_mstate(s);
     motion_manual_note(s->m, &s->note_seq);
     *out = s;
     return 0;

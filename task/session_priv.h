@@ -21,6 +21,11 @@ enum {
 };
 
 #define SESSION_MAX_CLIENTS 32
+/* Periods the e-stop chain gets to close after machine.power {on: true}, and the servo
+ * thread to take what the task queued. */
+#define SESSION_POWER_PERIODS 20
+/* Servo periods the drives have to report ready after the e-stop chain closed. */
+#define SESSION_ENABLE_PERIODS 2000
 
 struct session_client {
     int fd;
@@ -128,5 +133,20 @@ void session_server_send(struct session *s, struct session_client *c, json_t *ms
 /* Sends to every client subscribed to messages / due for a status. */
 void session_server_broadcast_message(struct session *s, json_t *msg);
 void session_server_status(struct session *s);
+
+/* The state checks and the hand-over to the servo thread the commands share (session.c).
+ * session_need_*: 0, or the refusal (RPC_STATE) in err naming `what` and what to do. */
+struct motion_hal_cmd;
+void session_wait_periods(struct session *s, int n);
+enum motion_state session_mstate(const struct session *s);
+bool session_at_rest(const struct session *s);
+int session_need_homed(struct session *s, const char *what, char *err, size_t len);
+int session_need_on(struct session *s, const char *what, char *err, size_t len);
+int session_need_idle(struct session *s, const char *what, char *err, size_t len);
+/* Waits until the servo thread has taken what was queued (a start, an abort, a command). */
+void session_settle(struct session *s);
+int session_push(struct session *s, const struct motion_hal_cmd *c, char *err, size_t len);
+/* The machine went off under a program or MDI line: the run ends, saying why. */
+void session_run_cut(struct session *s, const char *why);
 
 #endif

@@ -1,0 +1,207 @@
+/* session_prog.c: the session's MDI and program commands: MDI lines, open, check, run (from
+ * a line), pause, resume, step, abort. */
+#include "task/session_priv.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "common/errbuf.h"
+#include "interp/interp.h"
+#include "motion/motion_hal.h"
+
+/* Starts what runner_load_* loaded. */
+static int start_loaded(struct session *s, bool mdi, char *err, size_t len)
+{
+    char msg[600];
+    if (runner_start(s->r, msg, sizeof msg) != RUNNER_OK)
+        return errbuf_set(err, len, RPC_FAILED, "%s", msg);
+    s->running = true;
+    s->run_is_mdi = mdi;
+    s->stopping = false;
+    session_settle(s);
+    return 0;
+}
+
+int session_mdi(struct session *s, const char *line, char *err, size_t len)
+{
+    int rc;
+    if ((rc = session_need_on(s, "MDI", err, len)) || (rc = session_need_idle(s, "MDI", err, len)) ||
+        (rc = session_need_homed(s, "MDI", err, len)))
+        return rc;
+    if (strchr(line, '\n'))
+        return errbuf_set(err, len, RPC_PARAMS, "line: one line of G-code, without a newline");
+    struct canon_prog prog;
+    canon_prog_init(&prog);
+    double pose[KINS_POSE_DIM];
+    motion_hal_pose(s->hal, pose);
+    interp_set_start(s->mdi, pose);
+    memcpy(prog.start, pose, sizeof pose);
+    if (interp_run_text(s->mdi, "MDI", line, strlen(line), canon_prog_sink, &prog) !=
+        INTERP_OK) {
+        char msg[600];
+        interp_error_format(interp_last_error(s->mdi), msg, sizeof msg);
+        canon_prog_free(&prog);
+        return errbuf_set(err, len, RPC_PROGRAM, "%s", msg);
+    }
+    struct interp_view v;
+    interp_get_view(s->mdi, &v);
+    if (v.comp5_active) {
+        canon_prog_free(&prog);
+        /* the interpreter keeps the open run: drop it with a fresh interpreter state */
+        return errbuf_set(err, len, RPC_PROGRAM, "MDI:1: a G141/G142 run cannot span MDI lines: "
+                    "give the whole run, to its G140, in one line (or run it from a "
+                    "program)");
+    }
+    s->mode = SESS_MDI;
+    char msg[600];
+    int st = runner_load_canon(s->r, &prog, msg, sizeof msg);
+    canon_prog_free(&prog);
+    if (st != RUNNER_OK)
+        return errbuf_set(err, len, RPC_PROGRAM, "%s", msg);
+    if ((rc = start_loaded(s, true, err, len)))
+        return rc;
+    struct motion_plan_info pi;
+    runner_plan_info(s->r, &pi);
+    if (pi.segments == 0) {
+        /* nothing moves (G90, G10, M-codes without motion): done when the answer goes out,
+         * so that the next line is not refused */
+        for (int i = 0; i < SESSION_POWER_PERIODS && s->running; i++) {
+            session_wait_periods(s, 1);
+            session_tick(s);
+        }
+    }
+    return 0;
+}
+
+/* A program path from the API: relative ones from [DISPLAY] PROGRAM_PREFIX or the INI's
+ * folder. */
+static void resolve_program(struct session *s, const char *path, char *out, size_t len)
+{
+    const char *prefix = hal_ini_get(s->hal, "DISPLAY", "PROGRAM_PREFIX");
+    const char *dir = hal_ini_dir(s->hal);
+    if (path[0] == '/')
+        snprintf(out, len, "%s", path);
+    else if (prefix && prefix[0] == '/')
+        snprintf(out, len, "%s/%s", prefix, path);
+    else if (prefix && prefix[0])
+        snprintf(out, len, "%s/%s/%s", dir ? dir : ".", prefix, path);
+    else
+        snprintf(out, len, "%s/%s", dir && dir[0] ? dir : ".", path);
+}
+
+int session_open(struct session *s, const char *path, char *err, size_t len)
+{
+    if (s->running)
+        return errbuf_set(err, len, RPC_STATE, "program.open refused: a program is running");
+    char full[1024];
+    resolve_program(s, path, full, sizeof full);
+    struct stat st;
+    if (stat(full, &st) != 0)
+        return errbuf_set(err, len, RPC_NOT_FOUND, "%s: %s", full, strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return errbuf_set(err, len, RPC_NOT_FOUND, "%s: not a regular file", full);
+    FILE *f = fopen(full, "r");
+    if (!f)
+        return errbuf_set(err, len, RPC_NOT_FOUND, "%s: %s", full, strerror(errno));
+    long lines = 0;
+    int ch, last = '\n';
+    while ((ch = getc(f)) != EOF) {
+        if (ch == '\n')
+            lines++;
+        last = ch;
+    }
+    if (last != '\n')
+        lines++;
+    fclose(f);
+    snprintf(s->program, sizeof s->program, "%s", full);
+    s->program_lines = lines;
+    return 0;
+}
+
+int session_check(struct session *s, json_t **result, char *err, size_t len)
+{
+    int rc;
+    if (!s->program[0])
+        return errbuf_set(err, len, RPC_STATE, "program.check: no program is open (program.open)");
+    if ((rc = session_need_idle(s, "program.check", err, len)))
+        return rc;
+    char msg[800];
+    int st = runner_load_program(s->r, s->program, msg, sizeof msg);
+    if (st != RUNNER_OK) {
+        *result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line", 0, "text",
+                            msg);
+        return 0;
+    }
+    struct motion_plan_info pi;
+    runner_plan_info(s->r, &pi);
+    *result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
+                        pi.time_s, "length_mm", pi.length_mm, "segments",
+                        (json_int_t)pi.segments);
+    return 0;
+}
+
+int session_run_program(struct session *s, int from_line, char *err, size_t len)
+{
+    int rc;
+    if (!s->program[0])
+        return errbuf_set(err, len, RPC_STATE, "program.run refused: no program is open "
+                    "(program.open)");
+    if ((rc = session_need_on(s, "program.run", err, len)) ||
+        (rc = session_need_idle(s, "program.run", err, len)) ||
+        (rc = session_need_homed(s, "program.run", err, len)))
+        return rc;
+    s->mode = SESS_AUTO;
+    char msg[800];
+    /* checked again from where the machine is now, whatever an earlier check said */
+    if (runner_load_program_from(s->r, s->program, from_line > 1 ? from_line : 1, msg,
+                                 sizeof msg) != RUNNER_OK)
+        return errbuf_set(err, len, RPC_PROGRAM, "%s", msg);
+    if ((rc = start_loaded(s, false, err, len)))
+        return rc;
+    struct motion_plan_info pi;
+    runner_plan_info(s->r, &pi);
+    session_message(s, "info", "task", "program started%s: %s (%.3f s, %.3f mm planned)",
+                    from_line > 1 ? " from a line" : "", s->program, pi.time_s, pi.length_mm);
+    return 0;
+}
+
+int session_pause(struct session *s, char *err, size_t len)
+{
+    if (!s->running)
+        return errbuf_set(err, len, RPC_STATE, "program.pause: nothing is running");
+    struct motion_hal_cmd c = { .kind = MOTION_CMD_PAUSE };
+    return session_push(s, &c, err, len);
+}
+
+int session_resume(struct session *s, char *err, size_t len)
+{
+    if (!s->running)
+        return errbuf_set(err, len, RPC_STATE, "program.resume: nothing is running");
+    struct motion_hal_cmd c = { .kind = MOTION_CMD_RESUME };
+    return session_push(s, &c, err, len);
+}
+
+int session_step(struct session *s, char *err, size_t len)
+{
+    int rc;
+    if (!s->running && (rc = session_run_program(s, 1, err, len)))
+        return rc;
+    struct motion_hal_cmd c = { .kind = MOTION_CMD_STEP };
+    return session_push(s, &c, err, len);
+}
+
+int session_abort(struct session *s, char *err, size_t len)
+{
+    if (!s->running) {
+        struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG_STOP };
+        return s->state == SESS_ON ? session_push(s, &c, err, len) : 0;
+    }
+    s->stopping = true;
+    runner_abort(s->r);
+    session_settle(s);  /* the tick must not take "at rest" before motion saw the abort */
+    return 0;
+}
