@@ -146,6 +146,25 @@ static void wait_rest(struct conn *c)
     }
 }
 
+/* One call that sets the platform moving: seconds until its answer, and until status shows
+ * the commanded X changed. */
+static void call_until_moving(struct conn *c, const char *method, const char *params,
+                              double *answer_s, double *moving_s)
+{
+    json_t *st = call(c, "status.get", NULL);
+    double x0 = pose_x(st), x = x0;
+    json_decref(st);
+    double t0 = now_s();
+    json_decref(call(c, method, params));
+    *answer_s = now_s() - t0;
+    while (fabs(x - x0) <= 1e-9) {
+        st = call(c, "status.get", NULL);
+        x = pose_x(st);
+        json_decref(st);
+    }
+    *moving_s = now_s() - t0;
+}
+
 /* ---- the baseline: an echo server answering each line with a line of a given size */
 struct echo {
     int lfd;
@@ -251,23 +270,10 @@ int main(void)
     /* jog: answer (the servo thread took it) and first motion in status */
     static double jt_ans[JOG_TRIALS], jt_move[JOG_TRIALS];
     for (int k = 0; k < JOG_TRIALS; k++) {
-        json_t *s0 = call(&c, "status.get", NULL);
-        double x0 = pose_x(s0);
-        json_decref(s0);
         char p[128];
         snprintf(p, sizeof p, "{\"frame\":\"world\",\"axis\":\"X\",\"velocity\":%d,"
                  "\"distance\":0.5}", k % 2 ? -10 : 10);
-        double t0 = now_s();
-        json_decref(call(&c, "jog.move", p));
-        jt_ans[k] = now_s() - t0;
-        for (;;) {
-            json_t *s1 = call(&c, "status.get", NULL);
-            double x1 = pose_x(s1);
-            json_decref(s1);
-            if (fabs(x1 - x0) > 1e-9)
-                break;
-        }
-        jt_move[k] = now_s() - t0;
+        call_until_moving(&c, "jog.move", p, &jt_ans[k], &jt_move[k]);
         wait_rest(&c);
     }
     double am, ap, mm, mp;
@@ -281,20 +287,7 @@ int main(void)
     json_decref(call(&c, "program.open", "{\"path\":\"tmu-hexapod-demo.ngc\"}"));
     static double pr_ans[RUN_TRIALS], pr_move[RUN_TRIALS];
     for (int k = 0; k < RUN_TRIALS; k++) {
-        json_t *s0 = call(&c, "status.get", NULL);
-        double x0 = pose_x(s0);
-        json_decref(s0);
-        double t0 = now_s();
-        json_decref(call(&c, "program.run", NULL));
-        pr_ans[k] = now_s() - t0;
-        for (;;) {
-            json_t *s1 = call(&c, "status.get", NULL);
-            double x1 = pose_x(s1);
-            json_decref(s1);
-            if (fabs(x1 - x0) > 1e-9)
-                break;
-        }
-        pr_move[k] = now_s() - t0;
+        call_until_moving(&c, "program.run", NULL, &pr_ans[k], &pr_move[k]);
         json_decref(call(&c, "program.abort", NULL));
         wait_rest(&c);
         json_decref(call(&c, "mdi.execute", "{\"line\":\"G0 X0 Y0 Z645 A0 B0 C0\"}"));
