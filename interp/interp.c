@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 
 #include "interp/interp_int.h"
@@ -328,7 +329,8 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     return run_lines(in, text, len);
 }
 
-/* Reads the whole file into memory, then runs it as text. */
+/* Maps the file (read-only; the reader gives back the pages it has passed, oword.c) and
+ * runs it as text; a file that cannot be mapped (a pipe) is read into memory. */
 int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, void *ctx)
 {
     memset(&in->err, 0, sizeof in->err);
@@ -343,10 +345,22 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
     FILE *f = fopen(path, "rb");
     if (!f)
         return interp_fail(in, INTERP_ERR_IO, 0, "cannot open the program: %s", strerror(errno));
-    size_t cap = 1 << 16, len = 0;
     struct stat st;
-    if (fstat(fileno(f), &st) == 0 && st.st_size > 0)
-        cap = (size_t)st.st_size + 1; /* one read, no regrowth, for regular files */
+    if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+        size_t len = (size_t)st.st_size;
+        void *map = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fileno(f), 0);
+        fclose(f);
+        if (map == MAP_FAILED)
+            return interp_fail(in, INTERP_ERR_IO, 0, "cannot read the program: %s",
+                               strerror(errno));
+        madvise(map, len, MADV_SEQUENTIAL);
+        in->text_mapped = 1;
+        int rc = interp_run_text(in, path, map, len, sink, ctx);
+        in->text_mapped = 0;
+        munmap(map, len);
+        return rc;
+    }
+    size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap);
     int rc = 0;
     while (buf) {

@@ -69,12 +69,21 @@ struct named_table {
 #define OWORD_LABEL_MAX 72       /* "123" or "<name>" as normalised, with the brackets */
 #define OWORD_MAX_CALLS 64       /* subroutine nesting (recursion included) */
 #define OWORD_LOOP_LIMIT 10000000L /* loop iterations in one program: more is a runaway */
+/* Lines are found through a sparse index (the start of every OW_STRIDE-th line) and a
+ * cursor (the line read last), so the index of a 10-million-line program takes 1.3 MB and
+ * reading on from the cursor costs nothing. */
+#define OW_STRIDE 64
 struct ow_text {
     char *owned;                 /* the text, when read from a subroutine file, else NULL */
     const char *text;
     size_t len;
-    size_t *off;                 /* where each line starts */
+    size_t *off;                 /* off[k]: where line k * OW_STRIDE starts */
     int nlines;
+    int cur_idx;                 /* a line whose start is cur_off (the next to read) */
+    size_t cur_off;
+    int mapped;                  /* text is a read-only mapping of the file: pages behind
+                                  * the reading point are given back (oword_next_line) */
+    size_t released;             /* bytes from the start given back so far */
     char file[256];              /* for messages */
 };
 struct ow_ctl {                  /* an open if, while, do or repeat */
@@ -131,6 +140,7 @@ struct interp {
     char *param_path;            /* parameter file or NULL */
     struct tooltable *tt;        /* tool table or NULL (not owned) */
     int mdi;                     /* lines typed one at a time: no program end needed */
+    int text_mapped;             /* the program text is a file mapping (interp_run_file) */
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */

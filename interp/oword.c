@@ -8,6 +8,9 @@
  * same O number or name, so skipping a false branch is a scan for the next line with that
  * label and one of the keywords that can follow. */
 #include <ctype.h>
+#include <limits.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,21 +48,28 @@ static int text_add(struct oword *ow, char *owned, const char *text, size_t len,
     size_t n = 1;
     for (const char *p = text; (p = memchr(p, '\n', (size_t)(text + len - p))); p++)
         n++;
-    size_t *off = malloc(n * sizeof *off);
+    if (n > 1 && len > 0 && text[len - 1] == '\n')
+        n--;  /* a final newline does not start another line */
+    if (n > (size_t)INT_MAX - 1)
+        return -1;
+    size_t *off = malloc((n / OW_STRIDE + 1) * sizeof *off);
     if (!off)
         return -1;
     size_t k = 0;
-    off[k++] = 0;
+    off[0] = 0;
     for (const char *p = text; (p = memchr(p, '\n', (size_t)(text + len - p))); p++)
-        off[k++] = (size_t)(p + 1 - text);
-    if (off[k - 1] == len && k > 1)
-        k--;  /* a final newline does not start another line */
+        if (++k % OW_STRIDE == 0 && k < n)
+            off[k / OW_STRIDE] = (size_t)(p + 1 - text);
     struct ow_text *t = &ow->texts[ow->ntexts];
     t->owned = owned;
     t->text = text;
     t->len = len;
     t->off = off;
-    t->nlines = (int)k;
+    t->nlines = (int)n;
+    t->cur_idx = 0;
+    t->cur_off = 0;
+    t->mapped = 0;
+    t->released = 0;
     snprintf(t->file, sizeof t->file, "%s", file);
     return ow->ntexts++;
 }
@@ -81,14 +91,55 @@ int oword_begin(struct interp *in, const char *text, size_t len)
         ow->loop_limit = OWORD_LOOP_LIMIT;
     if (text_add(ow, NULL, text, len, in->file) < 0)
         return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory reading the program");
+    ow->texts[0].mapped = in->text_mapped;
     return 0;
+}
+
+/* Where line i of t starts and ends (b: past its newline, or the text's end), from the
+ * cursor when reading on, else from the sparse index; the cursor moves to line i + 1. */
+static void line_span(struct ow_text *t, int i, size_t *a, size_t *b)
+{
+    int k = i;
+    size_t p;
+    if (t->cur_idx <= i && i - t->cur_idx < OW_STRIDE) {
+        k = t->cur_idx;
+        p = t->cur_off;
+    } else {
+        k = i / OW_STRIDE * OW_STRIDE;
+        p = t->off[i / OW_STRIDE];
+    }
+    for (; k < i; k++) {
+        const char *e = memchr(t->text + p, '\n', t->len - p);
+        p = e ? (size_t)(e + 1 - t->text) : t->len;
+    }
+    *a = p;
+    const char *e = memchr(t->text + p, '\n', t->len - p);
+    *b = e ? (size_t)(e + 1 - t->text) : t->len;
+    t->cur_idx = i + 1;
+    t->cur_off = *b;
+}
+
+/* Gives back to the system the pages of a mapped program more than 4 MB behind the line
+ * being read, 16 MB at a time, so that reading a long file keeps little of it resident (a
+ * jump back reads them again from the file). */
+static void release_behind(struct ow_text *t, size_t at)
+{
+    const size_t keep = (size_t)4 << 20, step = (size_t)16 << 20;
+    if (!t->mapped || at < t->released + keep + step)
+        return;
+    size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    size_t upto = (at - keep) / page * page;
+    if (upto > t->released) {
+        madvise((char *)t->text + t->released, upto - t->released, MADV_DONTNEED);
+        t->released = upto;
+    }
 }
 
 /* The next line to read (without its newline); 0 at the end of the program. */
 int oword_next_line(struct interp *in, const char **line, size_t *len)
 {
     struct oword *ow = &in->ow;
-    const struct ow_text *t = &ow->texts[ow->text];
+    struct ow_text *t = &ow->texts[ow->text];
     if (ow->idx >= t->nlines) {
         if (ow->ncalls > 0) {
             in->line = t->nlines;
@@ -99,7 +150,9 @@ int oword_next_line(struct interp *in, const char **line, size_t *len)
         }
         return 0;
     }
-    size_t a = t->off[ow->idx], b = ow->idx + 1 < t->nlines ? t->off[ow->idx + 1] : t->len;
+    size_t a, b;
+    line_span(t, ow->idx, &a, &b);
+    release_behind(t, a);
     if (b > a && t->text[b - 1] == '\n')
         b--;
     *line = t->text + a;
@@ -164,17 +217,22 @@ static int kw_in(const char *kw, const char *set)
 
 /* The index of the next line after line idx of text labelled `label` whose keyword is in
  * set (kw gets the keyword), or -1. */
-static int find_line(const struct oword *ow, int text, int idx, const char *label,
+static int find_line(struct oword *ow, int text, int idx, const char *label,
                      const char *set, char *kw)
 {
-    const struct ow_text *t = &ow->texts[text];
+    struct ow_text *t = &ow->texts[text];
     char l[OWORD_LABEL_MAX];
-    for (int i = idx + 1; i < t->nlines; i++) {
-        size_t a = t->off[i], b = i + 1 < t->nlines ? t->off[i + 1] : t->len;
+    int cur_idx = t->cur_idx;   /* the reader's place: a scan ahead must not move it */
+    size_t cur_off = t->cur_off, a, b;
+    int found = -1;
+    for (int i = idx + 1; i < t->nlines && found < 0; i++) {
+        line_span(t, i, &a, &b);
         if (peek(t->text + a, b - a, l, kw) && !strcmp(l, label) && kw_in(kw, set))
-            return i;
+            found = i;
     }
-    return -1;
+    t->cur_idx = cur_idx;
+    t->cur_off = cur_off;
+    return found;
 }
 
 /* find_line, failing with a message that names what is missing. */
