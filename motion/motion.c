@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -62,6 +63,8 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     memcpy(m->joint_fb, m->joint_cmd, sizeof m->joint_fb);
     memcpy(m->motor_fb, m->joint_cmd, sizeof m->motor_fb);
     m->pose_known = 1;
+    m->run = &m->plan;
+    m->pb_at[0] = m->pb_at[1] = SIZE_MAX;
     *out = m;
     return MOTION_OK;
 }
@@ -72,6 +75,7 @@ void motion_destroy(struct motion *m)
     if (!m)
         return;
     motion_plan_free(&m->plan);
+    motion_plan_free(&m->names);
     free(m);
 }
 
@@ -93,8 +97,10 @@ static void rewind_plan(struct motion *m)
     memset(m->pose_vel, 0, sizeof m->pose_vel);
     memset(m->joint_vel, 0, sizeof m->joint_vel);
     memset(m->ferror, 0, sizeof m->ferror);
-    m->line = m->plan.nseg ? m->plan.segs[0].line : 0;
-    m->file = m->plan.nseg ? m->plan.segs[0].file : NULL;
+    m->marks_base = 0;
+    m->tail_taken = 0;
+    m->line = m->run && m->run->nseg ? m->run->segs[0].line : 0;
+    m->file = m->run && m->run->nseg ? m->run->segs[0].file : NULL;
 }
 
 /* Plans a program (see motion.h). */
@@ -108,6 +114,9 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
         return fail(m, MOTION_ERR_STATE, err, errlen);
     }
     motion_plan_free(&m->plan);
+    m->run = &m->plan;
+    m->streaming = 0;
+    m->chunk = NULL;
     m->loaded = 0;
     m->msg[0] = 0;
     m->state = MOTION_IDLE;
@@ -162,7 +171,7 @@ int motion_start(struct motion *m)
         return MOTION_ERR_STATE;
     rewind_plan(m);
     m->rate = m->override_cmd;
-    m->state = m->plan.nseg ? MOTION_RUNNING : MOTION_DONE;
+    m->state = m->streaming || m->plan.nseg ? MOTION_RUNNING : MOTION_DONE;
     return MOTION_OK;
 }
 
@@ -173,7 +182,7 @@ int motion_plan_info(const struct motion *m, struct motion_plan_info *out)
         return MOTION_ERR_ARG;
     if (!m->loaded)
         return MOTION_ERR_STATE;
-    *out = m->plan.info;
+    *out = m->streaming ? m->stream_info : m->plan.info;
     return MOTION_OK;
 }
 
@@ -335,4 +344,55 @@ enum motion_state motion_get_state(const struct motion *m)
 const char *motion_last_error(const struct motion *m)
 {
     return m ? m->msg : "no motion instance";
+}
+
+/* Follows a stream's chunks from now on (motion_stream.c). */
+int motion_stream_attach(struct motion *m, struct motion_stream *s,
+                         const struct motion_plan_info *totals)
+{
+    if (!m || !s)
+        return MOTION_ERR_ARG;
+    if (m->state != MOTION_IDLE && m->state != MOTION_DONE && m->state != MOTION_FAULT) {
+        motion_set_msg(m, "cannot load a program while %s", motion_state_name(m->state));
+        return MOTION_ERR_STATE;
+    }
+    motion_plan_free(&m->plan);
+    m->run = NULL;
+    m->chunk = NULL;
+    atomic_store(&m->stream_head, NULL);
+    atomic_store(&m->stream_need, 0);
+    m->streaming = 1;
+    m->msg[0] = 0;
+    m->state = MOTION_IDLE;
+    m->fault_status = MOTION_OK;
+    memset(&m->stream_info, 0, sizeof m->stream_info);
+    if (totals)
+        m->stream_info = *totals;
+    motion_stream_bind(s, m);
+    memcpy(m->start_pose, motion_stream_start(s), sizeof m->start_pose);
+    memcpy(m->pose, m->start_pose, sizeof m->pose);
+    kins_inverse(m->kins, m->pose, m->joint_cmd);
+    m->loaded = 1;
+    rewind_plan(m);
+    return MOTION_OK;
+}
+
+void motion_stream_detach(struct motion *m)
+{
+    if (!m || !m->streaming)
+        return;
+    m->streaming = 0;
+    m->chunk = NULL;
+    atomic_store(&m->stream_head, NULL);
+    atomic_store(&m->stream_need, 0);
+    m->run = &m->plan;
+    m->loaded = 0;
+    if (m->state == MOTION_RUNNING || m->state == MOTION_PAUSING ||
+        m->state == MOTION_PAUSED || m->state == MOTION_STOPPING)
+        m->state = MOTION_IDLE;
+}
+
+bool motion_stream_starving(const struct motion *m)
+{
+    return m && atomic_load_explicit(&((struct motion *)m)->stream_need, memory_order_relaxed);
 }

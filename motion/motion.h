@@ -38,6 +38,8 @@ enum motion_status {
     MOTION_ERR_FERROR,       /* following error beyond its limit: fault */
     MOTION_ERR_ESTOP,        /* emergency stop: fault */
     MOTION_ERR_CANCELLED,    /* the cancel flag was set (Ctrl-C) while planning */
+    MOTION_ERR_STARVED,      /* a streamed program's next part was not planned in time: the
+                              * machine stopped on the path at the end of what was planned */
     MOTION_STATUS_COUNT
 };
 const char *motion_strerror(int status);
@@ -226,6 +228,48 @@ int motion_set_optional_stop(struct motion *m, bool on);
 int motion_step_block(struct motion *m);
 /* Emergency stop: command freezes where it is, state FAULT (status MOTION_ERR_ESTOP). */
 int motion_estop(struct motion *m);
+
+/* ---- Streaming (motion_stream.c): a program planned window by window while it runs, in
+ * bounded memory, motion starting as soon as the first window is planned.
+ *   motion_stream_create(m, start, cancel, &s, ...)   a planner for m's machine
+ *   with an executor: motion_stream_attach(m, s, totals) at rest (the servo update kept
+ *     out), then motion_start(m); the machine holds until the first chunk is planned
+ *   the producer: motion_stream_add(s, cmd) for each command (windows are planned as they
+ *     fill), then motion_stream_finish(s); keep motion_stream_backlog(s) small (it frees the
+ *     chunks the executor has left)
+ *   at the end (done, idle, fault): motion_stream_detach(m) at rest, motion_stream_destroy(s)
+ * Without an executor the same calls only plan and check: `hexcnc check`'s pass before a
+ * streamed run. Every move is checked as motion_load checks it; the first error stops the
+ * stream (motion_stream_error). */
+struct motion_stream;
+struct motion_stream_info {
+    struct motion_plan_info plan; /* what was committed so far: time, length, segments,
+                                   * samples, largest leg rates */
+    size_t windows;               /* windows planned */
+    double entry_shortfall;       /* largest relative shortfall of a window's planned entry
+                                   * speed below the speed the previous one left (rounding) */
+    size_t window_capacity;       /* commands the window's buffer holds (memory bound) */
+};
+int motion_stream_create(struct motion *m, const double start[KINS_POSE_DIM],
+                         const volatile sig_atomic_t *cancel, struct motion_stream **out,
+                         char *err, size_t errlen);
+/* Adds one command; MOTION_OK or the stream's first error (message: motion_stream_error). */
+int motion_stream_add(struct motion_stream *s, const struct canon_cmd *cmd);
+/* Plans what is left, to the program's end. */
+int motion_stream_finish(struct motion_stream *s);
+/* Chunks handed to the executor that it has not left yet (frees those it has). */
+size_t motion_stream_backlog(struct motion_stream *s);
+const char *motion_stream_error(const struct motion_stream *s);
+void motion_stream_info(const struct motion_stream *s, struct motion_stream_info *out);
+void motion_stream_destroy(struct motion_stream *s);
+/* Executor side, with the servo update kept out: m follows s's chunks from now on (m idle,
+ * done or faulted; totals: the checked program's time and length for progress, or NULL). */
+int motion_stream_attach(struct motion *m, struct motion_stream *s,
+                         const struct motion_plan_info *totals);
+/* m forgets the stream's chunks (before motion_stream_destroy); the program is unloaded. */
+void motion_stream_detach(struct motion *m);
+/* Whether the executor is about to run out of planned path (a simulated clock waits). */
+bool motion_stream_starving(const struct motion *m);
 
 /* ---- Manual motion (motion_manual.c, motion_home.c): allowed in IDLE, DONE (and MANUAL, to
  * change a jog); never while a program runs. Leg positions below are joint positions (leg

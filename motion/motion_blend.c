@@ -187,7 +187,7 @@ static void abc_rate(const struct blend_rec *b, const struct canon_cmd *c, doubl
 /* Writes the blended program: trimmed lines, each followed by its blend arc; abc (out->count
  * entries) marks the arcs and the lines' A B C rates at their ends. */
 static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct canon_prog *out,
-                struct motion_blend_abc *abc)
+                struct motion_blend_abc *abc, size_t *ends)
 {
     memcpy(out->start, in->start, sizeof out->start);
     for (size_t i = 0; i < in->count; i++) {
@@ -214,6 +214,8 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
             if (canon_prog_sink(out, &a))
                 return MOTION_ERR_NOMEM;
         }
+        if (ends)
+            ends[i] = out->count;
     }
     return MOTION_OK;
 }
@@ -222,6 +224,16 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
 int motion_blend_program(const struct motion_config *c, const struct canon_prog *in,
                          struct canon_prog *out, size_t *nblends, struct motion_blend_abc **abc)
 {
+    return motion_blend_program_map(c, in, out, nblends, abc, NULL);
+}
+
+int motion_blend_program_map(const struct motion_config *c, const struct canon_prog *in,
+                             struct canon_prog *out, size_t *nblends,
+                             struct motion_blend_abc **abc, size_t *ends)
+{
+    if (ends)
+        for (size_t i = 0; i < in->count; i++)
+            ends[i] = i + 1;
     canon_prog_init(out);
     *nblends = 0;
     if (abc)
@@ -234,7 +246,7 @@ int motion_blend_program(const struct motion_config *c, const struct canon_prog 
     scan(c, in, rec);
     size_t n = find_blends(in, rec);
     struct motion_blend_abc *ab = n ? calloc(in->count + n, sizeof *ab) : NULL;
-    int st = n && !ab ? MOTION_ERR_NOMEM : n ? emit(in, rec, out, ab) : MOTION_OK;
+    int st = n && !ab ? MOTION_ERR_NOMEM : n ? emit(in, rec, out, ab, ends) : MOTION_OK;
     free(rec);
     if (st || !abc)
         free(ab);

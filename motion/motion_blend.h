@@ -65,5 +65,11 @@ struct motion_blend_abc {
  * MOTION_ERR_NOMEM when memory runs out (out is then empty). */
 int motion_blend_program(const struct motion_config *c, const struct canon_prog *in,
                          struct canon_prog *out, size_t *nblends, struct motion_blend_abc **abc);
+/* The same, and ends[i] (in->count entries, the caller's) = the count of commands of the
+ * blended program once command i and the blend arc after it are in (when there are no
+ * blends, i + 1): where a window of a streamed program may be cut (motion_stream.c). */
+int motion_blend_program_map(const struct motion_config *c, const struct canon_prog *in,
+                             struct canon_prog *out, size_t *nblends,
+                             struct motion_blend_abc **abc, size_t *ends);
 
 #endif

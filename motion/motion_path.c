@@ -1,5 +1,6 @@
 /* motion_path.c: turns the canonical program into path segments and evaluates poses on them. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -88,6 +89,8 @@ static const char *intern_file(struct motion_plan *p, const char *name)
 {
     if (!name)
         return NULL;
+    if (p->names_in)
+        p = p->names_in;
     for (size_t i = p->nfiles; i-- > 0;)
         if (strcmp(p->files[i], name) == 0)
             return p->files[i];
@@ -370,9 +373,15 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     int sp_dir = m->io.dir;    /* the spindle as the program leaves it so far */
     double sp_rpm = m->io.rpm;
     memcpy(at, prog->start, sizeof at);
-    for (size_t i = 0; i < prog->count; i++) {
+    for (int k = 0; k < 2; k++)
+        m->pb_seg[k] = p->nseg;
+    size_t i = 0;
+    for (; i < prog->count; i++) {
         const struct canon_cmd *c = &prog->cmds[i];
         size_t nseg0 = p->nseg;
+        for (int k = 0; k < 2; k++)
+            if (m->pb_at[k] != SIZE_MAX && i <= m->pb_at[k])
+                m->pb_seg[k] = p->nseg;
         if (motion_cancelled(m, c->file, c->line, err, errlen))
             return MOTION_ERR_CANCELLED;
         int rc = 0;
@@ -441,12 +450,15 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         if (c->type == CANON_PROGRAM_END)
             break;
     }
+    for (int k = 0; k < 2; k++)   /* cut points at or past the end: every segment before */
+        if (m->pb_at[k] != SIZE_MAX && m->pb_at[k] >= i)
+            m->pb_seg[k] = p->nseg;
     if (motion_chord_zones(m) < 0) {   /* knots where a chord's reach of an arc ends */
         snprintf(err, errlen, "out of memory planning the program");
         return MOTION_ERR_NOMEM;
     }
     double dist = 0;
-    for (size_t i = 0; i < p->nseg; i++) {
+    for (i = 0; i < p->nseg; i++) {
         p->segs[i].dist0_mm = dist;
         dist += p->segs[i].xyz_len_mm;
     }

@@ -168,18 +168,32 @@ static void speed_passes(struct motion_plan *p)
         p->iacc[i] = i + 1 < p->segs[j].k0 + p->segs[j].nk ? fmin(p->iacc[i], p->iacc[i + 1])
                                                             : 1e30;
     }
-    p->kv[0] = 0, p->kv[n - 1] = 0;
+    /* a streamed window starts at k_enter at the speed the previous window left there;
+     * the context knots before it are never followed and keep that speed */
+    size_t k0 = p->k_enter < n ? p->k_enter : 0;
+    double cap0 = p->kv[k0];
+    for (size_t i = 0; i <= k0; i++)
+        p->kv[i] = p->v_enter;
+    p->kv[n - 1] = 0;
     j = 0;
-    for (size_t i = 0; i + 1 < n; i++) {
+    for (size_t i = k0; i + 1 < n; i++) {
         while (i >= p->segs[j].k0 + p->segs[j].nk) j++;
         double ds = interval_ds(p, i, &p->segs[j]);
         p->kv[i + 1] = fmin(p->kv[i + 1], sqrt(p->kv[i] * p->kv[i] + 2 * p->iacc[i] * ds));
     }
     j = p->nseg - 1;
-    for (size_t i = n - 1; i-- > 0;) {
+    for (size_t i = n - 1; i-- > k0;) {
         while (i < p->segs[j].k0) j--;
         double ds = interval_ds(p, i, &p->segs[j]);
         p->kv[i] = fmin(p->kv[i], sqrt(p->kv[i + 1] * p->kv[i + 1] + 2 * p->iacc[i] * ds));
+    }
+    /* The previous window planned v_enter able to stop within its own tail, which this
+     * window holds and extends under the same caps: the backward pass cannot ask for less
+     * but by rounding. The entry keeps its speed; the shortfall is recorded. */
+    p->enter_deficit = 0;
+    if (p->v_enter > 0 && fmin(cap0, p->kv[k0]) < p->v_enter) {
+        p->enter_deficit = (p->v_enter - fmin(cap0, p->kv[k0])) / p->v_enter;
+        p->kv[k0] = p->v_enter;
     }
 }
 

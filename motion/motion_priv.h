@@ -3,6 +3,7 @@
 #define HEXCNC_MOTION_PRIV_H
 
 #include <stdbool.h>
+#include <stdatomic.h>
 #include <stddef.h>
 
 #include "motion/motion.h"
@@ -91,9 +92,34 @@ struct motion_plan {
     size_t nios, capios;
     char **files;            /* interned file names */
     size_t nfiles;
+    struct motion_plan *names_in; /* intern file names there instead (a streamed window's
+                                   * plan: its names outlive it, motion_stream.c) */
+    /* A streamed window (motion_stream.c): the executor enters at knot k_enter at speed
+     * v_enter; the knots before it are context (moves already run, kept for the junction
+     * and chord caps at the entry). 0 and 0 for a whole program. */
+    size_t k_enter;
+    double v_enter;
+    double enter_deficit;    /* how much the planned speed at k_enter fell short of v_enter
+                              * (relative; rounding only), for tests */
     double total_time_s;
     double total_len_mm;
     struct motion_plan_info info;
+};
+
+/* One planned window of a streamed program (motion_stream.c), handed to the executor:
+ * context, the committed part [k_enter, k_leave), and a tail to a stop at the window's end
+ * that the executor runs only if no successor came in time. Immutable once published. */
+#define MOTION_TAIL_TAKEN ((struct motion_chunk *)1)
+struct motion_chunk {
+    struct motion_plan plan;
+    size_t k_enter, s_enter; /* where the executor enters: knot and its segment */
+    size_t k_leave, s_leave; /* where it leaves for the successor: knot and its segment */
+    int last;                /* holds the program's end: no successor, run to the end */
+    double t0_s;             /* program plan time at k_enter, s */
+    struct motion_chunk *_Atomic next; /* successor (planner), or MOTION_TAIL_TAKEN (the
+                                        * executor went on into the tail) */
+    _Atomic int retired;     /* the executor has left it (the planner may free it) */
+    struct motion_chunk *newer; /* the planner's list */
 };
 
 /* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
@@ -123,7 +149,22 @@ struct motion {
     struct kins *kins;       /* borrowed */
     int nj;                  /* joints */
     struct motion_plan plan;
-    int loaded;              /* a program is planned */
+    struct motion_plan *run; /* the plan being followed: &plan, or a streamed chunk's */
+    int loaded;              /* a program is planned (or streams) */
+    /* Streaming (motion_stream.c): chunks come from a planner thread */
+    int streaming;           /* the program streams: chunks, not plan */
+    struct motion_chunk *chunk; /* the chunk being followed (NULL: none yet) */
+    struct motion_chunk *_Atomic stream_head; /* the first chunk, once planned */
+    _Atomic int stream_need; /* the executor is about to need a chunk not yet there */
+    int tail_taken;          /* no successor came in time: running to the tail's stop */
+    size_t marks_base;       /* setting points passed in chunks left behind */
+    struct motion_plan names; /* file names of streamed plans (only files used): they live
+                              * as long as the instance, so a status never points at a
+                              * freed chunk */
+    struct motion_plan_info stream_info; /* the checked program's totals (time, length) */
+    /* motion_path_build records how many segments the commands before pb_at[i] made
+     * (pb_seg[i]); SIZE_MAX: nothing to record (a streamed window's cut points) */
+    size_t pb_at[2], pb_seg[2];
     enum motion_state state;
     int fault_status;
     char msg[320];           /* last error / fault text */
@@ -198,6 +239,10 @@ static inline void motion_phases(double v0, double v1, double vp, double a, doub
     *td = (vp - v1) / a;
     *tc = sc > 0 && vp > 0 ? sc / vp : 0;
 }
+
+/* motion_stream.c, for motion.c's attach: the stream's executor and its start pose. */
+void motion_stream_bind(struct motion_stream *s, struct motion *m);
+const double *motion_stream_start(const struct motion_stream *s);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -57,7 +57,7 @@ static double ceiling_at(const struct motion_plan *p, size_t ci, double tau)
 static double next_rate(const struct motion *m, double target, double vp, double ap,
                         double ceiling, double dt)
 {
-    double r = m->rate, acc = m->plan.iacc[m->ci];
+    double r = m->rate, acc = m->run->iacc[m->ci];
     if (target > ceiling)
         target = ceiling;
     double lo = 0, hi = 2;
@@ -83,13 +83,13 @@ static double next_rate(const struct motion *m, double target, double vp, double
  * commands are in path order: the next one not applied lies further on). */
 static bool ios_reached(const struct motion *m)
 {
-    return m->ios_done == m->plan.nios || m->plan.ios[m->ios_done].at > m->cs;
+    return m->ios_done == m->run->nios || m->run->ios[m->ios_done].at > m->cs;
 }
 
 /* At the start of a wait for the spindle: hold there until it is at speed. */
 static int wait_here(struct motion *m)
 {
-    const struct motion_seg *sg = &m->plan.segs[m->cs];
+    const struct motion_seg *sg = &m->run->segs[m->cs];
     m->waiting = 0;
     if (sg->kind != SEG_WAIT || m->ci != sg->k0 || m->waited_at_seg == m->cs + 1)
         return 0;
@@ -102,7 +102,7 @@ static int wait_here(struct motion *m)
         return 0;
     }
     m->waiting = sg->wait_tool ? 2 : 1;
-    m->tau_s = m->plan.kt[m->ci];
+    m->tau_s = m->run->kt[m->ci];
     m->rate = 0;
     return 1;
 }
@@ -112,27 +112,67 @@ static int pause_here(struct motion *m)
 {
     if (wait_here(m))
         return 1;
-    const struct motion_seg *sg = &m->plan.segs[m->cs];
+    const struct motion_seg *sg = &m->run->segs[m->cs];
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
         return 0;
     m->paused_at_seg = m->cs + 1;
-    m->tau_s = m->plan.kt[m->ci];
+    m->tau_s = m->run->kt[m->ci];
     m->rate = 0;
     if (m->state == MOTION_RUNNING || m->state == MOTION_PAUSING)
         m->state = MOTION_PAUSED;
     return 1;
 }
 
+static void pass_marks_to(struct motion *m, size_t reached);
+static void pass_ios_to(struct motion *m, size_t reached);
+
+/* A streamed program's path has reached the knot where the chunk hands over (k_leave): on
+ * into the successor, at the same place and speed, with its own clock and indices. With
+ * no successor yet, the executor claims the tail (which stops at the window's end) and the
+ * planner can attach nothing more. Returns whether it switched. */
+static bool switch_chunk(struct motion *m)
+{
+    struct motion_chunk *c = m->chunk, *n = NULL;
+    if (!atomic_compare_exchange_strong(&c->next, &n, MOTION_TAIL_TAKEN)) {
+        /* what came before the hand-over point is passed; what lies at it is the next
+         * chunk's (its first commands) */
+        pass_marks_to(m, c->s_leave - 1);
+        pass_ios_to(m, c->s_leave - 1);
+        if (m->step_until_seg) {      /* the stepped block ended at the hand-over */
+            m->step_until_seg = 0;
+            if (m->state == MOTION_RUNNING)
+                m->state = MOTION_PAUSING;
+        }
+        m->tau_s += n->plan.kt[n->k_enter] - c->plan.kt[c->k_leave];
+        m->ci = n->k_enter;
+        m->cs = n->s_enter;
+        m->marks_base += m->marks_done;
+        m->marks_done = 0;
+        m->ios_done = 0;
+        m->paused_at_seg = 0;
+        m->waited_at_seg = 0;
+        m->chunk = n;
+        m->run = &n->plan;
+        atomic_store_explicit(&c->retired, 1, memory_order_release);
+        return true;
+    }
+    m->tail_taken = 1;
+    return false;
+}
+
 /* Moves ci and cs forward to the interval holding tau; stops at an unhonoured pause. */
 static void follow_knots(struct motion *m)
 {
-    const struct motion_plan *p = &m->plan;
+    const struct motion_plan *p = m->run;
     if (pause_here(m))
         return;
     while (m->ci + 2 < p->nknot && m->tau_s >= p->kt[m->ci + 1]) {
         m->ci++;
         while (m->ci >= p->segs[m->cs].k0 + p->segs[m->cs].nk)
             m->cs++;
+        if (m->chunk && !m->chunk->last && !m->tail_taken && m->ci == m->chunk->k_leave &&
+            switch_chunk(m))
+            p = m->run;
         if (pause_here(m))
             return;
     }
@@ -151,7 +191,7 @@ static int resting(const struct motion_plan *p, size_t ci, const struct motion_s
 /* Advances the plan clock by one period. */
 static void advance(struct motion *m, double dt)
 {
-    const struct motion_plan *p = &m->plan;
+    const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap;
     m->elapsed_s += dt;
@@ -183,14 +223,26 @@ static void advance(struct motion *m, double dt)
         m->rate = rn;
     }
     follow_knots(m);
+    p = m->run;                  /* a streamed program may have gone on into the next chunk */
     if (m->step_until_seg && m->cs >= m->step_until_seg && m->state == MOTION_RUNNING) {
         m->step_until_seg = 0;   /* the block is done: pause on the path */
         m->state = MOTION_PAUSING;
     }
     if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED && !m->waiting) {
         m->tau_s = p->total_time_s;
-        m->state = MOTION_DONE;
         m->rate = 0;
+        if (m->chunk && !m->chunk->last) {
+            /* the tail of a chunk whose successor never came: stopped on the path */
+            const struct motion_seg *e = &p->segs[p->nseg - 1];
+            motion_set_msg(m, "%s:%d: the program's next part was not planned in time (the "
+                           "planner fell behind the machine, or stopped on an error): the "
+                           "machine stopped on the path; run from line %d to go on",
+                           e->file ? e->file : "program", e->line, e->line);
+            m->state = MOTION_FAULT;
+            m->fault_status = MOTION_ERR_STARVED;
+        } else {
+            m->state = MOTION_DONE;
+        }
     }
     if (m->rate == 0 && m->state == MOTION_PAUSING)
         m->state = MOTION_PAUSED;
@@ -203,7 +255,7 @@ static void advance(struct motion *m, double dt)
 /* Pose, rates and legs at the current plan time. */
 static int evaluate(struct motion *m)
 {
-    const struct motion_plan *p = &m->plan;
+    const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
     plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
@@ -234,19 +286,17 @@ static int evaluate(struct motion *m)
 
 /* Counts the setting points the path has reached: those before the segment being followed,
  * and every one once the program is done. */
-static void pass_marks(struct motion *m)
+static void pass_marks_to(struct motion *m, size_t reached)
 {
-    const struct motion_plan *p = &m->plan;
-    size_t reached = m->state == MOTION_DONE ? p->nseg : m->cs;
+    const struct motion_plan *p = m->run;
     while (m->marks_done < p->nmarks && p->marks[m->marks_done] <= reached)
         m->marks_done++;
 }
 
-/* Applies the spindle and coolant commands the path has reached (as pass_marks counts). */
-static void pass_ios(struct motion *m)
+/* Applies the spindle and coolant commands before segment `reached` and at it. */
+static void pass_ios_to(struct motion *m, size_t reached)
 {
-    const struct motion_plan *p = &m->plan;
-    size_t reached = m->state == MOTION_DONE ? p->nseg : m->cs;
+    const struct motion_plan *p = m->run;
     while (m->ios_done < p->nios && p->ios[m->ios_done].at <= reached) {
         const struct motion_io *io = &p->ios[m->ios_done++];
         m->io_age = 0;
@@ -278,6 +328,23 @@ static void pass_ios(struct motion *m)
     }
 }
 
+/* The setting points and commands the path has reached: those before the segment being
+ * followed, and every one once the program is done. */
+static size_t reached_seg(const struct motion *m)
+{
+    return m->state == MOTION_DONE ? m->run->nseg : m->cs;
+}
+
+static void pass_marks(struct motion *m)
+{
+    pass_marks_to(m, reached_seg(m));
+}
+
+static void pass_ios(struct motion *m)
+{
+    pass_ios_to(m, reached_seg(m));
+}
+
 void motion_set_wait_tool(struct motion *m, bool on)
 {
     if (m)
@@ -304,6 +371,49 @@ void motion_set_spindle_at_speed(struct motion *m, bool at_speed)
         m->at_speed = at_speed;
 }
 
+/* A streamed program's first chunk, once the planner has published it (until then the
+ * machine holds where it is). Always true for a whole program. */
+static bool stream_ready(struct motion *m)
+{
+    if (!m->streaming || m->chunk)
+        return m->run != NULL;
+    struct motion_chunk *c = atomic_load_explicit(&m->stream_head, memory_order_acquire);
+    if (!c)
+        return false;
+    m->chunk = c;
+    m->run = &c->plan;
+    m->ci = c->k_enter;
+    m->cs = c->s_enter;
+    m->tau_s = c->plan.kt[c->k_enter];
+    return true;
+}
+
+/* Plan time left at override 1: of the program (a streamed one: from its checked total). */
+static double remaining(const struct motion *m)
+{
+    if (!m->loaded || !m->run)
+        return m->streaming ? m->stream_info.time_s : 0;
+    if (!m->streaming || !m->chunk)
+        return m->run->total_time_s - m->tau_s;
+    double t = m->chunk->t0_s + m->tau_s - m->run->kt[m->chunk->k_enter];
+    return fmax(0, m->stream_info.time_s - t);
+}
+
+/* Tells the planner's side whether the executor is short of plan: running on a chunk with
+ * no successor within 0.25 s of plan time of its hand-over, or with no chunk at all. */
+static void stream_watch(struct motion *m)
+{
+    int need = 0;
+    if (m->streaming && m->loaded && (m->state == MOTION_RUNNING ||
+                                      m->state == MOTION_PAUSING ||
+                                      m->state == MOTION_STOPPING)) {
+        const struct motion_chunk *c = m->chunk;
+        need = !c || (!c->last && !atomic_load_explicit(&c->next, memory_order_acquire) &&
+                      c->plan.kt[c->k_leave] - m->tau_s < 0.25);
+    }
+    atomic_store_explicit(&m->stream_need, need, memory_order_relaxed);
+}
+
 /* One servo period (see motion.h). */
 int motion_step(struct motion *m, double period_s, struct motion_out *out)
 {
@@ -314,9 +424,11 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
                  m->state == MOTION_STOPPING;
     if (m->state == MOTION_PAUSED)
         m->elapsed_s += period_s;
+    if (moving && m->streaming && stream_ready(m) && m->chunk->last && m->run->nseg == 0)
+        m->state = MOTION_DONE;  /* a streamed program without a move */
     if (m->state == MOTION_MANUAL) {
         motion_manual_step(m, period_s);
-    } else if (moving && m->loaded && m->plan.nseg) {
+    } else if (moving && m->loaded && stream_ready(m) && m->run->nseg) {
         m->io_age++;
         pass_ios(m);           /* the commands at the present place first: a wait there */
         advance(m, period_s);  /* must see its own spindle command out */
@@ -341,6 +453,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         memset(m->joint_vel, 0, sizeof m->joint_vel);
     }
+    stream_watch(m);
     memcpy(out->pose, m->pose, sizeof out->pose);
     memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
@@ -357,11 +470,11 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
     out->path_vel = m->path_vel;
     out->time_elapsed_s = m->elapsed_s;
-    out->time_remaining_s = m->loaded ? m->plan.total_time_s - m->tau_s : 0;
+    out->time_remaining_s = remaining(m);
     out->distance_done_mm = m->dist_mm;
-    out->distance_total_mm = m->plan.total_len_mm;
+    out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
     out->feed_override = m->rate;
-    out->settings_done = m->marks_done;
+    out->settings_done = m->marks_base + m->marks_done;
     out->spindle = m->io;
     out->waiting = m->waiting;
     out->tool = m->tool;

@@ -1,0 +1,264 @@
+/* test_motion_stream.c: a program planned window by window while it runs (motion_stream.c)
+ * against the same program planned whole (motion_load). */
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+
+/* A long program on the TMU hexapod: short G64 P0.01 moves around a 20 mm circle while A
+ * rocks by 2 deg, with spindle commands, settings and a dwell along the way. */
+static void long_program(struct canon_prog *p, int nmoves)
+{
+    canon_prog_init(p);
+    double home[6] = {0, 0, 645, 0, 0, 0};
+    memcpy(p->start, home, sizeof home);
+    tm_add(p, CANON_PATH_MODE, 1, NULL, 0, 0.01);
+    double e[6] = {20, 0, 645, 0, 0, 0};
+    tm_add(p, CANON_TRAVERSE, 2, e, 0, 0);
+    tm_add(p, CANON_SPINDLE_SPEED, 3, NULL, 0, 8000);
+    tm_add(p, CANON_SPINDLE_ON, 3, NULL, 0, 1);
+    for (int i = 1; i <= nmoves; i++) {
+        double a = i * 0.025;
+        double q[6] = {20 * cos(a), 20 * sin(a), 645 - 0.002 * i, 2 * sin(a * 3), 0, 0};
+        tm_add(p, CANON_FEED, 10 + i, q, 3000, 0);
+        if (i % 1500 == 0)
+            tm_add(p, CANON_SETTING, 10 + i, NULL, 0, 0);
+        if (i % 2500 == 0)
+            tm_add(p, CANON_SPINDLE_SPEED, 10 + i, NULL, 0, 8000 + i);
+        if (i == nmoves / 2)
+            tm_add(p, CANON_DWELL, 10 + i, NULL, 0, 0.05);
+    }
+    tm_add(p, CANON_SPINDLE_STOP, 20 + nmoves, NULL, 0, 0);
+    tm_add(p, CANON_PROGRAM_END, 21 + nmoves, NULL, 0, 0);
+}
+
+/* The producer, run from the executor's loop: keeps at most `ahead` chunks queued. */
+struct feed {
+    struct motion_stream *s;
+    const struct canon_prog *p;
+    size_t next;
+    size_t ahead;
+    size_t stop_at;          /* stop feeding there (SIZE_MAX: never) */
+    double max_off_path;     /* largest distance of the commanded XYZ from the programmed
+                              * path, mm */
+    size_t max_backlog;
+};
+
+static void feed_some(struct feed *f)
+{
+    while (f->next < f->p->count && f->next < f->stop_at &&
+           motion_stream_backlog(f->s) < f->ahead) {
+        ck_assert_int_eq(motion_stream_add(f->s, &f->p->cmds[f->next++]), MOTION_OK);
+        if (f->next == f->p->count)
+            ck_assert_int_eq(motion_stream_finish(f->s), MOTION_OK);
+    }
+    f->max_backlog = fmax(f->max_backlog, motion_stream_backlog(f->s));
+}
+
+static int feed_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    (void)m, (void)step;
+    struct feed *f = ctx;
+    feed_some(f);
+    f->max_off_path = fmax(f->max_off_path, tm_dist_path(o->pose, f->p));
+    return 0;
+}
+
+static struct motion_stream *stream_open(struct tm_machine *mc, const struct canon_prog *p,
+                                         struct feed *f, size_t ahead)
+{
+    struct motion_stream *s = NULL;
+    char err[400] = "";
+    ck_assert_msg(motion_stream_create(mc->m, p->start, NULL, &s, err, sizeof err) ==
+                  MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_stream_attach(mc->m, s, NULL), MOTION_OK);
+    memset(f, 0, sizeof *f);
+    f->s = s;
+    f->p = p;
+    f->ahead = ahead;
+    f->stop_at = SIZE_MAX;
+    feed_some(f);
+    ck_assert_int_eq(motion_start(mc->m), MOTION_OK);
+    return s;
+}
+
+/* Streamed, the program takes the time the whole plan takes, stays on its path and within
+ * every leg's limits, and passes every setting and spindle command. */
+START_TEST(stream_matches_whole_plan)
+{
+    struct tm_machine whole, st;
+    struct tk_cfg *c1 = tm_hexapod_cfg(), *c2 = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c1);
+    ck_assert_int_eq(tm_open(&whole, c1, &kins_hexapod_ops), 0);
+    ck_assert_int_eq(tm_open(&st, c2, &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    long_program(&p, 9000);
+    char err[400];
+    ck_assert_msg(motion_load(whole.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(whole.m), MOTION_OK);
+    struct tm_stats sw, ss;
+    tm_run(whole.m, DT, 2000000, &sw, NULL, NULL);
+    ck_assert_int_eq(sw.last.state, MOTION_DONE);
+
+    struct feed f;
+    struct motion_stream *s = stream_open(&st, &p, &f, 2);
+    tm_run(st.m, DT, 2000000, &ss, feed_hook, &f);
+    ck_assert_msg(ss.last.state == MOTION_DONE, "state %d: %s", ss.last.state,
+                  motion_last_error(st.m));
+    struct motion_stream_info si;
+    motion_stream_info(s, &si);
+    printf("stream: %zu windows, time %.4f s (whole plan %.4f s), run %.4f s (whole %.4f s), "
+           "entry shortfall %.2e, off path %.5f mm, backlog <= %zu\n", si.windows,
+           si.plan.time_s, sw.last.time_elapsed_s, ss.t_s, sw.t_s, si.entry_shortfall,
+           f.max_off_path, f.max_backlog);
+    ck_assert_uint_gt(si.windows, 4);                     /* it did stream */
+    ck_assert_uint_le(f.max_backlog, 2);
+    ck_assert_double_lt(fabs(ss.t_s - sw.t_s), 0.002 * sw.t_s);
+    ck_assert_double_lt(si.entry_shortfall, 1e-6);
+    ck_assert_double_lt(f.max_off_path, 0.01 + 1e-3);     /* G64 P0.01 */
+    for (int j = 0; j < 6; j++) {
+        ck_assert_double_le(ss.max_leg_v[j], 100 * 1.001);
+        ck_assert_double_le(ss.max_leg_a[j], fmax(1000, sw.max_leg_a[j]) * 1.01);
+    }
+    ck_assert_uint_eq(ss.last.settings_done, 6);           /* 9000 / 1500 */
+    ck_assert_uint_eq(sw.last.settings_done, 6);
+    ck_assert_int_eq(ss.last.spindle.dir, 0);
+    ck_assert_double_eq(ss.last.spindle.rpm, sw.last.spindle.rpm);
+    for (int k = 0; k < 6; k++)
+        ck_assert_double_lt(fabs(ss.last.pose[k] - sw.last.pose[k]), 1e-9);
+    motion_stream_detach(st.m);
+    motion_stream_destroy(s);
+    canon_prog_free(&p);
+    tm_close(&whole);
+    tm_close(&st);
+}
+END_TEST
+
+/* A producer that stops: the executor runs into the last chunk's tail and stops there on the
+ * path, saying why; nothing can be attached after that. */
+START_TEST(stream_starved_stops_on_path)
+{
+    struct tm_machine mc;
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    long_program(&p, 9000);
+    struct feed f;
+    struct motion_stream *s = stream_open(&mc, &p, &f, 2);
+    f.stop_at = 4000;
+    struct tm_stats ss;
+    tm_run(mc.m, DT, 2000000, &ss, feed_hook, &f);
+    ck_assert_int_eq(ss.last.state, MOTION_FAULT);
+    ck_assert_int_eq(ss.last.status, MOTION_ERR_STARVED);
+    ck_assert_ptr_nonnull(strstr(motion_last_error(mc.m), "not planned in time"));
+    ck_assert_double_eq(ss.last.path_vel, 0);
+    ck_assert_double_lt(f.max_off_path, 0.011);
+    for (int j = 0; j < 6; j++)
+        ck_assert_double_le(ss.max_leg_a[j], 1000 * 1.01);
+    /* the producer comes back: refused, the machine has left the stream */
+    int st = MOTION_OK;
+    for (size_t i = f.next; i < p.count && st == MOTION_OK; i++)
+        st = motion_stream_add(s, &p.cmds[i]);
+    if (st == MOTION_OK)
+        st = motion_stream_finish(s);
+    ck_assert_int_eq(st, MOTION_ERR_STARVED);
+    motion_stream_detach(mc.m);
+    motion_stream_destroy(s);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Abort, pause and resume work across chunks: the stop stays on the path. */
+static int pause_then_abort(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    feed_hook(m, o, step, ctx);
+    if (step == 20000)
+        motion_pause(m);
+    if (step == 21500) {
+        ck_assert_int_eq(o->state, MOTION_PAUSED);
+        motion_resume(m);
+    }
+    if (step == 40000)
+        motion_abort(m);
+    return 0;
+}
+
+START_TEST(stream_pause_resume_abort)
+{
+    struct tm_machine mc;
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    long_program(&p, 9000);
+    struct feed f;
+    struct motion_stream *s = stream_open(&mc, &p, &f, 2);
+    struct tm_stats ss;
+    tm_run(mc.m, DT, 2000000, &ss, pause_then_abort, &f);
+    ck_assert_int_eq(ss.last.state, MOTION_IDLE);
+    ck_assert_int_gt(ss.steps, 40000);
+    ck_assert_int_lt(ss.steps, 41000);
+    ck_assert_double_lt(f.max_off_path, 0.011);
+    for (int j = 0; j < 6; j++)
+        ck_assert_double_le(ss.max_leg_a[j], 1000 * 1.01);
+    motion_stream_detach(mc.m);
+    motion_stream_destroy(s);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Without an executor the stream checks: an unreachable move far into the program is
+ * reported by its line, as motion_load reports it. */
+START_TEST(stream_check_reports_line)
+{
+    struct tm_machine mc;
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    long_program(&p, 9000);
+    p.cmds[7000].end[2] = 2000;           /* out of reach */
+    int line = p.cmds[7000].line;
+    struct motion_stream *s = NULL;
+    char err[400] = "", whole[400] = "";
+    ck_assert_int_eq(motion_stream_create(mc.m, p.start, NULL, &s, err, sizeof err), MOTION_OK);
+    int st = MOTION_OK;
+    for (size_t i = 0; i < p.count && st == MOTION_OK; i++)
+        st = motion_stream_add(s, &p.cmds[i]);
+    if (st == MOTION_OK)
+        st = motion_stream_finish(s);
+    ck_assert_int_eq(st, MOTION_ERR_UNREACHABLE);
+    ck_assert_int_eq(motion_load(mc.m, &p, whole, sizeof whole), MOTION_ERR_UNREACHABLE);
+    char at[64];
+    snprintf(at, sizeof at, "test.ngc:%d:", line);
+    ck_assert_msg(strstr(motion_stream_error(s), at), "%s", motion_stream_error(s));
+    ck_assert_msg(strstr(whole, at), "%s", whole);
+    struct motion_stream_info si;
+    motion_stream_info(s, &si);
+    ck_assert_uint_le(si.window_capacity, 16384);    /* bounded: never the whole program */
+    motion_stream_destroy(s);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("motion_stream");
+    TCase *tc = tcase_create("stream");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, stream_matches_whole_plan);
+    tcase_add_test(tc, stream_starved_stops_on_path);
+    tcase_add_test(tc, stream_pause_resume_abort);
+    tcase_add_test(tc, stream_check_reports_line);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
