@@ -360,7 +360,7 @@ int motion_stream_attach(struct motion *m, struct motion_stream *s,
     m->run = NULL;
     m->chunk = NULL;
     atomic_store(&m->stream_head, NULL);
-    atomic_store(&m->stream_need, 0);
+    atomic_store(&m->stream_wait, NULL);
     m->streaming = 1;
     m->msg[0] = 0;
     m->state = MOTION_IDLE;
@@ -384,7 +384,7 @@ void motion_stream_detach(struct motion *m)
     m->streaming = 0;
     m->chunk = NULL;
     atomic_store(&m->stream_head, NULL);
-    atomic_store(&m->stream_need, 0);
+    atomic_store(&m->stream_wait, NULL);
     m->run = &m->plan;
     m->loaded = 0;
     if (m->state == MOTION_RUNNING || m->state == MOTION_PAUSING ||
@@ -394,5 +394,14 @@ void motion_stream_detach(struct motion *m)
 
 bool motion_stream_starving(const struct motion *m)
 {
-    return m && atomic_load_explicit(&((struct motion *)m)->stream_need, memory_order_relaxed);
+    if (!m)
+        return false;
+    struct motion *w = (struct motion *)m;
+    struct motion_chunk *c = atomic_load_explicit(&w->stream_wait, memory_order_acquire);
+    if (!c)
+        return false;
+    if (c == MOTION_TAIL_TAKEN)     /* no chunk yet: until the first is out */
+        return !atomic_load_explicit(&w->stream_head, memory_order_acquire);
+    /* the chunk stays alive while the executor is on it (it retires it when it leaves) */
+    return !atomic_load_explicit(&c->next, memory_order_acquire);
 }

@@ -17,6 +17,18 @@ struct motion *motion_hal_get(const struct hal *h);
  * MOTION_ERR_* with a message naming file and line in err on failure. */
 int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, size_t errlen);
 
+/* A program that streams (motion.h's motion_stream_*): a planner for the component's
+ * machine, attached to its motion instance at rest after the start-pose check of
+ * motion_hal_load; it starts as motion_hal_load's programs do. totals: the checked
+ * program's time and length (for progress). The caller feeds it from its own thread. */
+int motion_hal_stream_begin(struct hal *h, const double start[KINS_POSE_DIM],
+                            const struct motion_plan_info *totals,
+                            const volatile sig_atomic_t *cancel, struct motion_stream **out,
+                            char *err, size_t errlen);
+/* Detaches the motion instance from the stream (at rest or not: it is unloaded) and frees
+ * the stream. The producer must have stopped. */
+void motion_hal_stream_end(struct hal *h, struct motion_stream *s);
+
 /* Whether motion_hal_load marks the program to start (default true); false: only
  * motion_hal_start does (a check must never start anything). */
 int motion_hal_set_autostart(struct hal *h, bool on);

@@ -155,7 +155,9 @@ struct motion {
     int streaming;           /* the program streams: chunks, not plan */
     struct motion_chunk *chunk; /* the chunk being followed (NULL: none yet) */
     struct motion_chunk *_Atomic stream_head; /* the first chunk, once planned */
-    _Atomic int stream_need; /* the executor is about to need a chunk not yet there */
+    struct motion_chunk *_Atomic stream_wait; /* the chunk whose successor the executor
+                              * is about to need (MOTION_TAIL_TAKEN: the first chunk), or
+                              * NULL (motion_stream_starving) */
     int tail_taken;          /* no successor came in time: running to the tail's stop */
     size_t marks_base;       /* setting points passed in chunks left behind */
     struct motion_plan names; /* file names of streamed plans (only files used): they live

@@ -403,15 +403,19 @@ static double remaining(const struct motion *m)
  * no successor within 0.25 s of plan time of its hand-over, or with no chunk at all. */
 static void stream_watch(struct motion *m)
 {
-    int need = 0;
+    struct motion_chunk *wait = NULL;
     if (m->streaming && m->loaded && (m->state == MOTION_RUNNING ||
                                       m->state == MOTION_PAUSING ||
                                       m->state == MOTION_STOPPING)) {
-        const struct motion_chunk *c = m->chunk;
-        need = !c || (!c->last && !atomic_load_explicit(&c->next, memory_order_acquire) &&
-                      c->plan.kt[c->k_leave] - m->tau_s < 0.25);
+        struct motion_chunk *c = m->chunk;
+        if (!c)
+            wait = MOTION_TAIL_TAKEN;
+        else if (!c->last && !m->tail_taken &&
+                 !atomic_load_explicit(&c->next, memory_order_acquire) &&
+                 c->plan.kt[c->k_leave] - m->tau_s < 0.25)
+            wait = c;
     }
-    atomic_store_explicit(&m->stream_need, need, memory_order_relaxed);
+    atomic_store_explicit(&m->stream_wait, wait, memory_order_release);
 }
 
 /* One servo period (see motion.h). */

@@ -1,6 +1,6 @@
 # task/: the runner behind `hexcnc run`: INI + HAL files, interpret and plan the whole
 # program, run it on the servo thread, watch every period, summarise.
-LIB_SRCS += task/runner.c task/runner_exec.c task/runner_settings.c
+LIB_SRCS += task/runner.c task/runner_exec.c task/runner_settings.c task/runner_stream.c
 # The machine session (`hexcnc machine`, docs/api.md).
 LIB_SRCS += task/session.c task/session_machine.c task/session_prog.c task/session_status.c \
             task/session_server.c task/session_api.c

@@ -135,6 +135,7 @@ int runner_create(const struct runner_opts *opts, struct runner **out, char *err
         free(r);
         return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
+    pthread_mutex_init(&r->settings_lock, NULL);
     int st;
     if (hal_load_machine_ini(r->hal, opts->ini_path) != HAL_OK) {
         st = errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", hal_last_error(r->hal));
@@ -158,9 +159,11 @@ void runner_destroy(struct runner *r)
 {
     if (!r)
         return;
+    runner_stream_close(r);  /* the planner thread first: it feeds motion */
     hal_destroy(r->hal);  /* stops the threads first */
     interp_destroy(r->interp);
     runner_settings_free(r);
+    pthread_mutex_destroy(&r->settings_lock);
     free(r);
 }
 
@@ -291,6 +294,7 @@ int runner_load_canon(struct runner *r, const struct canon_prog *prog, char *err
 {
     if (runner_moving(r))
         return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine is still running");
+    runner_stream_close(r);
     r->loaded = false;
     int st = runner_settings_load(r, prog, err, errlen);
     if (st == RUNNER_OK) {

@@ -183,4 +183,27 @@ int runner_run(struct runner *r, const volatile sig_atomic_t *stop, runner_progr
 /* What the run did (valid during and after it). */
 int runner_summary(struct runner *r, struct runner_summary *s);
 
+/* Programs that stream (runner_stream.c): read and planned window by window, in bounded
+ * memory, whatever their length.
+ *   runner_check_stream(r, path, &info, ...)   the verification pass over the whole file
+ *                                              from where the machine is: every error
+ *                                              (file:line) here, nothing moves
+ *   runner_stream_start(r, path, from_line, ...) checks again unless the file, the tool
+ *                                              table, the parameter file and the start pose
+ *                                              are those of the last check; then starts the
+ *                                              planner thread and returns once the first
+ *                                              part is planned; runner_start starts it
+ *   runner_stream_close(r)                     once the run has ended (done, aborted, fault)
+ */
+int runner_check_stream(struct runner *r, const char *path, struct motion_plan_info *info,
+                        char *err, size_t errlen);
+int runner_stream_start(struct runner *r, const char *path, int from_line, char *err,
+                        size_t errlen);
+void runner_stream_close(struct runner *r);
+/* The planner thread's error, once it has stopped on one (RUNNER_OK otherwise). */
+int runner_stream_outcome(const struct runner *r, char *err, size_t errlen);
+/* Whether the machine is about to run out of planned path while the planner still works
+ * (a simulated clock waits for it). */
+bool runner_stream_starving(const struct runner *r);
+
 #endif

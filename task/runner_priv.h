@@ -2,11 +2,30 @@
 #ifndef HEXCNC_TASK_RUNNER_PRIV_H
 #define HEXCNC_TASK_RUNNER_PRIV_H
 
+#include <pthread.h>
 #include <stdatomic.h>
+#include <sys/types.h>
 
 #include "hal/hal.h"
 #include "interp/interp.h"
 #include "task/runner.h"
+
+/* What a verification pass of a streamed program was made for (runner_stream.c): the file,
+ * the files the interpreter starts from and the start pose; a run of the same starts at
+ * once, anything else is checked again. */
+struct runner_check {
+    bool valid;
+    char path[1024];
+    dev_t dev;
+    ino_t ino;
+    off_t size;
+    int64_t mtime_ns, ctime_ns;
+    int64_t files_ns;                   /* tool table and parameter file, folded */
+    double start[KINS_POSE_DIM];
+    struct motion_plan_info info;       /* the program's time, length, segments */
+    size_t settings;                    /* CANON_SETTING commands it holds */
+};
+struct runner_stream;
 
 /* The machine, the program and what the monitor has seen. */
 struct runner {
@@ -35,7 +54,12 @@ struct runner {
                                          * file names the plan's moves point at, so it lives
                                          * until the next program or runner_destroy */
 
+    /* A streamed program (runner_stream.c) and its verification pass. */
+    struct runner_stream *stream;       /* the run's planner thread, NULL when none */
+    struct runner_check checked;        /* the last verification pass */
+
     /* Settings the program writes (runner_settings.c), saved as execution reaches them. */
+    pthread_mutex_t settings_lock;      /* settings grows on a streamed run's planner thread */
     struct canon_prog settings;         /* the program's CANON_SETTING commands, in order */
     struct interp *store;               /* applies and saves them: set up with the machine's
                                          * parameter file and tool table (NULL: none) */
@@ -88,6 +112,8 @@ int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *
                          size_t errlen);
 void runner_settings_apply(struct runner *r);
 void runner_settings_free(struct runner *r);
+/* The interpreter settings are saved through, for a streamed run (its settings come later). */
+int runner_settings_store(struct runner *r, char *err, size_t errlen);
 
 
 /* Starts the threads with the machine off until the motion component follows the legs'

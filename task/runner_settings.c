@@ -33,12 +33,7 @@ int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *
             return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     if (r->settings.count == 0)
         return RUNNER_OK;
-    r->store = interp_create();
-    r->store_tt = malloc(sizeof *r->store_tt);
-    if (!r->store || !r->store_tt)
-        return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
-    tooltable_init(r->store_tt);
-    int st = runner_setup_interp(r, r->store, r->store_tt, err, errlen);
+    int st = runner_settings_store(r, err, errlen);
     if (st != RUNNER_OK)
         return st;
     for (size_t i = 0; i < r->settings.count; i++) {
@@ -53,11 +48,22 @@ int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *
     return RUNNER_OK;
 }
 
+int runner_settings_store(struct runner *r, char *err, size_t errlen)
+{
+    r->store = interp_create();
+    r->store_tt = malloc(sizeof *r->store_tt);
+    if (!r->store || !r->store_tt)
+        return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
+    tooltable_init(r->store_tt);
+    return runner_setup_interp(r, r->store, r->store_tt, err, errlen);
+}
+
 /* Applies and saves every setting the machine has passed and that is not saved yet. A save
  * that fails stops the program (controlled stop); the run then reports it. */
 void runner_settings_apply(struct runner *r)
 {
     size_t done = atomic_load_explicit(&r->mon_settings, memory_order_acquire);
+    pthread_mutex_lock(&r->settings_lock);  /* a streamed run's planner appends */
     if (done > r->settings.count)
         done = r->settings.count;
     while (r->settings_applied < done && !r->save_err[0]) {
@@ -69,4 +75,5 @@ void runner_settings_apply(struct runner *r)
             runner_abort(r);
         }
     }
+    pthread_mutex_unlock(&r->settings_lock);
 }

@@ -142,6 +142,7 @@ void session_run_cut(struct session *s, const char *why)
     s->running = false;
     s->stopping = false;
     runner_settings_apply(s->r);
+    runner_stream_close(s->r);
     session_message(s, "error", "task", "%s stopped at line %d: %s", s->run_is_mdi ?
                     "MDI line" : "program", line, why);
     if (!s->run_is_mdi)
@@ -199,10 +200,16 @@ static void run_outcome(struct session *s, enum motion_state st)
     int line = atomic_load(&s->r->mon_line);
     s->running = false;
     runner_settings_apply(s->r);
+    char perr[800];
+    bool planner_failed = runner_stream_outcome(s->r, perr, sizeof perr) != RUNNER_OK;
+    runner_stream_close(s->r);
     const char *what = s->run_is_mdi ? "MDI line" : "program";
     if (s->r->save_err[0])
         session_message(s, "error", "task", "%s", s->r->save_err);
-    if (st == MOTION_FAULT)
+    if (planner_failed)  /* the file changed under the run, or memory ran out */
+        session_message(s, "error", "task", "%s stopped on the path at line %d: reading it on "
+                        "failed: %s", what, line, perr);
+    else if (st == MOTION_FAULT)
         session_message(s, "error", "motion", "%s stopped on a fault: %s%s%s%s", what,
                         motion_hal_fault(s->hal), s->r->first_fault[0] ? " (cause: " : "",
                         s->r->first_fault, s->r->first_fault[0] ? ")" : "");
@@ -376,6 +383,13 @@ int session_run(struct session *s, const volatile sig_atomic_t *stop)
             long ns = busy ? 10 * s->period_ns
                            : (long)fmin((now - last) * 1e9, 20e6);
             ns -= ns % s->period_ns;
+            if (runner_stream_starving(s->r)) {
+                /* the simulated machine outran the planner's thread: wait for it, as a
+                 * real machine never has to (the planner is far ahead in real time) */
+                struct timespec ts = { 0, 200000 };
+                nanosleep(&ts, NULL);
+                ns = 0;
+            }
             if (ns > 0)
                 hal_sim_advance(s->hal, ns);
             last = now;

@@ -130,14 +130,15 @@ int session_check(struct session *s, json_t **result, char *err, size_t len)
     if ((rc = session_need_idle(s, "program.check", err, len)))
         return rc;
     char msg[800];
-    int st = runner_load_program(s->r, s->program, msg, sizeof msg);
+    struct motion_plan_info pi;
+    /* the verification pass streams over the whole file in bounded memory; a run of the
+     * same file from the same place starts without checking it again */
+    int st = runner_check_stream(s->r, s->program, &pi, msg, sizeof msg);
     if (st != RUNNER_OK) {
         *result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line", 0, "text",
                             msg);
         return 0;
     }
-    struct motion_plan_info pi;
-    runner_plan_info(s->r, &pi);
     *result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
                         pi.time_s, "length_mm", pi.length_mm, "segments",
                         (json_int_t)pi.segments);
@@ -156,9 +157,11 @@ int session_run_program(struct session *s, int from_line, char *err, size_t len)
         return rc;
     s->mode = SESS_AUTO;
     char msg[800];
-    /* checked again from where the machine is now, whatever an earlier check said */
-    if (runner_load_program_from(s->r, s->program, from_line > 1 ? from_line : 1, msg,
-                                 sizeof msg) != RUNNER_OK)
+    /* streamed: checked first unless the last check was of this file, unchanged, with the
+     * same tools and offsets, from where the machine is now; motion starts once the first
+     * part is planned */
+    if (runner_stream_start(s->r, s->program, from_line > 1 ? from_line : 1, msg,
+                            sizeof msg) != RUNNER_OK)
         return errbuf_set(err, len, RPC_PROGRAM, "%s", msg);
     if ((rc = start_loaded(s, false, err, len)))
         return rc;

@@ -431,6 +431,60 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
     return st;
 }
 
+/* A streamed program (motion_stream.c): the planner made for the component's machine and
+ * attached to its motion instance, under the plan lock, after the same start-pose check as
+ * motion_hal_load. */
+int motion_hal_stream_begin(struct hal *h, const double start[KINS_POSE_DIM],
+                            const struct motion_plan_info *totals,
+                            const volatile sig_atomic_t *cancel, struct motion_stream **out,
+                            char *err, size_t errlen)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    *out = NULL;
+    if (!c) {
+        snprintf(err, errlen, "no motion component: the HAL files must `loadrt motion`");
+        return MOTION_ERR_STATE;
+    }
+    pthread_mutex_lock(&c->plan_lock);
+    double L[KINS_MAX_JOINTS];
+    if (c->updates > MOTION_FEEDBACK_SETTLE && motion_pose_known(c->m) &&
+        kins_inverse(hal_get_object(h, "kins"), start, L) == KINS_OK) {
+        for (int i = 0; i < c->nj; i++) {
+            double off = L[i] - c->last.joint_pos[i];
+            if (fabs(off) > MOTION_START_TOL_MM) {
+                pthread_mutex_unlock(&c->plan_lock);
+                snprintf(err, errlen, "the program was planned from a pose the machine is "
+                         "not at: leg %d ([JOINT_%d]) is %.4f mm from the program's start; "
+                         "plan it again from where the machine is", i + 1, i, -off);
+                return MOTION_ERR_STATE;
+            }
+        }
+    }
+    motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
+    motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
+    int st = motion_stream_create(c->m, start, cancel, out, err, errlen);
+    if (st == MOTION_OK && (st = motion_stream_attach(c->m, *out, totals)) != MOTION_OK) {
+        snprintf(err, errlen, "%s", motion_last_error(c->m));
+        motion_stream_destroy(*out);
+        *out = NULL;
+    }
+    c->start_pending = st == MOTION_OK && c->autostart;
+    pthread_mutex_unlock(&c->plan_lock);
+    return st;
+}
+
+void motion_hal_stream_end(struct hal *h, struct motion_stream *s)
+{
+    struct motion_comp *c = h ? hal_get_object(h, "motion-comp") : NULL;
+    if (c) {
+        pthread_mutex_lock(&c->plan_lock);
+        motion_stream_detach(c->m);
+        c->start_pending = 0;
+        pthread_mutex_unlock(&c->plan_lock);
+    }
+    motion_stream_destroy(s);
+}
+
 /* Requests a start at the next update. */
 int motion_hal_start(struct hal *h)
 {
