@@ -131,7 +131,7 @@ $(BUILD)/bench/%: bench/%.c $(LIBHEX) | $(GEN_HDRS)
 # Tests and benches find the tree through these variables, whatever O is.
 RUN_ENV := HEXCNC_ROOT=$(CURDIR) HEXCNC_BIN=$(abspath $(HEXCNC)) \
            HEXCNC_PLUGIN_DIR=$(abspath $(LIBDIR)) HEXCNC_BUILD=$(abspath $(BUILD)) \
-           CK_DEFAULT_TIMEOUT=120
+           CK_DEFAULT_TIMEOUT=120 HEXCNC_SANITIZED=$(if $(SAN),1,0)
 
 test: all $(TEST_BINS)
 	@$(RUN_ENV) sh mk/run-tests.sh $(TEST_BINS) -- $(SCRIPT_TESTS)
