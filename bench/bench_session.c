@@ -3,8 +3,11 @@
  * baseline, measured side by side in this run), the time from a jog.move request to its
  * answer (the servo thread has taken the jog) and to the first commanded motion seen in
  * status, and the time from program.run to motion on the demo program. Wall-clock figures:
- * median and 99th percentile of repeated trials. */
+ * median and 99th percentile of repeated trials. Then a 10-million-line program streamed:
+ * the check's time and this process's peak resident memory, the time to first motion, set
+ * beside `hexcnc check` planning a 1-million-line program whole (the baseline). */
 #include <errno.h>
+#include <fcntl.h>
 #include <jansson.h>
 #include <math.h>
 #include <pthread.h>
@@ -12,8 +15,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -200,6 +206,100 @@ out:
     return NULL;
 }
 
+/* ---- a long program streamed through the session */
+#define STREAM_LINES 10000000L   /* the 10-million-line program */
+#define WHOLE_LINES 1000000L     /* the baseline: `hexcnc check` plans a whole program */
+
+/* This process's VmHWM or VmRSS, kB. */
+static long proc_kb(const char *key)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char l[256];
+    long kb = -1;
+    size_t n = strlen(key);
+    while (f && fgets(l, sizeof l, f))
+        if (!strncmp(l, key, n) && l[n] == ':')
+            kb = atol(l + n + 1);
+    if (f)
+        fclose(f);
+    return kb;
+}
+
+/* n moves of 0.1 mm round a 20 mm circle at Z645, G64 P0.01, F6000. */
+static int write_program(const char *path, long n)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "G21 G90 G64 P0.01\nG0 X20 Y0 Z645 A0 B0 C0\nF6000\n");
+    for (long k = 1; k <= n; k++)
+        fprintf(f, "G1 X%.4f Y%.4f\n", 20 * cos(k * 0.005), 20 * sin(k * 0.005));
+    fprintf(f, "M2\n");
+    return fclose(f);
+}
+
+/* `hexcnc check` (the whole program in memory) on path: wall seconds and peak kB. */
+static int whole_check(const char *path, double *wall_s, long *peak_kb)
+{
+    const char *bin = getenv("HEXCNC_BIN");
+    double t0 = now_s();
+    pid_t pid = fork();
+    if (pid == 0) {
+        int dn = open("/dev/null", O_WRONLY);
+        dup2(dn, 1);
+        execl(bin ? bin : "bin/hexcnc", "hexcnc", "check", "configs/sim/tmu-hexapod.ini",
+              path, (char *)NULL);
+        _exit(127);
+    }
+    int status;
+    struct rusage ru;
+    if (pid < 0 || wait4(pid, &status, 0, &ru) != pid)
+        return -1;
+    *wall_s = now_s() - t0;
+    *peak_kb = ru.ru_maxrss;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : -1;
+}
+
+static void bench_stream(struct conn *c, const char *dir)
+{
+    char big[200], mid[200], params[300];
+    snprintf(big, sizeof big, "%s/big.ngc", dir);
+    snprintf(mid, sizeof mid, "%s/mid.ngc", dir);
+    if (write_program(big, STREAM_LINES) || write_program(mid, WHOLE_LINES)) {
+        fprintf(stderr, "bench_session: cannot write the programs in %s\n", dir);
+        return;
+    }
+    double ws;
+    long wkb;
+    if (whole_check(mid, &ws, &wkb) == 0)
+        printf("baseline, the whole program in memory (hexcnc check, %ld lines): %.1f s, "
+               "peak %.0f MB\n", WHOLE_LINES, ws, wkb / 1024.0);
+    struct stat sb;
+    double file_mb = stat(big, &sb) == 0 ? (double)sb.st_size / 1e6 : 0;
+    long rss0 = proc_kb("VmRSS");
+    snprintf(params, sizeof params, "{\"path\":\"%s\"}", big);
+    json_decref(call(c, "program.open", params));
+    double t0 = now_s();
+    json_t *r = call(c, "program.check", NULL);
+    double t_check = now_s() - t0;
+    long hwm_check = proc_kb("VmHWM");
+    printf("streamed (%ld lines, %.0f MB file): program.check %.1f s (%s, %.0f s of "
+           "machining); this process before %.0f MB, peak %.0f MB\n", STREAM_LINES,
+           file_mb, t_check, json_is_true(json_object_get(r, "ok")) ?
+           "ok" : "refused", json_real_value(json_object_get(r, "time_s")), rss0 / 1024.0,
+           hwm_check / 1024.0);
+    json_decref(r);
+    double ans, mov;
+    call_until_moving(c, "program.run", NULL, &ans, &mov);
+    usleep(3000000);                 /* 3 s of machining, windows planned meanwhile */
+    json_decref(call(c, "program.abort", NULL));
+    wait_rest(c);
+    printf("  program.run: answer %.1f ms, first motion %.1f ms; peak resident after 3 s of "
+           "the run %.0f MB\n", ans * 1e3, mov * 1e3, proc_kb("VmHWM") / 1024.0);
+    unlink(big);
+    unlink(mid);
+}
+
 static volatile sig_atomic_t session_stop;
 
 static void *session_main(void *arg)
@@ -298,6 +398,8 @@ int main(void)
     printf("program.run (configs/sim demo, %d starts): answer median %.2f ms, first motion "
            "median %.2f ms (max %.2f ms)\n", RUN_TRIALS, am / 1000, mm / 1000,
            pr_move[RUN_TRIALS - 1] * 1000);
+
+    bench_stream(&c, dir);
 
     json_decref(call(&c, "machine.shutdown", NULL));
     pthread_join(th, NULL);

@@ -129,9 +129,9 @@ const struct config_key config_keys[] = {
     { "EMCMOT", "SIM_CLOCK", INT, "", "0..1", 0, 0, "0", "`hexcnc run` runs on the simulated "
       "clock (1) or paces the servo thread on the wall clock (0)" },
     { "EMCMOT", "NUM_DIO", INT, "", "0..64", 0, 0, "4", "digital outputs "
-      "motion.digital-out-NN (M62..M65)" },
+      "motion.digital-out-NN (M62..M65) and inputs motion.digital-in-NN (M66 P)" },
     { "EMCMOT", "NUM_AIO", INT, "", "0..16", 0, 0, "4", "analog outputs "
-      "motion.analog-out-NN (M67, M68)" },
+      "motion.analog-out-NN (M67, M68) and inputs motion.analog-in-NN (M66 E)" },
     { "EMCMOT", "EMCMOT", STR, "", "", 0, IGN, "", "LinuxCNC's motion module" },
     { "EMCMOT", "COMM_TIMEOUT", NUM, "s", "", 0, IGN, "", "LinuxCNC's" },
     { "EMCMOT", "BASE_PERIOD", INT, "ns", "", 0, IGN, "", "LinuxCNC's base thread" },

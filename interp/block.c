@@ -79,10 +79,7 @@ int interp_add_m(struct interp *in, double v, int column)
     case 7: case 8: case 9: grp = 8; break;
     case 62: case 63: case 64: case 65: case 67: case 68: grp = 5; break;
     case 70: case 71: case 72: case 73: grp = 9; break;
-    case 66:
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "M66 (wait for an input) is not "
-                           "supported yet: its result #5399 would have to reach the lines "
-                           "after it while the program runs");
+    case 66: grp = 5; break;
     case 48: case 49: case 50: case 51: case 52: case 53: case 60:
         return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "M%d is not supported yet", c);
     default:
@@ -174,11 +171,11 @@ static int word_used(const struct interp *in, char w)
     case 'i': case 'j': case 'k': return arc || g0 == 100;
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 ||
-                     (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 65);
+                     (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66);
     case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640 ||
-                     b->m[6] == 61 || b->m[5] == 67 || b->m[5] == 68;
-    case 'e': return b->m[5] == 67 || b->m[5] == 68;
-    case 'l': return cycle || g0 == 100;
+                     b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68;
+    case 'e': return b->m[5] >= 66 && b->m[5] <= 68;
+    case 'l': return cycle || g0 == 100 || b->m[5] == 66;
     case 'h': return b->g[8] == 430;
     case 'd': case 'w': return comp;
     default: return 1;
@@ -194,13 +191,13 @@ static int check_unused(struct interp *in)
         "I, J and K are arc centre words: use them with G2 or G3",
         "I, J and K are arc centre words: use them with G2 or G3",
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
-        "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G82/G89 (dwell) and M62..M65",
-        "Q is used by the peck cycles G73 and G83, G10, G64, M61, M67 and M68",
-        "L is used by G10 and canned cycles (repeats)",
+        "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G82/G89 (dwell) and M62..M66",
+        "Q is used by the peck cycles G73 and G83, G10, G64, M61, M66, M67 and M68",
+        "L is used by G10, canned cycles (repeats) and M66",
         "H is used by G43 (tool length offset)",
         "D (tool for the radius) is only used with G141/G142",
         "W (tool radius) is only used with G141/G142",
-        "E is the analog output of M67 and M68",
+        "E is the analog input of M66 and the analog output of M67 and M68",
     };
     for (int i = 0; words[i]; i++) {
         char w = words[i];

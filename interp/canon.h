@@ -38,6 +38,9 @@ enum canon_type {
     CANON_DIGITAL_OUT,     /* M62/M63 (synchronised with motion) and M64/M65 (immediate):
                             * output ivalue set (value 1) or cleared (0) */
     CANON_ANALOG_OUT,      /* M67 (synchronised) / M68 (immediate): output ivalue = value */
+    CANON_WAIT_INPUT,      /* M66: wait (at rest) on input ivalue (analog: E, else P) in
+                            * wait_mode (0 read at once, 1 rise, 2 fall, 3 high, 4 low) for
+                            * at most value seconds; its result is #5399 */
     CANON_TYPE_COUNT
 };
 
@@ -80,6 +83,8 @@ struct canon_cmd {
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
     int immediate;         /* DIGITAL_OUT, ANALOG_OUT: M64/M65/M68 (else M62/M63/M67) */
+    int analog;            /* WAIT_INPUT: an analog input (E), else digital (P) */
+    int wait_mode;         /* WAIT_INPUT: L, 0..4 */
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */

@@ -128,10 +128,54 @@ static int exec_modal_state(struct interp *in, const struct interp_block *b)
     }
 }
 
+/* M66 P|E L Q: wait on an input; the machine's answer (interp_set_input_fn) is #5399. */
+static int exec_wait(struct interp *in, const struct interp_block *b)
+{
+    int n, mode = 0;
+    bool analog = W('e') != 0;
+    if (W('p') && W('e'))
+        return interp_fail(in, INTERP_ERR_WORD, W('e'), "M66: give a P word (digital input) "
+                           "or an E word (analog input), not both");
+    if (!W('p') && !W('e'))
+        return interp_fail(in, INTERP_ERR_WORD, b->mcol[5], "M66 needs a P word (the digital "
+                           "input's number) or an E word (the analog input's number)");
+    char w = analog ? 'e' : 'p';
+    CHP(interp_to_int(in, V(w), W(w), analog ? "E (analog input)" : "P (digital input)", &n));
+    if (n < 0)
+        return interp_fail(in, INTERP_ERR_WORD, W(w), "M66: input %d: inputs are numbered "
+                           "from 0", n);
+    if (W('l'))
+        CHP(interp_to_int(in, V('l'), W('l'), "L (wait mode)", &mode));
+    if (mode < 0 || mode > 4)
+        return interp_fail(in, INTERP_ERR_WORD, W('l'), "M66 L%d: the wait mode is 0 (read at "
+                           "once), 1 (rise), 2 (fall), 3 (high) or 4 (low)", mode);
+    if (analog && mode != 0)
+        return interp_fail(in, INTERP_ERR_WORD, W('l'), "M66 E%d L%d: an analog input can only "
+                           "be read at once (L0)", n, mode);
+    double timeout = W('q') ? V('q') : 0;
+    if (mode != 0 && !(timeout > 0))
+        return interp_fail(in, INTERP_ERR_WORD, W('q') ? W('q') : b->mcol[5], "M66 L%d needs a "
+                           "Q word: the time-out in seconds, more than 0", mode);
+    struct canon_cmd c;
+    interp_cmd_init(in, &c, CANON_WAIT_INPUT);
+    c.ivalue = n;
+    c.analog = analog;
+    c.wait_mode = mode;
+    c.value = mode != 0 ? timeout : 0;
+    c.feed_mm_min = in->feed_mm_min;
+    CHP(interp_emit(in, &c));
+    /* the lines after it see the machine's answer; without a machine (check, hexcnc interp)
+     * it is 0, as LinuxCNC's rs274 reads it */
+    in->params[5399] = in->input_fn ? in->input_fn(in->input_ctx, &c) : 0;
+    return 0;
+}
+
 /* M62..M65 P: a digital output; M67/M68 E Q: an analog output (docs/gcode.md). */
 static int exec_io(struct interp *in, const struct interp_block *b)
 {
     int code = b->m[5], n;
+    if (code == 66)
+        return exec_wait(in, b);
     struct canon_cmd c;
     bool digital = code <= 65;
     char w = digital ? 'p' : 'e';

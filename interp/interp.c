@@ -307,6 +307,18 @@ static int run_lines(struct interp *in, const char *text, size_t len)
     return 0;
 }
 
+void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx)
+{
+    in->input_fn = fn;
+    in->input_ctx = ctx;
+}
+
+void interp_set_param(struct interp *in, int n, double v)
+{
+    if (n >= 1 && n < INTERP_NPARAMS)
+        in->params[n] = v;
+}
+
 void interp_set_mdi(struct interp *in, int on)
 {
     in->mdi = on != 0;

@@ -101,6 +101,13 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
 int interp_run_text(struct interp *in, const char *file_name, const char *text, size_t len,
                     canon_sink_fn sink, void *ctx);
 const struct interp_error *interp_last_error(const struct interp *in);
+/* M66: after the sink got the CANON_WAIT_INPUT command, fn returns the machine's answer
+ * (the input's value, or -1 after the time-out), which becomes #5399 for the lines after it;
+ * fn may block until the machine has reached the wait. NULL (the default): 0, as rs274. */
+typedef double (*interp_input_fn)(void *ctx, const struct canon_cmd *wait);
+void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx);
+/* Sets numbered parameter #n (1..5602) (the session: #5399 after an MDI line's M66). */
+void interp_set_param(struct interp *in, int n, double v);
 /* MDI: lines come one at a time (a run need not end with M2 or M30). */
 void interp_set_mdi(struct interp *in, int on);
 /* The tool in the spindle (as M61 Q sets it, without a tool change). */

@@ -141,6 +141,8 @@ struct interp {
     struct tooltable *tt;        /* tool table or NULL (not owned) */
     int mdi;                     /* lines typed one at a time: no program end needed */
     int text_mapped;             /* the program text is a file mapping (interp_run_file) */
+    interp_input_fn input_fn;    /* M66's answer (NULL: 0) */
+    void *input_ctx;
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */

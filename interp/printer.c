@@ -249,7 +249,7 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
 {
     struct interp_printer *p = ctx;
     struct interp_view v;
-    if (c->type == CANON_SETTING)  /* what the machine saves; rs274 prints no such call */
+    if (c->type == CANON_SETTING || c->type == CANON_WAIT_INPUT)  /* rs274 prints no such call */
         return 0;
     interp_get_view(p->in, &v);
     if (v.inch != p->inch) {

@@ -147,6 +147,12 @@ struct motion_plan_info {
 };
 int motion_plan_info(const struct motion *m, struct motion_plan_info *out);
 
+/* Inputs M66 waits on (motion.digital-in-NN, motion.analog-in-NN), this period. */
+void motion_set_inputs(struct motion *m, const bool *din, int nd, const double *ain, int na);
+/* The last M66's answer (the input's value, or -1 after its time-out) and, in *seq, how many
+ * M66 waits have been answered since the program started (any thread). */
+double motion_input_result(const struct motion *m, unsigned *seq);
+
 /* The spindle and coolant as the program commands them at the point the path has reached. */
 struct motion_spindle {
     int dir;                 /* 1 (M3), -1 (M4), 0 (stopped) */
@@ -192,7 +198,7 @@ struct motion_out {
     double feed_override;              /* override in effect now (ramps to the requested) */
     struct motion_spindle spindle;     /* spindle and coolant commands in force */
     int waiting;                       /* holding on the path: 1 for the spindle to be at
-                                        * speed, 2 for a tool change */
+                                        * speed, 2 for a tool change, 3 for an input (M66) */
     struct motion_tool tool;           /* tool change requests, the tool in the spindle */
     struct motion_outputs outputs;     /* M62..M68 in force (kept from program to program) */
     size_t settings_done;              /* CANON_SETTING commands of the program the machine has
@@ -268,6 +274,9 @@ int motion_stream_attach(struct motion *m, struct motion_stream *s,
                          const struct motion_plan_info *totals);
 /* m forgets the stream's chunks (before motion_stream_destroy); the program is unloaded. */
 void motion_stream_detach(struct motion *m);
+/* Sync: the window so far is planned to a stop at its end (an M66 wait there) and handed
+ * over; what comes next starts a new window at rest there. */
+int motion_stream_sync(struct motion_stream *s);
 /* Whether the executor is about to run out of planned path (a simulated clock waits). */
 bool motion_stream_starving(const struct motion *m);
 

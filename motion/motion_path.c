@@ -423,6 +423,25 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             rc = add_io(p, dig ? IO_DOUT : IO_AOUT, c->value, c->ivalue);
             break;
         }
+        case CANON_WAIT_INPUT: {
+            int n = c->analog ? m->cfg.num_aio : m->cfg.num_dio;
+            if (c->ivalue >= n) {
+                snprintf(err, errlen, "%s:%d: M66: %s input %d does not exist: the machine has "
+                         "%d ([EMCMOT] %s)", c->file ? c->file : "program", c->line,
+                         c->analog ? "analog" : "digital", c->ivalue, n,
+                         c->analog ? "NUM_AIO" : "NUM_DIO");
+                return MOTION_ERR_PROGRAM;
+            }
+            if ((rc = add_stop(p, c, at, SEG_WAIT, 0)) == 0) {
+                struct motion_seg *w = &p->segs[p->nseg - 1];
+                w->wait_input = 1;
+                w->input = c->ivalue;
+                w->input_analog = c->analog;
+                w->input_mode = c->wait_mode;
+                w->timeout_s = c->value;
+            }
+            break;
+        }
         case CANON_TOOL_CHANGE:
             rc = add_io(p, c->value == 0 ? IO_TOOL_CHANGE : IO_TOOL_SET, 0, c->ivalue);
             if (rc == 0 && c->value == 0 && m->wait_tool && (rc = add_stop(p, c, at, SEG_WAIT,

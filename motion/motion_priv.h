@@ -62,6 +62,9 @@ struct motion_seg {
                               * sample between them at this spacing */
     int arc;                 /* index into arcs for SEG_ARC, else -1 */
     int wait_tool;           /* SEG_WAIT: for a tool change (else for the spindle) */
+    int wait_input;          /* SEG_WAIT: for an input (M66): input, its kind and mode */
+    int input, input_analog, input_mode;
+    double timeout_s;        /* M66 Q */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
      * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
@@ -115,6 +118,8 @@ struct motion_chunk {
     size_t k_enter, s_enter; /* where the executor enters: knot and its segment */
     size_t k_leave, s_leave; /* where it leaves for the successor: knot and its segment */
     int last;                /* holds the program's end: no successor, run to the end */
+    int sync;                /* ends at rest on an M66 wait: the interpreter reads on once the
+                              * machine has its answer; the successor starts at rest there */
     double t0_s;             /* program plan time at k_enter, s */
     struct motion_chunk *_Atomic next; /* successor (planner), or MOTION_TAIL_TAKEN (the
                                         * executor went on into the tail) */
@@ -199,6 +204,13 @@ struct motion {
     long io_age;             /* periods since a spindle or coolant command last changed */
     int wait_tool;           /* plan a wait at M6 (motion_hal: tool-changed is wired) */
     struct motion_tool tool; /* tool change requests and the tool in the spindle */
+    bool din[MOTION_MAX_DIO];  /* motion.digital-in-NN this period */
+    double ain[MOTION_MAX_AIO];/* motion.analog-in-NN */
+    bool in_prev;            /* the waited-for digital input last period (edges) */
+    double in_since_s;       /* when the present M66 wait began (elapsed_s) */
+    int in_waiting;          /* an M66 wait is under way at waited segment in_seg */
+    _Atomic double input_result; /* the last M66's answer: the value, or -1 (time-out) */
+    _Atomic unsigned input_seq;  /* M66 waits answered since the program started */
     struct motion_outputs outputs; /* M62..M68 in force */
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */

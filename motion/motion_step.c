@@ -86,6 +86,37 @@ static bool ios_reached(const struct motion *m)
     return m->ios_done == m->run->nios || m->run->ios[m->ios_done].at > m->cs;
 }
 
+/* An M66 wait at sg: whether it is answered (the answer in *v). It begins the first period
+ * the path is there; a rise or fall must happen after that. */
+static bool input_answered(struct motion *m, const struct motion_seg *sg, double *v)
+{
+    bool cur = m->din[sg->input];
+    if (!m->in_waiting) {
+        m->in_waiting = 1;
+        m->in_since_s = m->elapsed_s;
+        m->in_prev = cur;
+    }
+    bool prev = m->in_prev, done;
+    m->in_prev = cur;
+    *v = cur;
+    switch (sg->input_mode) {
+    case 1: done = !prev && cur; break;    /* rise */
+    case 2: done = prev && !cur; break;    /* fall */
+    case 3: done = cur; break;             /* high */
+    case 4: done = !cur; break;            /* low */
+    default:                               /* at once: the value now */
+        done = true;
+        if (sg->input_analog)
+            *v = m->ain[sg->input];
+        break;
+    }
+    if (!done && m->elapsed_s - m->in_since_s >= sg->timeout_s - 1e-9) {
+        *v = -1;                           /* LinuxCNC's time-out answer */
+        done = true;
+    }
+    return done;
+}
+
 /* At the start of a wait for the spindle: hold there until it is at speed. */
 static int wait_here(struct motion *m)
 {
@@ -93,6 +124,20 @@ static int wait_here(struct motion *m)
     m->waiting = 0;
     if (sg->kind != SEG_WAIT || m->ci != sg->k0 || m->waited_at_seg == m->cs + 1)
         return 0;
+    if (sg->wait_input) {
+        double v;
+        if (ios_reached(m) && input_answered(m, sg, &v)) {
+            m->in_waiting = 0;
+            m->waited_at_seg = m->cs + 1;
+            atomic_store_explicit(&m->input_result, v, memory_order_relaxed);
+            atomic_fetch_add_explicit(&m->input_seq, 1, memory_order_release);
+            return 0;
+        }
+        m->waiting = 3;
+        m->tau_s = m->run->kt[m->ci];
+        m->rate = 0;
+        return 1;
+    }
     /* the report counts once the spindle has had the command for MOTION_AT_SPEED_LAG
      * periods: an at-speed that was true for the old speed says nothing of the new */
     bool done = sg->wait_tool ? m->tool_done_seq == m->tool.seq
@@ -231,7 +276,29 @@ static void advance(struct motion *m, double dt)
     if (m->tau_s >= p->total_time_s && m->state != MOTION_PAUSED && !m->waiting) {
         m->tau_s = p->total_time_s;
         m->rate = 0;
-        if (m->chunk && !m->chunk->last) {
+        if (m->chunk && m->chunk->sync) {
+            /* at rest after an M66: on into the next part once the interpreter, which has
+             * the answer now, has planned it */
+            struct motion_chunk *c = m->chunk, *n = atomic_load(&c->next);
+            if (n && n != MOTION_TAIL_TAKEN) {
+                pass_marks_to(m, c->plan.nseg);
+                pass_ios_to(m, c->plan.nseg);
+                /* (the part after the wait may hold no move: the program's end) */
+                m->tau_s = n->plan.nknot ? n->plan.kt[n->k_enter] : 0;
+                m->ci = n->k_enter;
+                m->cs = n->s_enter;
+                m->marks_base += m->marks_done;
+                m->marks_done = 0;
+                m->ios_done = 0;
+                m->paused_at_seg = 0;
+                m->waited_at_seg = 0;
+                m->chunk = n;
+                m->run = &n->plan;
+                atomic_store_explicit(&c->retired, 1, memory_order_release);
+                if (n->plan.nseg == 0 && n->last)
+                    m->state = MOTION_DONE;
+            }
+        } else if (m->chunk && !m->chunk->last) {
             /* the tail of a chunk whose successor never came: stopped on the path */
             const struct motion_seg *e = &p->segs[p->nseg - 1];
             motion_set_msg(m, "%s:%d: the program's next part was not planned in time (the "
@@ -345,6 +412,24 @@ static void pass_ios(struct motion *m)
     pass_ios_to(m, reached_seg(m));
 }
 
+void motion_set_inputs(struct motion *m, const bool *din, int nd, const double *ain, int na)
+{
+    if (!m)
+        return;
+    for (int i = 0; i < nd && i < MOTION_MAX_DIO; i++)
+        m->din[i] = din[i];
+    for (int i = 0; i < na && i < MOTION_MAX_AIO; i++)
+        m->ain[i] = ain[i];
+}
+
+double motion_input_result(const struct motion *m, unsigned *seq)
+{
+    struct motion *w = (struct motion *)m;
+    if (seq)
+        *seq = atomic_load_explicit(&w->input_seq, memory_order_acquire);
+    return atomic_load_explicit(&w->input_result, memory_order_relaxed);
+}
+
 void motion_set_wait_tool(struct motion *m, bool on)
 {
     if (m)
@@ -395,6 +480,8 @@ static double remaining(const struct motion *m)
         return m->streaming ? m->stream_info.time_s : 0;
     if (!m->streaming || !m->chunk)
         return m->run->total_time_s - m->tau_s;
+    if (!m->run->nknot)      /* a streamed end that holds no move */
+        return 0;
     double t = m->chunk->t0_s + m->tau_s - m->run->kt[m->chunk->k_enter];
     return fmax(0, m->stream_info.time_s - t);
 }
@@ -410,6 +497,9 @@ static void stream_watch(struct motion *m)
         struct motion_chunk *c = m->chunk;
         if (!c)
             wait = MOTION_TAIL_TAKEN;
+        else if (c->sync)    /* after the M66 wait: the interpreter reads on */
+            wait = m->tau_s >= c->plan.total_time_s && !m->waiting &&
+                   !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
         else if (!c->last && !m->tail_taken &&
                  !atomic_load_explicit(&c->next, memory_order_acquire) &&
                  c->plan.kt[c->k_leave] - m->tau_s < 0.25)
@@ -438,7 +528,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         advance(m, period_s);  /* must see its own spindle command out */
         pass_marks(m);
         pass_ios(m);
-        int st = evaluate(m);
+        int st = m->run->nseg ? evaluate(m) : KINS_OK;  /* (a streamed end holds no move) */
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
                      "(%s); machine stopped", m->file ? m->file : "program", m->line,

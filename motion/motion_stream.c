@@ -239,9 +239,40 @@ static void shift_window(struct motion_stream *s, size_t cut)
     memcpy(s->start, at, sizeof at);
 }
 
+/* After a sync: the next window starts at rest where this one ended, with the path mode and
+ * the spindle it left. */
+static void restart_window(struct motion_stream *s)
+{
+    for (size_t i = 0; i < s->n; i++) {
+        const struct canon_cmd *c = &s->win[i];
+        if (is_move(c->type))
+            memcpy(s->start, c->end, sizeof s->start);
+        if (c->type == CANON_PATH_MODE)
+            s->tol_mm = motion_blend_tolerance(&s->pm->cfg, c);
+        if (i < s->nctx)
+            continue;
+        if (c->type == CANON_SPINDLE_ON)
+            s->pm->io.dir = c->value < 0 ? -1 : 1;
+        else if (c->type == CANON_SPINDLE_STOP)
+            s->pm->io.dir = 0;
+        else if (c->type == CANON_SPINDLE_SPEED)
+            s->pm->io.rpm = fabs(c->value);
+    }
+    struct canon_cmd pm;
+    memset(&pm, 0, sizeof pm);
+    pm.type = CANON_PATH_MODE;
+    pm.value = s->tol_mm;
+    pm.ivalue = s->tol_mm > 0 ? 640 : 610;
+    s->win[0] = pm;
+    s->n = 1;
+    s->nctx = 0;
+    s->fresh = 0;
+    s->v_enter = 0;
+}
+
 /* Plans the window; with final, all of it (the program's end), else up to a cut when one
  * fits (returns MOTION_OK and plans nothing when not: more commands are needed). */
-static int plan_window(struct motion_stream *s, bool final)
+static int plan_window(struct motion_stream *s, bool final, bool sync)
 {
     struct motion *pm = s->pm;
     size_t cut = final ? SIZE_MAX : choose_cut(s);
@@ -302,7 +333,8 @@ static int plan_window(struct motion_stream *s, bool final)
     c->s_enter = s_enter;
     c->k_leave = k_leave;
     c->s_leave = s_leave;
-    c->last = final;
+    c->last = final && !sync;
+    c->sync = sync;
     c->t0_s = s->t_done_s;
     s->v_enter = final ? 0 : p->kv[k_leave];
     s->t_done_s += t;
@@ -323,6 +355,8 @@ static int plan_window(struct motion_stream *s, bool final)
     memset(p, 0, sizeof *p);
     if (!final)
         shift_window(s, cut);
+    else if (sync)
+        restart_window(s);
     else
         s->n = 0;
     return publish(s, c);
@@ -353,7 +387,7 @@ int motion_stream_add(struct motion_stream *s, const struct canon_cmd *cmd)
      * over (the tail): each command is planned about twice, however long the tail */
     if (++s->fresh >= STREAM_WINDOW && s->fresh % 256 == 0 &&
         (2 * s->fresh >= s->n || s->n >= STREAM_WINDOW_MAX))
-        return plan_window(s, false);
+        return plan_window(s, false, false);
     return MOTION_OK;
 }
 
@@ -361,7 +395,14 @@ int motion_stream_finish(struct motion_stream *s)
 {
     if (s->status)
         return s->status;
-    return plan_window(s, true);
+    return plan_window(s, true, false);
+}
+
+int motion_stream_sync(struct motion_stream *s)
+{
+    if (s->status)
+        return s->status;
+    return plan_window(s, true, true);
 }
 
 const char *motion_stream_error(const struct motion_stream *s)

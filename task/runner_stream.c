@@ -39,6 +39,7 @@ struct stream_sink {
     const _Atomic int *stop;
     _Atomic int *first_ready;        /* run pass: set once the first chunk is out */
     size_t settings;
+    unsigned waits;                  /* M66 waits sent to the machine */
     int status;                      /* RUNNER_ERR_* of the first error */
     char err[800];
 };
@@ -116,10 +117,40 @@ static int take(struct stream_sink *k, const struct canon_cmd *c)
     return 0;
 }
 
+/* M66 on a run: the window so far goes to the machine to a stop at the wait; the
+ * interpreter reads on with the machine's answer once it has it (LinuxCNC's M66 is a
+ * "queue buster" too). The verification pass reads 0, as rs274 does. */
+static double input_answer(void *ctx, const struct canon_cmd *w)
+{
+    struct stream_sink *k = ctx;
+    (void)w;
+    if (!k->run || k->status)
+        return 0;
+    if (motion_stream_sync(k->ms) != MOTION_OK) {
+        sink_fail(k, RUNNER_ERR_PLAN, "%s", motion_stream_error(k->ms));
+        return 0;
+    }
+    atomic_store(k->first_ready, 1);
+    k->waits++;
+    for (;;) {
+        unsigned seq;
+        double v = motion_input_result(k->r->motion, &seq);
+        if (seq >= k->waits)
+            return v;
+        if (atomic_load(k->stop)) {
+            sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+            return 0;
+        }
+        sleep_ms(1);
+    }
+}
+
 static int sink(void *ctx, const struct canon_cmd *c)
 {
     struct stream_sink *k = ctx;
     struct stream_cut *cut = &k->cut;
+    if (k->status)
+        return -1;
     if (!cut->started && c->line >= cut->from_line && c->type != CANON_OFFSETS) {
         cut->started = true;
         if (cut->from_line > 1) {
@@ -364,6 +395,7 @@ int runner_stream_start(struct runner *r, const char *path, int from_line, char 
     rs->sink.stop = &rs->stop;
     rs->sink.first_ready = &rs->first_ready;
     rs->sink.cut.from_line = from_line > 1 ? from_line : 1;
+    interp_set_input_fn(r->interp, input_answer, &rs->sink);
     if (pthread_create(&rs->thread, NULL, producer, r) != 0) {
         st = errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "cannot start the planner's thread");
         goto fail;

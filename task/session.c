@@ -49,6 +49,11 @@ bool session_at_rest(const struct session *s)
 bool session_busy(const struct session *s)
 {
     enum motion_state st = session_mstate(s);
+    struct motion_out o;
+    /* a program held by M66 waits on the world outside: the simulated clock then keeps the
+     * wall clock's pace, so that its time-out means what it says to whoever sets the input */
+    if (s->running && motion_hal_out(s->hal, &o) == MOTION_OK && o.waiting == 3)
+        return false;
     return s->running || st == MOTION_MANUAL || motion_homing(s->m);
 }
 
@@ -219,6 +224,10 @@ static void run_outcome(struct session *s, enum motion_state st)
     else if (!s->run_is_mdi)
         session_message(s, "info", "task", "program finished");
     s->stopping = false;
+    unsigned waits;
+    double answer = motion_input_result(s->m, &waits);
+    if (s->run_is_mdi && waits > 0)  /* an MDI line's M66: the next lines read its answer */
+        interp_set_param(s->mdi, 5399, answer);
     if (!s->run_is_mdi)
         mdi_renew(s);
 }

@@ -246,6 +246,72 @@ START_TEST(stream_check_reports_line)
 }
 END_TEST
 
+/* M66 streamed: the window up to the wait goes out (sync), the machine waits on the input
+ * until its time-out, answers -1, and the next window starts at rest there; the time is the
+ * whole plan's. */
+START_TEST(stream_sync_on_input_wait)
+{
+    struct tm_machine whole, st;
+    ck_assert_int_eq(tm_open(&whole, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    ck_assert_int_eq(tm_open(&st, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double home[6] = {0, 0, 645, 0, 0, 0}, a[6] = {5, 0, 645, 0, 0, 0}, b[6] = {5, 5, 645, 0, 0, 0};
+    memcpy(p.start, home, sizeof home);
+    tm_add(&p, CANON_FEED, 1, a, 3000, 0);
+    tm_add(&p, CANON_WAIT_INPUT, 2, NULL, 0, 0.5);
+    p.cmds[1].wait_mode = 3;                 /* high, input 0: never comes */
+    tm_add(&p, CANON_FEED, 3, b, 3000, 0);
+    tm_add(&p, CANON_PROGRAM_END, 4, NULL, 0, 0);
+    char err[400];
+    ck_assert_msg(motion_load(whole.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(whole.m), MOTION_OK);
+    struct tm_stats sw;
+    tm_run(whole.m, DT, 100000, &sw, NULL, NULL);
+    ck_assert_int_eq(sw.last.state, MOTION_DONE);
+
+    struct motion_stream *s = NULL;
+    ck_assert_int_eq(motion_stream_create(st.m, p.start, NULL, &s, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(motion_stream_attach(st.m, s, NULL), MOTION_OK);
+    ck_assert_int_eq(motion_stream_add(s, &p.cmds[0]), MOTION_OK);
+    ck_assert_int_eq(motion_stream_add(s, &p.cmds[1]), MOTION_OK);
+    ck_assert_int_eq(motion_stream_sync(s), MOTION_OK);
+    ck_assert_int_eq(motion_start(st.m), MOTION_OK);
+    struct motion_out o;
+    unsigned seq = 0;
+    int k = 0;
+    for (; k < 100000 && seq == 0; k++) {
+        motion_step(st.m, DT, &o);
+        motion_input_result(st.m, &seq);
+    }
+    ck_assert_uint_eq(seq, 1);
+    ck_assert_double_eq(motion_input_result(st.m, NULL), -1);
+    for (int j = 0; j < 50; j++) {           /* at rest there until the next part comes */
+        motion_step(st.m, DT, &o);
+        ck_assert_double_eq(o.path_vel, 0);
+        ck_assert(motion_stream_starving(st.m));
+    }
+    ck_assert_int_eq(motion_stream_add(s, &p.cmds[2]), MOTION_OK);
+    ck_assert_int_eq(motion_stream_add(s, &p.cmds[3]), MOTION_OK);
+    ck_assert_int_eq(motion_stream_finish(s), MOTION_OK);
+    struct tm_stats ss;
+    tm_run(st.m, DT, 100000, &ss, NULL, NULL);
+    ck_assert_int_eq(ss.last.state, MOTION_DONE);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_lt(fabs(ss.last.pose[i] - b[i]), 1e-9);
+    /* the whole plan's time, plus the 50 periods it was held for the next part */
+    printf("M66 streamed: %.3f s (whole plan %.3f s)\n", ss.last.time_elapsed_s,
+           sw.last.time_elapsed_s);
+    ck_assert_double_lt(fabs(ss.last.time_elapsed_s - 0.050 - sw.last.time_elapsed_s), 0.003);
+    ck_assert_double_gt(sw.last.time_elapsed_s, 0.5);
+    motion_stream_detach(st.m);
+    motion_stream_destroy(s);
+    canon_prog_free(&p);
+    tm_close(&whole);
+    tm_close(&st);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("motion_stream");
@@ -255,6 +321,7 @@ int main(void)
     tcase_add_test(tc, stream_starved_stops_on_path);
     tcase_add_test(tc, stream_pause_resume_abort);
     tcase_add_test(tc, stream_check_reports_line);
+    tcase_add_test(tc, stream_sync_on_input_wait);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

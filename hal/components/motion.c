@@ -62,6 +62,8 @@ struct motion_comp {
     int ndio, naio;                          /* [EMCMOT] NUM_DIO, NUM_AIO */
     bool *dout[MOTION_MAX_DIO];              /* out: motion.digital-out-NN (M62..M65) */
     double *aout[MOTION_MAX_AIO];            /* out: motion.analog-out-NN (M67, M68) */
+    bool *din[MOTION_MAX_DIO];               /* in: motion.digital-in-NN (M66 P) */
+    double *ain[MOTION_MAX_AIO];             /* in: motion.analog-in-NN (M66 E) */
     /* the tool changer's handshake, LinuxCNC's iocontrol pins */
     int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
     bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
@@ -217,6 +219,13 @@ static void motion_comp_update(void *arg, long period_ns)
         sw[i] = *c->home_sw[i];
     }
     motion_set_home_switches(c->m, sw);
+    bool din[MOTION_MAX_DIO];
+    double ain[MOTION_MAX_AIO];
+    for (int i = 0; i < c->ndio; i++)
+        din[i] = *c->din[i];
+    for (int i = 0; i < c->naio; i++)
+        ain[i] = *c->ain[i];
+    motion_set_inputs(c->m, din, c->ndio, ain, c->naio);
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
@@ -311,6 +320,10 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
         st = hal_pin_bit_newf(h, HAL_OUT, &c->dout[i], "motion.digital-out-%02d", i);
     for (int i = 0; st == HAL_OK && i < c->naio; i++)
         st = hal_pin_float_newf(h, HAL_OUT, &c->aout[i], "motion.analog-out-%02d", i);
+    for (int i = 0; st == HAL_OK && i < c->ndio; i++)
+        st = hal_pin_bit_newf(h, HAL_IN, &c->din[i], "motion.digital-in-%02d", i);
+    for (int i = 0; st == HAL_OK && i < c->naio; i++)
+        st = hal_pin_float_newf(h, HAL_IN, &c->ain[i], "motion.analog-in-%02d", i);
     if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");

@@ -296,6 +296,51 @@ def plain_session(tmp):
     st = c.wait()
     check("runs again from a line after the e-stop", st["motion"] == "done", st["motion"])
 
+    # M66: a time-out, a wait until an input is set, an analog input read at once; the
+    # branches after each take the machine's answer (#5399)
+    c.ok("hal.set", name="motion.analog-in-00", value=2.5)
+    prog = os.path.join(tmp, "m66.ngc")
+    open(prog, "w").write("G21 G90\nG0 X0 Y0 Z645 A0 B0 C0\n"
+                          "M66 P0 L3 Q0.5\n"                      # line 3: times out
+                          "O100 if [#5399 LT 0]\nG1 X5 F3000\nO100 else\nG1 X-5 F3000\n"
+                          "O100 endif\n"
+                          "M66 P1 L1 Q30\n"                       # line 9: a rise of input 1
+                          "O101 if [#5399 EQ 1]\nG1 Y5\nO101 endif\n"
+                          "M66 E0 L0\nG1 Z[645 + #5399]\nM2\n")
+    c.ok("program.open", path=prog)
+    c.ok("program.run")
+    t = time.time()
+    waits = []
+    while time.time() - t < 30:
+        st = c.status()
+        if st["interp"] == "waiting":
+            waits.append((st["line"], st["time"], st["machine_pose"]["commanded"][:2]))
+        if st["line"] == 9 and st["interp"] == "waiting":
+            break
+        time.sleep(0.005)
+    first = [w for w in waits if w[0] == 3]
+    check("M66 P0 L3 Q0.5 waits its 0.5 s, then times out (#5399 -1: the X5 branch)",
+          first and waits[-1][0] == 9 and abs(waits[-1][2][0] - 5) < 1e-6 and
+          0.3 < first[-1][1] - first[0][1] <= 0.55, waits[:1] + waits[-1:])
+    t9 = c.status()["time"]
+    time.sleep(0.3)
+    st = c.status()
+    check("M66 P1 L1 waits for input 1 to rise", st["interp"] == "waiting" and
+          st["line"] == 9 and st["time"] - t9 > 0.1, (st["interp"], st["line"], st["time"]))
+    c.ok("hal.set", name="motion.digital-in-01", value=True)
+    st = c.wait()
+    q = st["machine_pose"]["commanded"]
+    check("... the rise ends the wait (#5399 1: Y5), M66 E0 reads 2.5 (Z647.5)",
+          st["motion"] == "done" and max(abs(a - b) for a, b in zip(q[:3], [5, 5, 647.5]))
+          < 1e-6, (st["motion"], st["error"], q))
+    c.ok("hal.set", name="motion.digital-in-01", value=False)
+    c.ok("mdi.execute", line="M66 P1 L3 Q0.2")
+    c.wait()
+    c.ok("mdi.execute", line="G0 Z[645 + #5399]")
+    st = c.wait()
+    check("MDI: M66 times out and the next line reads #5399 -1",
+          abs(st["machine_pose"]["commanded"][2] - 644) < 1e-6, st["machine_pose"])
+
     # control: a second client is refused while the first holds it
     c.ok("control.acquire")
     d = Conn(sock)
