@@ -35,7 +35,7 @@ static void drop_calls(struct oword *ow)
 /* Adds one text (the program, or a subroutine file) with its line table; returns its index
  * or -1 when out of memory. owned: the text to free with the interpreter, or NULL. */
 static int text_add(struct oword *ow, char *owned, const char *text, size_t len,
-                    const char *file)
+                    const char *file, int mapped)
 {
     if (ow->ntexts == ow->captexts) {
         int cap = ow->captexts ? ow->captexts * 2 : 4;
@@ -45,21 +45,41 @@ static int text_add(struct oword *ow, char *owned, const char *text, size_t len,
         ow->texts = t;
         ow->captexts = cap;
     }
-    size_t n = 1;
-    for (const char *p = text; (p = memchr(p, '\n', (size_t)(text + len - p))); p++)
-        n++;
-    if (n > 1 && len > 0 && text[len - 1] == '\n')
-        n--;  /* a final newline does not start another line */
-    if (n > (size_t)INT_MAX - 1)
-        return -1;
-    size_t *off = malloc((n / OW_STRIDE + 1) * sizeof *off);
+    /* one pass: count the lines and note every OW_STRIDE-th line's start; a mapped program
+     * gives its pages back behind the scan, as the reader does later (release_behind) */
+    size_t n = 1, cap = 1024, page = (size_t)sysconf(_SC_PAGESIZE), released = 0;
+    size_t *off = malloc(cap * sizeof *off);
     if (!off)
         return -1;
-    size_t k = 0;
     off[0] = 0;
-    for (const char *p = text; (p = memchr(p, '\n', (size_t)(text + len - p))); p++)
-        if (++k % OW_STRIDE == 0 && k < n)
-            off[k / OW_STRIDE] = (size_t)(p + 1 - text);
+    for (const char *p = text; (p = memchr(p, '\n', (size_t)(text + len - p))); p++) {
+        size_t at = (size_t)(p + 1 - text);
+        if (n % OW_STRIDE == 0) {
+            if (n / OW_STRIDE >= cap) {
+                size_t *no = realloc(off, 2 * cap * sizeof *off);
+                if (!no) {
+                    free(off);
+                    return -1;
+                }
+                off = no, cap *= 2;
+            }
+            off[n / OW_STRIDE] = at;
+        }
+        n++;
+        if (mapped && at >= released + ((size_t)16 << 20)) {
+            size_t upto = at / page * page;
+            madvise((char *)text + released, upto - released, MADV_DONTNEED);
+            released = upto;
+        }
+    }
+    if (n > 1 && len > 0 && text[len - 1] == '\n')
+        n--;  /* a final newline does not start another line */
+    if (mapped && released > 0)
+        madvise((char *)text, released, MADV_DONTNEED);
+    if (n > (size_t)INT_MAX - 1) {
+        free(off);
+        return -1;
+    }
     struct ow_text *t = &ow->texts[ow->ntexts];
     t->owned = owned;
     t->text = text;
@@ -68,7 +88,7 @@ static int text_add(struct oword *ow, char *owned, const char *text, size_t len,
     t->nlines = (int)n;
     t->cur_idx = 0;
     t->cur_off = 0;
-    t->mapped = 0;
+    t->mapped = mapped;
     t->released = 0;
     snprintf(t->file, sizeof t->file, "%s", file);
     return ow->ntexts++;
@@ -89,9 +109,8 @@ int oword_begin(struct interp *in, const char *text, size_t len)
     ow->loops = 0;
     if (!ow->loop_limit)
         ow->loop_limit = OWORD_LOOP_LIMIT;
-    if (text_add(ow, NULL, text, len, in->file) < 0)
+    if (text_add(ow, NULL, text, len, in->file, in->text_mapped) < 0)
         return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory reading the program");
-    ow->texts[0].mapped = in->text_mapped;
     return 0;
 }
 
@@ -383,7 +402,7 @@ static int find_sub(struct interp *in, const char *label, int *text, int *idx)
             fclose(f);
             if (!buf)
                 return interp_fail(in, INTERP_ERR_NOMEM, 1, "out of memory reading %s", path);
-            int t = text_add(ow, buf, buf, len, path);
+            int t = text_add(ow, buf, buf, len, path, 0);
             if (t < 0) {
                 free(buf);
                 return interp_fail(in, INTERP_ERR_NOMEM, 1, "out of memory reading %s", path);

@@ -82,6 +82,9 @@ int session_need_on(struct session *s, const char *what, char *err, size_t len)
 
 int session_need_idle(struct session *s, const char *what, char *err, size_t len)
 {
+    if (s->checking)
+        return errbuf_set(err, len, RPC_STATE, "%s refused: program.check is under way (it "
+                          "answers when it ends; program.abort stops it)", what);
     if (s->running)
         return errbuf_set(err, len, RPC_STATE, "%s refused: %s is running (program.abort first)",
                     what, s->run_is_mdi ? "an MDI line" : "a program");
@@ -235,6 +238,7 @@ static void run_outcome(struct session *s, enum motion_state st)
 void session_tick(struct session *s)
 {
     drain_hal_messages(s);
+    session_check_poll(s, false);
     enum motion_state st = session_mstate(s);
     if (s->state == SESS_ON && !*s->r->emc_enable_in) {
         s->state = SESS_ESTOP;
@@ -360,6 +364,8 @@ void session_destroy(struct session *s)
 {
     if (!s)
         return;
+    s->check_cancel = 1;          /* a check under way stops at its next line */
+    session_check_poll(s, true);
     session_server_close(s);
     runner_destroy(s->r);
     interp_destroy(s->mdi);

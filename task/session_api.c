@@ -548,6 +548,11 @@ json_t *session_dispatch(struct session *s, struct session_client *c, const char
         code = m->fn(s, c, params ? params : empty, &result, err, sizeof err);
         json_decref(empty);
     }
+    if (code == RPC_DEFERRED) {  /* the answer comes when the work ends */
+        s->check_client = c->id;
+        s->check_id = id ? json_incref(id) : NULL;
+        goto out;
+    }
     if (!id) {           /* a notification: no answer */
         json_decref(result);
         goto out;

@@ -3,6 +3,9 @@
 #define HEXCNC_TASK_SESSION_PRIV_H
 
 #include <jansson.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -75,7 +78,21 @@ struct session {
     struct session_client *cl[SESSION_MAX_CLIENTS];
     unsigned next_id;
     unsigned holder;             /* client id holding control, 0: none */
+    /* program.check runs on its own thread, so that a long file stalls nobody; its answer
+     * goes to the client that asked when it ends (session_check_poll) */
+    pthread_t check_thread;
+    bool checking;
+    _Atomic int check_done;
+    volatile sig_atomic_t check_cancel;
+    unsigned check_client;       /* who asked */
+    json_t *check_id;            /* their request's id (NULL: a notification) */
+    int check_status;
+    char check_err[800];
+    struct motion_plan_info check_info;
 };
+
+/* A method's answer comes later (session_dispatch keeps the request's id). */
+#define RPC_DEFERRED 1
 
 /* session.c: commands (each returns 0 or an RPC error code with the message in err). */
 int session_estop(struct session *s, bool active, char *err, size_t len);
@@ -100,6 +117,8 @@ int session_tooltable_set(struct session *s, const struct session_tool_edit *e, 
 int session_mdi(struct session *s, const char *line, char *err, size_t len);
 int session_open(struct session *s, const char *path, char *err, size_t len);
 int session_check(struct session *s, json_t **result, char *err, size_t len);
+/* The end of a program.check: its answer to the client that asked (session_tick). */
+void session_check_poll(struct session *s, bool wait);
 int session_run_program(struct session *s, int from_line, char *err, size_t len);
 int session_pause(struct session *s, char *err, size_t len);
 int session_resume(struct session *s, char *err, size_t len);

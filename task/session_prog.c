@@ -97,6 +97,9 @@ int session_open(struct session *s, const char *path, char *err, size_t len)
 {
     if (s->running)
         return errbuf_set(err, len, RPC_STATE, "program.open refused: a program is running");
+    if (s->checking)
+        return errbuf_set(err, len, RPC_STATE, "program.open refused: program.check is under "
+                          "way");
     char full[1024];
     resolve_program(s, path, full, sizeof full);
     struct stat st;
@@ -122,27 +125,74 @@ int session_open(struct session *s, const char *path, char *err, size_t len)
     return 0;
 }
 
+/* The line an error message names ("file:LINE:..."), 0 when none. */
+static int session_error_line(const char *msg)
+{
+    for (const char *p = strchr(msg, ':'); p; p = strchr(p + 1, ':')) {
+        char *end;
+        long n = strtol(p + 1, &end, 10);
+        if (end > p + 1 && *end == ':' && n > 0 && n < 1000000000L)
+            return (int)n;
+    }
+    return 0;
+}
+
+static void *check_main(void *arg)
+{
+    struct session *s = arg;
+    s->check_status = runner_check_stream(s->r, s->program, &s->check_info, s->check_err,
+                                          sizeof s->check_err);
+    atomic_store(&s->check_done, 1);
+    return NULL;
+}
+
+/* program.check: the verification pass streams over the whole file in bounded memory, on
+ * its own thread; the session goes on serving (status, e-stop) meanwhile and answers the
+ * caller when it ends. A run of the same file from the same place then starts at once. */
 int session_check(struct session *s, json_t **result, char *err, size_t len)
 {
     int rc;
+    (void)result;
     if (!s->program[0])
         return errbuf_set(err, len, RPC_STATE, "program.check: no program is open (program.open)");
     if ((rc = session_need_idle(s, "program.check", err, len)))
         return rc;
-    char msg[800];
-    struct motion_plan_info pi;
-    /* the verification pass streams over the whole file in bounded memory; a run of the
-     * same file from the same place starts without checking it again */
-    int st = runner_check_stream(s->r, s->program, &pi, msg, sizeof msg);
-    if (st != RUNNER_OK) {
-        *result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line", 0, "text",
-                            msg);
-        return 0;
+    atomic_store(&s->check_done, 0);
+    s->check_cancel = 0;
+    runner_set_cancel(s->r, &s->check_cancel);
+    if (pthread_create(&s->check_thread, NULL, check_main, s) != 0)
+        return errbuf_set(err, len, RPC_FAILED, "program.check: cannot start its thread");
+    s->checking = true;
+    return RPC_DEFERRED;
+}
+
+void session_check_poll(struct session *s, bool wait)
+{
+    if (!s->checking || (!wait && !atomic_load(&s->check_done)))
+        return;
+    pthread_join(s->check_thread, NULL);
+    s->checking = false;
+    runner_set_cancel(s->r, NULL);
+    json_t *result;
+    if (s->check_status != RUNNER_OK)
+        result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line",
+                           session_error_line(s->check_err), "text", s->check_err);
+    else
+        result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
+                           s->check_info.time_s, "length_mm", s->check_info.length_mm,
+                           "segments", (json_int_t)s->check_info.segments);
+    for (int i = 0; i < SESSION_MAX_CLIENTS && s->check_id; i++) {
+        struct session_client *c = s->cl[i];
+        if (c && c->id == s->check_client) {
+            json_t *resp = json_pack("{s:s, s:O, s:O}", "jsonrpc", "2.0", "id", s->check_id,
+                                     "result", result);
+            session_server_send(s, c, resp);
+            json_decref(resp);
+        }
     }
-    *result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
-                        pi.time_s, "length_mm", pi.length_mm, "segments",
-                        (json_int_t)pi.segments);
-    return 0;
+    json_decref(result);
+    json_decref(s->check_id);
+    s->check_id = NULL;
 }
 
 int session_run_program(struct session *s, int from_line, char *err, size_t len)
@@ -199,6 +249,8 @@ int session_step(struct session *s, char *err, size_t len)
 
 int session_abort(struct session *s, char *err, size_t len)
 {
+    if (s->checking)
+        s->check_cancel = 1;     /* the check stops at its next line and says so */
     if (!s->running) {
         struct motion_hal_cmd c = { .kind = MOTION_CMD_JOG_STOP };
         return s->state == SESS_ON ? session_push(s, &c, err, len) : 0;

@@ -70,7 +70,22 @@ def main():
         c.wait()
         c.ok("program.open", path=prog)
         t = time.time()
-        r = c.ok("program.check")
+        rid = c.send("program.check")
+        # the check runs on its own thread: the session goes on answering meanwhile
+        d = ms.Conn(sock)
+        lat = []
+        for _ in range(20):
+            t1 = time.time()
+            st = d.status()
+            lat.append(time.time() - t1)
+        r2 = d.call("program.run")
+        check("status is answered during the check (slowest of 20: %.1f ms)" %
+              (max(lat) * 1e3), max(lat) < 0.5 and st["state"] == "on", lat)
+        check("program.run during the check is refused, saying why",
+              ms.err_code(r2) == -32001 and "program.check is under way" in
+              r2["error"]["message"], r2)
+        d.s.close()
+        r = c.reply(rid)["result"]
         t_check = time.time() - t
         check("program.check of %d lines: ok" % LINES, r["ok"] and r["segments"] > LINES,
               r)
@@ -173,6 +188,30 @@ def main():
         check("a 12,000-move program streams to its end, its last point", st["motion"] ==
               "done" and st["error"] is None and max(abs(a - b) for a, b in zip(q, end)) <
               1e-4, (st["motion"], st["error"], q))
+        # the paper's programs: the session's (streamed) check agrees with `hexcnc check`,
+        # and one runs to its end in the time planned
+        import json
+        import subprocess
+        for name in ("prog10_g141_d20", "prog11_g142_d10"):
+            path = os.path.join(ms.ROOT, "examples", "paper", name + ".ngc")
+            whole = json.loads(subprocess.run(
+                [ms.BIN, "check", "--json", os.path.join(ms.SIM, "tmu-hexapod.ini"), path],
+                capture_output=True, text=True, check=True).stdout)
+            c.ok("mdi.execute", line="G0 X0 Y0 Z645 A0 B0 C0")
+            c.wait()
+            c.ok("program.open", path=path)
+            r = c.ok("program.check")
+            check("%s: program.check %.3f s planned, hexcnc check %.3f s" %
+                  (name, r["time_s"], whole["planned_time_s"]), r["ok"] and whole["ok"] and
+                  abs(r["time_s"] - whole["planned_time_s"]) < 1e-6 * whole["planned_time_s"],
+                  (r, whole["planned_time_s"]))
+        t0 = c.status()["time"]
+        c.ok("program.run")
+        st = c.wait(300)
+        took = st["time"] - t0
+        check("prog11_g142_d10 runs to its end in the time planned (%.2f s of %.2f s)" %
+              (took, r["time_s"]), st["motion"] == "done" and st["error"] is None and
+              abs(took - r["time_s"]) < 0.01 * r["time_s"], (st["motion"], st["error"], took))
         check("stream session exits 0", ms.stop(p, c) == 0)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
