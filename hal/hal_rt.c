@@ -112,6 +112,13 @@ static bool hal_rt_lock_memory(void)
     struct rlimit rl;
     if (geteuid() != 0 && (getrlimit(RLIMIT_MEMLOCK, &rl) != 0 || rl.rlim_cur != RLIM_INFINITY))
         return false;
+    /* MCL_ONFAULT: later mappings are locked page by page as they are touched, not read in
+     * whole when mapped (a program file the interpreter maps, interp_run_file, would else be
+     * read and locked entirely at once) */
+#ifdef MCL_ONFAULT
+    if (mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT) == 0)
+        return true;
+#endif
     return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
 }
 

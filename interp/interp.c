@@ -365,6 +365,9 @@ int interp_run_file(struct interp *in, const char *path, canon_sink_fn sink, voi
         if (map == MAP_FAILED)
             return interp_fail(in, INTERP_ERR_IO, 0, "cannot read the program: %s",
                                strerror(errno));
+        /* not locked in memory (a real-time process locks what it maps): the reader gives
+         * back the pages it has passed (oword.c), which locked pages would refuse */
+        munlock(map, len);
         madvise(map, len, MADV_SEQUENTIAL);
         in->text_mapped = 1;
         int rc = interp_run_text(in, path, map, len, sink, ctx);
