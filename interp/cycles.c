@@ -200,6 +200,10 @@ int interp_cycle(struct interp *in, int g)
             return interp_fail(in, INTERP_ERR_CYCLE, W('l'), "L (repeats) must be 1 to %d, not "
                                "%d", CYCLE_MAX_REPEATS, reps);
     }
+    if (in->blk.polar_inc && !(c.ax.u == 0 && c.ax.v == 1))
+        return interp_fail(in, INTERP_ERR_CYCLE, in->blk.col[26] ? in->blk.col[26]
+                           : in->blk.col[27], "G91 polar coordinates (@ ^) in a canned cycle "
+                           "need the XY plane (G17)");
     double cur[6], step[2];
     interp_prog_pos(in, cur);
     /* The level a series of cycle blocks started from on the drilling axis (LinuxCNC's
@@ -227,8 +231,12 @@ int interp_cycle(struct interp *in, int g)
     if (restore)
         CHP(path_mode(in, 610, 0.0));
     for (int i = 0; i < reps; i++) {
-        c.x += step[0];
-        c.y += step[1];
+        if (in->blk.polar_inc && c.ax.u == 0 && c.ax.v == 1) {
+            interp_polar_step(in, &c.x, &c.y);  /* G91 polar: each repeat turns about */
+        } else {                               /* the origin (LinuxCNC) */
+            c.x += step[0];
+            c.y += step[1];
+        }
         double over = i == 0 && cur_z > c.r ? cur_z : c.clear; /* level of the rapid over */
         CHP(cyc_move(in, &c, CANON_TRAVERSE, c.x, c.y, over));
         if (over > c.r)

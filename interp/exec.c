@@ -227,7 +227,7 @@ void interp_target(struct interp *in, int machine, double t[6])
         double v = i < 3 ? interp_len_mm(in, V(ax[i])) : V(ax[i]);
         if (machine)
             t[i] = v;
-        else if (in->incremental)
+        else if (in->incremental && !(i < 2 && in->blk.polar_inc))
             t[i] = in->pos[i] + v;
         else
             t[i] = v + in->g5x[i] + in->g92[i] + in->tool[i];
@@ -428,11 +428,61 @@ static int flush_comp5(struct interp *in)
     return 0;
 }
 
+#define DEG (M_PI / 180.0)
+
+void interp_polar_step(const struct interp *in, double *x, double *y)
+{
+    const struct interp_block *b = &in->blk;
+    double r = hypot(*x, *y) + (b->col[26] ? b->val[26] : 0);
+    double a = atan2(*y, *x) + (b->col[27] ? b->val[27] * DEG : 0);
+    *x = r * cos(a);
+    *y = r * sin(a);
+}
+
+/* @ and ^ to X and Y words: G90 takes the radius and angle about the program origin (the
+ * current one for a word left out), G91 adds them to the current point's (which must not be
+ * the origin, where its angle is not defined). LinuxCNC's rules: in the XY plane, which must
+ * be the plane in force when the block starts (a G18 in the same block does not count). */
+int interp_polar_words(struct interp *in)
+{
+    struct interp_block *b = &in->blk;
+    int col = b->col[26] ? b->col[26] : b->col[27];
+    if (!col)
+        return 0;
+    if (b->plane_before != 17)  /* rs274 checks the plane the block starts in */
+        return interp_fail(in, INTERP_ERR_WORD, col, "polar coordinates (@ ^) need the XY "
+                           "plane (G17) in force before the block");
+    if (W('x') || W('y'))
+        return interp_fail(in, INTERP_ERR_WORD, W('x') ? W('x') : W('y'), "%c and polar "
+                           "coordinates (@ ^) in one block: give the point one way",
+                           W('x') ? 'X' : 'Y');
+    double cur[6];
+    interp_prog_pos(in, cur);
+    double x = cur[0], y = cur[1];
+    if (in->incremental) {
+        if (fabs(x) < 1e-12 && fabs(y) < 1e-12)
+            return interp_fail(in, INTERP_ERR_WORD, col, "G91 with polar coordinates at the "
+                               "origin: the angle of the present point is not defined");
+        interp_polar_step(in, &x, &y);
+        b->polar_inc = 1;
+    } else {
+        double r = b->col[26] ? b->val[26] : hypot(x, y);
+        double a = b->col[27] ? b->val[27] * DEG : atan2(y, x);
+        x = r * cos(a);
+        y = r * sin(a);
+    }
+    b->col['x' - 'a'] = b->col['y' - 'a'] = col;
+    b->val['x' - 'a'] = x;
+    b->val['y' - 'a'] = y;
+    return 0;
+}
+
 /* The motion of the block: G0 G1 G2 G3, canned cycles, G53 moves. */
 static int exec_motion(struct interp *in)
 {
     struct interp_block *b = &in->blk;
     int g0 = b->g[0];
+    CHP(interp_polar_words(in));
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
         if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
@@ -525,6 +575,7 @@ int interp_execute(struct interp *in)
     }
     int g0 = b->g[0];
     int comp = g0 == 1410 || g0 == 1420;
+    b->plane_before = in->plane;
     if (!comp && !block_empty(b))
         CHP(flush_comp5(in));
     if (b->has_comment) {

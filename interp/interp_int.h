@@ -31,8 +31,12 @@ enum {
 
 /* One block as read: words by letter, G and M codes by modal group, #n= settings. */
 struct interp_block {
-    double val[26];              /* value of each letter word ('a' = 0) */
-    int col[26];                 /* 1-based column of each word, 0 = absent */
+    double val[28];              /* value of each letter word ('a' = 0; '@' 26, '^' 27) */
+    int col[28];                 /* 1-based column of each word, 0 = absent */
+    int plane_before;            /* the plane in force before this block (polar words) */
+    int polar_inc;               /* G91 polar words: each cycle repeat turns about the origin
+                                  * (interp_polar_step); X and Y hold the point itself, not
+                                  * a step (interp_target), as LinuxCNC computes it */
     int g[INTERP_GROUPS];        /* G code x10 per group (G92.1 = 921), -1 = none */
     int gcol[INTERP_GROUPS];
     int m[INTERP_MGROUPS];       /* M code per group, -1 = none */
@@ -259,6 +263,11 @@ int interp_emit_tool_setting(struct interp *in, int tool);
 /* exec.c: runs the block in in->blk in LinuxCNC's order of execution. */
 int interp_execute(struct interp *in);
 int interp_emit(struct interp *in, struct canon_cmd *c);
+/* Polar coordinates (@ radius, ^ angle, in the XY plane about the program origin): the
+ * block's X and Y words made from them, as G90 or G91 reads them (exec.c). */
+int interp_polar_words(struct interp *in);
+/* The next point of a G91 polar step from (x, y), program units (cycle repeats). */
+void interp_polar_step(const struct interp *in, double *x, double *y);
 void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t);
 double interp_len_mm(const struct interp *in, double v); /* program length -> mm */
 void interp_prog_pos(const struct interp *in, double prog[6]); /* current pos, program units */

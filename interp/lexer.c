@@ -9,6 +9,7 @@
 static void block_reset(struct interp_block *b)
 {
     memset(b->col, 0, sizeof b->col);
+    b->polar_inc = 0;
     for (int i = 0; i < INTERP_GROUPS; i++)
         b->g[i] = -1;
     for (int i = 0; i < INTERP_MGROUPS; i++)
@@ -133,7 +134,7 @@ static int read_word(struct interp *in, int *pos)
     if ((c < ' ' || c > '~') && c != 0)  /* control or non-ASCII byte: shown as a code */
         return interp_fail(in, INTERP_ERR_SYNTAX, col, "byte 0x%02X is not G-code text (G-code "
                            "is ASCII)", (unsigned)(unsigned char)c);
-    if (c < 'a' || c > 'z')
+    if ((c < 'a' || c > 'z') && c != '@' && c != '^')
         return interp_fail(in, INTERP_ERR_SYNTAX, col,
                            c >= '0' && c <= '9' ? "a number without a word letter before it"
                                                 : "'%c' is not a G-code word",
@@ -143,7 +144,8 @@ static int read_word(struct interp *in, int *pos)
     while (in->norm[k] >= 'a' && in->norm[k] <= 'z')
         k++;
     if (in->norm[*pos] == 0 || (k > *pos && in->norm[k] != '['))
-        return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value", c - 32);
+        return interp_fail(in, INTERP_ERR_SYNTAX, col, "%c word without a value",
+                           c >= 'a' ? c - 32 : c);
     int digits = 0;  /* an N word keeps the digits it was written with, as rs274 prints it */
     while (in->norm[*pos + digits] >= '0' && in->norm[*pos + digits] <= '9')
         digits++;
@@ -168,11 +170,11 @@ static int read_word(struct interp *in, int *pos)
         b->n_digits = digits;
         return 0;
     }
-    k = c - 'a';
+    k = c == '@' ? 26 : c == '^' ? 27 : c - 'a';
     if (b->col[k])
         return interp_fail(in, INTERP_ERR_WORD, col,
-                           "two %c words in one block (the first is at column %d)", c - 32,
-                           b->col[k]);
+                           "two %c words in one block (the first is at column %d)",
+                           k < 26 ? c - 32 : c, b->col[k]);
     b->col[k] = col;
     b->val[k] = v;
     return 0;
