@@ -20,7 +20,7 @@ struct runner_check {
     ino_t ino;
     off_t size;
     int64_t mtime_ns, ctime_ns;
-    int64_t files_ns;                   /* tool table and parameter file, folded */
+    uint64_t files_ns;                  /* tool table and parameter file, folded */
     double start[KINS_POSE_DIM];
     struct motion_plan_info info;       /* the program's time, length, segments */
     size_t settings;                    /* CANON_SETTING commands it holds */

@@ -270,8 +270,9 @@ static int identify(struct runner *r, const char *path, struct runner_check *id,
         snprintf(f, sizeof f, "%s%s%s", v[0] == '/' || !dir ? "" : dir,
                  v[0] == '/' || !dir ? "" : "/", v);
         if (stat(f, &st) == 0)
-            id->files_ns = id->files_ns * 31 + (int64_t)st.st_mtim.tv_sec * 1000000000 +
-                           st.st_mtim.tv_nsec + (int64_t)st.st_ino + (int64_t)st.st_size;
+            id->files_ns = id->files_ns * 31u + (uint64_t)st.st_mtim.tv_sec * 1000000000u +
+                           (uint64_t)st.st_mtim.tv_nsec + (uint64_t)st.st_ino +
+                           (uint64_t)st.st_size;   /* (unsigned: wraps, as a hash may) */
     }
     motion_hal_pose(r->hal, id->start);
     return RUNNER_OK;
