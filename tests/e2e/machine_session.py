@@ -490,6 +490,13 @@ def homing_ini(tmp):
             "net spindle-cmd spindle.0.speed-out => sim-spindle.speed-in",
             "net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed",
             "addf sim-spindle.update servo-thread"]
+    # a tool changer that takes 0.5 s to prepare and 2 s to change
+    hal += ["loadrt sim-toolchanger",
+            "net tool-prepare iocontrol.0.tool-prepare => sim-toolchanger.prepare",
+            "net tool-prepared sim-toolchanger.prepared => iocontrol.0.tool-prepared",
+            "net tool-change iocontrol.0.tool-change => sim-toolchanger.change",
+            "net tool-changed sim-toolchanger.changed => iocontrol.0.tool-changed",
+            "addf sim-toolchanger.update servo-thread"]
     open(os.path.join(tmp, "homing.hal"), "w").write("\n".join(hal) + "\n")
     return os.path.join(tmp, "homing.ini"), offsets
 
@@ -550,6 +557,21 @@ def homing_session(tmp):
     c.wait()
     on = c.ok("hal.get", name="spindle.0.on")["value"]
     check("M5: spindle.0.on false", on in ("FALSE", "0", "false"), on)
+    # the simulated tool changer: M6 waits through its prepare and change handshakes
+    t0 = c.status()["time"]
+    c.ok("mdi.execute", line="T3 M6")
+    seen = set()
+    while True:
+        st = c.status()
+        seen.add(st["interp"])
+        if st["interp"] == "idle" and st["motion"] in ("idle", "done"):
+            break
+        time.sleep(0.002)
+    changes = int(c.ok("hal.get", name="sim-toolchanger.changes")["value"])
+    check("T3 M6 waits for the tool changer (prepare 0.5 s, change 2 s: %.2f s)" %
+          (st["time"] - t0), 2.5 <= st["time"] - t0 < 2.7 and
+          changes == 1 and st["tool"]["number"] == 3, (seen, st["time"] - t0, changes,
+                                                        st["tool"]))
     # the tool table: one tool changed through the API, saved, and used by MDI at once
     tbl = os.path.join(tmp, "tmu-hexapod.tbl")
     r = c.call("tooltable.set", tool=2, diameter=-1)
