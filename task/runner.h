@@ -200,6 +200,9 @@ int runner_check_stream(struct runner *r, const char *path, struct motion_plan_i
 int runner_stream_start(struct runner *r, const char *path, int from_line, char *err,
                         size_t errlen);
 void runner_stream_close(struct runner *r);
+/* Whether the last verification pass holds for path as it is now, from where the machine
+ * is (runner_stream_start would start without checking again). */
+bool runner_stream_checked(struct runner *r, const char *path);
 /* The planner thread's error, once it has stopped on one (RUNNER_OK otherwise). */
 int runner_stream_outcome(const struct runner *r, char *err, size_t errlen);
 /* Whether the machine is about to run out of planned path while the planner still works

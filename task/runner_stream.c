@@ -352,6 +352,14 @@ void runner_stream_close(struct runner *r)
     r->stream = NULL;
 }
 
+bool runner_stream_checked(struct runner *r, const char *path)
+{
+    struct runner_check id;
+    char err[200];
+    return identify(r, path, &id, err, sizeof err) == RUNNER_OK && r->checked.valid &&
+           same_check(&r->checked, &id);
+}
+
 int runner_stream_start(struct runner *r, const char *path, int from_line, char *err,
                         size_t errlen)
 {

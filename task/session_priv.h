@@ -85,6 +85,9 @@ struct session {
     _Atomic int check_done;
     volatile sig_atomic_t check_cancel;
     unsigned check_client;       /* who asked */
+    bool check_then_run;         /* program.run asked: run from check_from_line if it passes */
+    bool check_then_step;        /* program.step asked: then one block */
+    int check_from_line;
     json_t *check_id;            /* their request's id (NULL: a notification) */
     int check_status;
     char check_err[800];

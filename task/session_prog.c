@@ -149,14 +149,9 @@ static void *check_main(void *arg)
 /* program.check: the verification pass streams over the whole file in bounded memory, on
  * its own thread; the session goes on serving (status, e-stop) meanwhile and answers the
  * caller when it ends. A run of the same file from the same place then starts at once. */
-int session_check(struct session *s, json_t **result, char *err, size_t len)
+/* Starts the verification pass on its own thread (the answer comes later). */
+static int check_start(struct session *s, char *err, size_t len)
 {
-    int rc;
-    (void)result;
-    if (!s->program[0])
-        return errbuf_set(err, len, RPC_STATE, "program.check: no program is open (program.open)");
-    if ((rc = session_need_idle(s, "program.check", err, len)))
-        return rc;
     atomic_store(&s->check_done, 0);
     s->check_cancel = 0;
     runner_set_cancel(s->r, &s->check_cancel);
@@ -166,6 +161,18 @@ int session_check(struct session *s, json_t **result, char *err, size_t len)
     return RPC_DEFERRED;
 }
 
+int session_check(struct session *s, json_t **result, char *err, size_t len)
+{
+    int rc;
+    (void)result;
+    if (!s->program[0])
+        return errbuf_set(err, len, RPC_STATE, "program.check: no program is open (program.open)");
+    if ((rc = session_need_idle(s, "program.check", err, len)))
+        return rc;
+    s->check_then_run = s->check_then_step = false;
+    return check_start(s, err, len);
+}
+
 void session_check_poll(struct session *s, bool wait)
 {
     if (!s->checking || (!wait && !atomic_load(&s->check_done)))
@@ -173,19 +180,43 @@ void session_check_poll(struct session *s, bool wait)
     pthread_join(s->check_thread, NULL);
     s->checking = false;
     runner_set_cancel(s->r, NULL);
-    json_t *result;
-    if (s->check_status != RUNNER_OK)
+    json_t *result = NULL;
+    int code = 0;
+    char err[800];
+    if (s->check_then_run) {
+        /* program.run that needed a check first: now it runs, or says why not */
+        bool step = s->check_then_step;
+        s->check_then_step = false;
+        if (s->check_status != RUNNER_OK)
+            code = errbuf_set(err, sizeof err, RPC_PROGRAM, "%s", s->check_err);
+        else
+            code = session_run_program(s, s->check_from_line, err, sizeof err);
+        if (code == RPC_DEFERRED) {   /* the machine moved meanwhile: checked again */
+            s->check_then_step = step;
+            return;
+        }
+        if (!code && step) {
+            struct motion_hal_cmd sc = { .kind = MOTION_CMD_STEP };
+            code = session_push(s, &sc, err, sizeof err);
+        }
+        if (!code)
+            result = json_object();
+    } else if (s->check_status != RUNNER_OK) {
         result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line",
                            session_error_line(s->check_err), "text", s->check_err);
-    else
+    } else {
         result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
                            s->check_info.time_s, "length_mm", s->check_info.length_mm,
                            "segments", (json_int_t)s->check_info.segments);
+    }
     for (int i = 0; i < SESSION_MAX_CLIENTS && s->check_id; i++) {
         struct session_client *c = s->cl[i];
         if (c && c->id == s->check_client) {
-            json_t *resp = json_pack("{s:s, s:O, s:O}", "jsonrpc", "2.0", "id", s->check_id,
-                                     "result", result);
+            json_t *resp = code ? json_pack("{s:s, s:O, s:{s:i, s:s}}", "jsonrpc", "2.0",
+                                            "id", s->check_id, "error", "code", code,
+                                            "message", err)
+                                : json_pack("{s:s, s:O, s:O}", "jsonrpc", "2.0", "id",
+                                            s->check_id, "result", result);
             session_server_send(s, c, resp);
             json_decref(resp);
         }
@@ -205,6 +236,14 @@ int session_run_program(struct session *s, int from_line, char *err, size_t len)
         (rc = session_need_idle(s, "program.run", err, len)) ||
         (rc = session_need_homed(s, "program.run", err, len)))
         return rc;
+    if (!runner_stream_checked(s->r, s->program)) {
+        /* the verification pass first, on its own thread: the answer (and the run) come
+         * when it passes; the session serves everyone meanwhile */
+        s->check_then_run = true;
+        s->check_then_step = false;
+        s->check_from_line = from_line;
+        return check_start(s, err, len);
+    }
     s->mode = SESS_AUTO;
     char msg[800];
     /* streamed: checked first unless the last check was of this file, unchanged, with the
@@ -241,8 +280,11 @@ int session_resume(struct session *s, char *err, size_t len)
 int session_step(struct session *s, char *err, size_t len)
 {
     int rc;
-    if (!s->running && (rc = session_run_program(s, 1, err, len)))
+    if (!s->running && (rc = session_run_program(s, 1, err, len))) {
+        if (rc == RPC_DEFERRED)
+            s->check_then_step = true;  /* one block once the check has passed */
         return rc;
+    }
     struct motion_hal_cmd c = { .kind = MOTION_CMD_STEP };
     return session_push(s, &c, err, len);
 }
