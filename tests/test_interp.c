@@ -527,6 +527,46 @@ START_TEST(two_interpreters)
 }
 END_TEST
 
+/* Lines are found through a sparse index (every 64th line) and a cursor: loops that jump
+ * back across many lines, a subroutine defined 500 lines after its call, and a mapped file
+ * (interp_run_file) read the same lines as the text in memory. */
+START_TEST(long_jumps_across_the_line_index)
+{
+    size_t cap = 1 << 16, n = 0;
+    char *text = malloc(cap);
+    ck_assert_ptr_nonnull(text);
+    n += (size_t)snprintf(text + n, cap - n, "G21 G90 F100\n#1=0\no100 repeat [3]\n");
+    for (int i = 0; i < 150; i++)        /* a body of 150 lines: the loop jumps back 150 */
+        n += (size_t)snprintf(text + n, cap - n, "#1=[#1+1]\n");
+    n += (size_t)snprintf(text + n, cap - n, "G1 X#1\no100 endrepeat\no<far> call [7]\n");
+    for (int i = 0; i < 500; i++)        /* 500 lines before the subroutine */
+        n += (size_t)snprintf(text + n, cap - n, "(filler %d)\n", i);
+    n += (size_t)snprintf(text + n, cap - n, "M2\no<far> sub\nG1 Y#1\no<far> endsub\n");
+    struct canon_prog p;
+    ck_assert_int_eq(run_text(text, &p, NULL), INTERP_OK);
+    ck_assert_double_eq(nth(&p, CANON_FEED, 0)->end[0], 150);
+    ck_assert_double_eq(nth(&p, CANON_FEED, 2)->end[0], 450);
+    ck_assert_double_eq(nth(&p, CANON_FEED, 3)->end[1], 7);
+    size_t count = p.count;
+    canon_prog_free(&p);
+    char path[] = "/tmp/hexcnc-test-lines-XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    ck_assert_int_eq(write(fd, text, n), (ssize_t)n);
+    close(fd);
+    struct interp *in = interp_create();
+    canon_prog_init(&p);
+    ck_assert_int_eq(interp_run_file(in, path, canon_prog_sink, &p), INTERP_OK);
+    ck_assert_uint_eq(p.count, count);
+    ck_assert_double_eq(nth(&p, CANON_FEED, 2)->end[0], 450);
+    ck_assert_double_eq(nth(&p, CANON_FEED, 3)->end[1], 7);
+    canon_prog_free(&p);
+    interp_destroy(in);
+    unlink(path);
+    free(text);
+}
+END_TEST
+
 static Suite *interp_suite(void)
 {
     Suite *s = suite_create("interp");
@@ -536,6 +576,7 @@ static Suite *interp_suite(void)
     tcase_add_test(tc, lexer_utf8_bom);
     tcase_add_test(tc, g64_q_is_stored);
     tcase_add_test(tc, cancel_flag_stops_before_the_next_line);
+    tcase_add_test(tc, long_jumps_across_the_line_index);
     tcase_add_test(tc, lexer_block_delete);
     tcase_add_test(tc, expr_precedence);
     tcase_add_test(tc, expr_functions);
