@@ -185,12 +185,22 @@ class Client:
     def open(self, path):
         return self.call("program.open", path=path)
 
+    def _call_long(self, method, **params):
+        """A call that may wait for the check of a whole program (a minute for ten million
+        lines): no time limit while the session is there."""
+        old = self.sock.gettimeout()
+        self.sock.settimeout(None)
+        try:
+            return self.call(method, **params)
+        finally:
+            self.sock.settimeout(old)
+
     def check(self):
-        return self.call("program.check")
+        return self._call_long("program.check")
 
     def run(self, from_line=None):
-        return self.call("program.run", **({} if from_line is None else
-                                           {"from_line": from_line}))
+        return self._call_long("program.run", **({} if from_line is None else
+                                                 {"from_line": from_line}))
 
     def pause(self):
         return self.call("program.pause")
@@ -199,7 +209,7 @@ class Client:
         return self.call("program.resume")
 
     def step(self):
-        return self.call("program.step")
+        return self._call_long("program.step")
 
     def abort(self):
         return self.call("program.abort")

@@ -101,8 +101,12 @@ static json_t *ctl_call(struct ctl_conn *c, const char *method, json_t *params, 
 {
     if (ctl_send(c, method, params, id) != 0)
         return NULL;
+    /* program.check (and a run or step that checks first) answers when the check of the
+     * whole file ends, a minute for ten million lines: wait for it while the session is */
+    bool long_ok = !strcmp(method, "program.check") || !strcmp(method, "program.run") ||
+                   !strcmp(method, "program.step");
     for (;;) {
-        json_t *j = ctl_read(c, 30000);
+        json_t *j = ctl_read(c, long_ok ? -1 : 30000);
         if (!j)
             return NULL;
         json_t *jid = json_object_get(j, "id");
@@ -135,7 +139,8 @@ static int ctl_print(json_t *resp)
 {
     if (!resp) {
         fprintf(stderr, "hexcnc ctl: no answer from the session (it ended, or took longer "
-                "than 30 s)\n");
+                "than 30 s; program.check, program.run and program.step wait as long as "
+                "it takes)\n");
         return 1;
     }
     json_t *e = json_object_get(resp, "error");
