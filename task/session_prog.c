@@ -111,11 +111,12 @@ int session_open(struct session *s, const char *path, char *err, size_t len)
     if (!f)
         return errbuf_set(err, len, RPC_NOT_FOUND, "%s: %s", full, strerror(errno));
     long lines = 0;
-    int ch, last = '\n';
-    while ((ch = getc(f)) != EOF) {
-        if (ch == '\n')
+    char buf[1 << 16], last = '\n';
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        for (const char *p = buf; (p = memchr(p, '\n', (size_t)(buf + n - p))); p++)
             lines++;
-        last = ch;
+        last = buf[n - 1];
     }
     if (last != '\n')
         lines++;
