@@ -119,6 +119,15 @@ static int fail(struct motion_stream *s, int st, const char *msg)
     return st;
 }
 
+/* Empties a plan but keeps its arrays (and their pages) for the next window. */
+static void plan_reset(struct motion_plan *p)
+{
+    p->nseg = p->narc = p->nknot = p->nmarks = p->nios = 0;
+    p->k_enter = 0;
+    p->v_enter = p->enter_deficit = p->total_time_s = p->total_len_mm = 0;
+    memset(&p->info, 0, sizeof p->info);
+}
+
 /* Hands a planned chunk to the executor (or drops it: a check). */
 static int publish(struct motion_stream *s, struct motion_chunk *c)
 {
@@ -291,7 +300,7 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
         free(ends);
         return fail(s, st, "out of memory planning the program");
     }
-    motion_plan_free(&pm->plan);
+    plan_reset(&pm->plan);        /* (a chunk handed over took the arrays before) */
     pm->plan.names_in = s->m ? &s->m->names : &pm->names;
     pm->pb_at[0] = s->nctx ? ends[s->nctx - 1] : 0;
     pm->pb_at[1] = final ? SIZE_MAX : ends[cut];
@@ -305,7 +314,7 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     if (st)
         return fail(s, st, pm->msg);
     if (!final && (s_leave >= p->nseg || s_leave <= s_enter)) {
-        motion_plan_free(p);     /* nothing to commit, or no path after the cut: wait */
+        plan_reset(p);           /* nothing to commit, or no path after the cut: wait */
         return MOTION_OK;
     }
     p->k_enter = s_enter < p->nseg ? p->segs[s_enter].k0 : 0;
@@ -351,8 +360,10 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     s->info.limited_by_kin_tol += p->info.limited_by_kin_tol;
     s->info.stops_held += p->info.stops_held;
     s->windows++;
-    c->plan = *p;
-    memset(p, 0, sizeof *p);
+    if (s->m) {                  /* the executor's from now on; a check keeps the arrays */
+        c->plan = *p;
+        memset(p, 0, sizeof *p);
+    }
     if (!final)
         shift_window(s, cut);
     else if (sync)
