@@ -346,8 +346,15 @@ static int runner_check_started(struct runner *r, char *err, size_t errlen)
                            "longer than their configured time-outs allow (%.0f ms): the "
                            "program did not start", what, waited_ms, (double)budget_ns * 1e-6);
     }
-    if (r->ready_since < 0)
+    if (r->ready_since < 0) {
         r->ready_since = periods;
+        /* the reset pulse of runner_start may have come while a drive was still starting
+         * (its fault output holding the latch open: under load the drives can take longer
+         * than the settling before it); the drives are ready now, so the reset is sent
+         * again, as an operator would press it again */
+        if (!*r->emc_enable_in && *r->user_enable_out)
+            *r->user_request_enable = true;
+    }
     if (periods - r->ready_since < RUNNER_START_PERIODS)
         return RUNNER_OK;
     return errbuf_set(err, errlen, RUNNER_ERR_STATE, "the machine did not come out of "
