@@ -171,6 +171,25 @@ static int pause_here(struct motion *m)
 static void pass_marks_to(struct motion *m, size_t reached);
 static void pass_ios_to(struct motion *m, size_t reached);
 
+/* Goes on in chunk n at its entry, its clock at tau, with its own indices; the chunk left
+ * (NULL for the first) is retired for the planner to free. */
+static void enter_chunk(struct motion *m, struct motion_chunk *c, struct motion_chunk *n,
+                        double tau)
+{
+    m->tau_s = tau;
+    m->ci = n->k_enter;
+    m->cs = n->s_enter;
+    m->marks_base += m->marks_done;
+    m->marks_done = 0;
+    m->ios_done = 0;
+    m->paused_at_seg = 0;
+    m->waited_at_seg = 0;
+    m->chunk = n;
+    m->run = &n->plan;
+    if (c)
+        atomic_store_explicit(&c->retired, 1, memory_order_release);
+}
+
 /* A streamed program's path has reached the knot where the chunk hands over (k_leave): on
  * into the successor, at the same place and speed, with its own clock and indices. With
  * no successor yet, the executor claims the tail (which stops at the window's end) and the
@@ -188,17 +207,7 @@ static bool switch_chunk(struct motion *m)
             if (m->state == MOTION_RUNNING)
                 m->state = MOTION_PAUSING;
         }
-        m->tau_s += n->plan.kt[n->k_enter] - c->plan.kt[c->k_leave];
-        m->ci = n->k_enter;
-        m->cs = n->s_enter;
-        m->marks_base += m->marks_done;
-        m->marks_done = 0;
-        m->ios_done = 0;
-        m->paused_at_seg = 0;
-        m->waited_at_seg = 0;
-        m->chunk = n;
-        m->run = &n->plan;
-        atomic_store_explicit(&c->retired, 1, memory_order_release);
+        enter_chunk(m, c, n, m->tau_s + n->plan.kt[n->k_enter] - c->plan.kt[c->k_leave]);
         return true;
     }
     m->tail_taken = 1;
@@ -284,17 +293,7 @@ static void advance(struct motion *m, double dt)
                 pass_marks_to(m, c->plan.nseg);
                 pass_ios_to(m, c->plan.nseg);
                 /* (the part after the wait may hold no move: the program's end) */
-                m->tau_s = n->plan.nknot ? n->plan.kt[n->k_enter] : 0;
-                m->ci = n->k_enter;
-                m->cs = n->s_enter;
-                m->marks_base += m->marks_done;
-                m->marks_done = 0;
-                m->ios_done = 0;
-                m->paused_at_seg = 0;
-                m->waited_at_seg = 0;
-                m->chunk = n;
-                m->run = &n->plan;
-                atomic_store_explicit(&c->retired, 1, memory_order_release);
+                enter_chunk(m, c, n, n->plan.nknot ? n->plan.kt[n->k_enter] : 0);
                 if (n->plan.nseg == 0 && n->last)
                     m->state = MOTION_DONE;
             }
@@ -465,11 +464,7 @@ static bool stream_ready(struct motion *m)
     struct motion_chunk *c = atomic_load_explicit(&m->stream_head, memory_order_acquire);
     if (!c)
         return false;
-    m->chunk = c;
-    m->run = &c->plan;
-    m->ci = c->k_enter;
-    m->cs = c->s_enter;
-    m->tau_s = c->plan.kt[c->k_enter];
+    enter_chunk(m, NULL, c, c->plan.nknot ? c->plan.kt[c->k_enter] : 0);
     return true;
 }
 

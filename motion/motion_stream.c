@@ -208,71 +208,58 @@ static size_t choose_cut(const struct motion_stream *s)
     return cut;
 }
 
-/* Starts the next window after the cut: the synthetic path mode in force, the move cut
- * after (context), and everything after it. */
-static void shift_window(struct motion_stream *s, size_t cut)
+/* The state the window's first `end` commands leave for what follows: where the path is,
+ * the G64 tolerance, and (from the committed commands) the spindle, which the path build of
+ * the next window starts from. */
+static void carry_state(struct motion_stream *s, size_t end)
 {
-    double at[KINS_POSE_DIM];
-    memcpy(at, s->start, sizeof at);
-    double tol = s->tol_mm;
-    for (size_t i = 0; i < cut; i++) {
+    for (size_t i = 0; i < end; i++) {
         const struct canon_cmd *c = &s->win[i];
         if (is_move(c->type))
-            memcpy(at, c->end, sizeof at);
-        if (c->type == CANON_PATH_MODE)
-            tol = motion_blend_tolerance(&s->pm->cfg, c);
-    }
-    for (size_t i = s->nctx; i <= cut; i++) {  /* the spindle as the committed part leaves it */
-        const struct canon_cmd *c = &s->win[i];
-        if (c->type == CANON_SPINDLE_ON)
+            memcpy(s->start, c->end, sizeof s->start);
+        else if (c->type == CANON_PATH_MODE)
+            s->tol_mm = motion_blend_tolerance(&s->pm->cfg, c);
+        else if (i < s->nctx)
+            continue;
+        else if (c->type == CANON_SPINDLE_ON)
             s->pm->io.dir = c->value < 0 ? -1 : 1;
         else if (c->type == CANON_SPINDLE_STOP)
             s->pm->io.dir = 0;
         else if (c->type == CANON_SPINDLE_SPEED)
             s->pm->io.rpm = fabs(c->value);
     }
-    struct canon_cmd pm = s->win[cut];
+}
+
+/* The window's first command after a cut or a sync: the path mode in force, stated. */
+static struct canon_cmd path_mode_cmd(const struct motion_stream *s, const struct canon_cmd *at)
+{
+    struct canon_cmd pm = *at;
     pm.type = CANON_PATH_MODE;
-    pm.value = tol;
-    pm.ivalue = tol > 0 ? 640 : 610;
-    if (cut > 0) {               /* (cut 0: the room for one more is there, add() made it) */
-        memmove(&s->win[1], &s->win[cut], (s->n - cut) * sizeof *s->win);
-    } else {
-        memmove(&s->win[1], &s->win[0], s->n * sizeof *s->win);
-    }
+    pm.value = s->tol_mm;
+    pm.ivalue = s->tol_mm > 0 ? 640 : 610;
+    return pm;
+}
+
+/* Starts the next window after the cut: the path mode in force, the move cut after
+ * (context), and everything after it. */
+static void shift_window(struct motion_stream *s, size_t cut)
+{
+    carry_state(s, cut);
+    struct canon_cmd pm = path_mode_cmd(s, &s->win[cut]);
+    /* (add() keeps one spare entry, for cut 0) */
+    memmove(&s->win[1], &s->win[cut], (s->n - cut) * sizeof *s->win);
     s->win[0] = pm;
     s->n = s->n - cut + 1;
     s->fresh = 0;
     s->nctx = 2;
-    s->tol_mm = tol;
-    memcpy(s->start, at, sizeof at);
 }
 
 /* After a sync: the next window starts at rest where this one ended, with the path mode and
  * the spindle it left. */
 static void restart_window(struct motion_stream *s)
 {
-    for (size_t i = 0; i < s->n; i++) {
-        const struct canon_cmd *c = &s->win[i];
-        if (is_move(c->type))
-            memcpy(s->start, c->end, sizeof s->start);
-        if (c->type == CANON_PATH_MODE)
-            s->tol_mm = motion_blend_tolerance(&s->pm->cfg, c);
-        if (i < s->nctx)
-            continue;
-        if (c->type == CANON_SPINDLE_ON)
-            s->pm->io.dir = c->value < 0 ? -1 : 1;
-        else if (c->type == CANON_SPINDLE_STOP)
-            s->pm->io.dir = 0;
-        else if (c->type == CANON_SPINDLE_SPEED)
-            s->pm->io.rpm = fabs(c->value);
-    }
-    struct canon_cmd pm;
-    memset(&pm, 0, sizeof pm);
-    pm.type = CANON_PATH_MODE;
-    pm.value = s->tol_mm;
-    pm.ivalue = s->tol_mm > 0 ? 640 : 610;
-    s->win[0] = pm;
+    carry_state(s, s->n);
+    s->win[0] = path_mode_cmd(s, &s->win[s->n ? s->n - 1 : 0]);
     s->n = 1;
     s->nctx = 0;
     s->fresh = 0;

@@ -37,7 +37,7 @@ const char *runner_strerror(int status)
 }
 
 /* A path from the INI, made relative to the INI's folder unless absolute. */
-static void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len)
+void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len)
 {
     const char *dir = hal_ini_dir(r->hal);
     if (value[0] == '/' || !dir || !dir[0])
@@ -244,41 +244,58 @@ static int runner_check_size(struct runner *r, const char *path, char *err, size
     return RUNNER_OK;
 }
 
-/* Interprets the whole program into prog, starting from the machine's present pose. */
-static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
-                            char *err, size_t errlen)
+/* A fresh interpreter for a program from start: the INI's settings, the tool the machine
+ * has, the cancel flag and block delete switch. Its tool table tt stays the caller's. */
+int runner_new_interp(struct runner *r, const double start[KINS_POSE_DIM], struct interp **out,
+                      struct tooltable **tt_out, char *err, size_t errlen)
 {
-    interp_destroy(r->interp);  /* the previous program's plan is being replaced */
-    struct interp *in = r->interp = interp_create();
+    struct interp *in = interp_create();
     struct tooltable *tt = malloc(sizeof *tt);
-    int st = RUNNER_ERR_NOMEM;
+    *out = NULL;
+    *tt_out = NULL;
     if (!in || !tt) {
-        errbuf_set(err, errlen, st, "out of memory");
-        goto out;
+        interp_destroy(in);
+        free(tt);
+        return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
     tooltable_init(tt);
-    double start[KINS_POSE_DIM];
-    motion_hal_pose(r->hal, start);
     interp_set_start(in, start);
-    memcpy(prog->start, start, sizeof start);
-    if ((st = runner_setup_interp(r, in, tt, err, errlen)))
-        goto out;
+    int st = runner_setup_interp(r, in, tt, err, errlen);
+    if (st) {
+        interp_destroy(in);
+        free(tt);
+        return st;
+    }
     struct motion_out mo;
     if (motion_hal_out(r->hal, &mo) == MOTION_OK)
         interp_set_current_tool(in, mo.tool.number);  /* the tool the machine has */
     interp_set_cancel(in, r->cancel);
     interp_set_block_delete(in, r->block_delete);
-    if (interp_run_file(in, path, canon_prog_sink, prog) != INTERP_OK) {
+    *out = in;
+    *tt_out = tt;
+    return RUNNER_OK;
+}
+
+/* Interprets the whole program into prog, starting from the machine's present pose. */
+static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
+                            char *err, size_t errlen)
+{
+    interp_destroy(r->interp);  /* the previous program's plan is being replaced */
+    r->interp = NULL;
+    struct tooltable *tt;
+    double start[KINS_POSE_DIM];
+    motion_hal_pose(r->hal, start);
+    memcpy(prog->start, start, sizeof start);
+    int st = runner_new_interp(r, start, &r->interp, &tt, err, errlen);
+    if (st)
+        return st;
+    if (interp_run_file(r->interp, path, canon_prog_sink, prog) != INTERP_OK) {
         char msg[600];
-        const struct interp_error *e = interp_last_error(in);
+        const struct interp_error *e = interp_last_error(r->interp);
         st = errbuf_set(err, errlen, e->status == INTERP_ERR_CANCELLED ? RUNNER_ERR_ABORTED
                         : RUNNER_ERR_PROGRAM, "%s", interp_error_format(e, msg, sizeof msg));
-        goto out;
     }
-    st = RUNNER_OK;
-out:
-    if (in)
-        interp_set_tooltable(in, NULL);  /* the table goes; the interpreter stays */
+    interp_set_tooltable(r->interp, NULL);  /* the table goes; the interpreter stays */
     free(tt);
     return st;
 }

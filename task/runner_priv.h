@@ -102,6 +102,13 @@ int runner_monitor_install(struct runner *r, char *err, size_t errlen);
 /* Whether the motion core is under way (running, pausing, paused, stopping). */
 bool runner_moving(const struct runner *r);
 
+/* A value of the INI that names a file: as is when absolute, else from the INI's folder. */
+void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len);
+/* A fresh interpreter for a program from start, set up as every program's is (runner.c);
+ * *tt_out is its tool table, to free once the interpreter no longer uses it. */
+int runner_new_interp(struct runner *r, const double start[KINS_POSE_DIM], struct interp **out,
+                      struct tooltable **tt_out, char *err, size_t errlen);
+
 /* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE to an interpreter (runner.c). */
 struct tooltable;
 int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt, char *err,

@@ -180,37 +180,6 @@ static int sink(void *ctx, const struct canon_cmd *c)
     return take(k, c);
 }
 
-/* A fresh interpreter for the program, set up as runner_interpret sets one up. */
-static int new_interp(struct runner *r, const double start[KINS_POSE_DIM], struct interp **out,
-                      struct tooltable **tt_out, char *err, size_t errlen)
-{
-    struct interp *in = interp_create();
-    struct tooltable *tt = malloc(sizeof *tt);
-    *out = NULL;
-    *tt_out = NULL;
-    if (!in || !tt) {
-        interp_destroy(in);
-        free(tt);
-        return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
-    }
-    tooltable_init(tt);
-    interp_set_start(in, start);
-    int st = runner_setup_interp(r, in, tt, err, errlen);
-    if (st) {
-        interp_destroy(in);
-        free(tt);
-        return st;
-    }
-    struct motion_out mo;
-    if (motion_hal_out(r->hal, &mo) == MOTION_OK)
-        interp_set_current_tool(in, mo.tool.number);
-    interp_set_cancel(in, r->cancel);
-    interp_set_block_delete(in, r->block_delete);
-    *out = in;
-    *tt_out = tt;
-    return RUNNER_OK;
-}
-
 /* The interpreter's outcome, after the sink's. */
 static int interp_outcome(struct stream_sink *k, struct interp *in, int ist)
 {
@@ -263,12 +232,10 @@ static int identify(struct runner *r, const char *path, struct runner_check *id,
     static const char *const keys[] = { "TOOL_TABLE", "PARAMETER_FILE" };
     for (int i = 0; i < 2; i++) {
         const char *v = hal_ini_get(r->hal, "RS274NGC", keys[i]);
-        const char *dir = hal_ini_dir(r->hal);
         char f[1200];
         if (!v || !v[0])
             continue;
-        snprintf(f, sizeof f, "%s%s%s", v[0] == '/' || !dir ? "" : dir,
-                 v[0] == '/' || !dir ? "" : "/", v);
+        runner_ini_path(r, v, f, sizeof f);
         if (stat(f, &st) == 0)
             id->files_ns = id->files_ns * 31u + (uint64_t)st.st_mtim.tv_sec * 1000000000u +
                            (uint64_t)st.st_mtim.tv_nsec + (uint64_t)st.st_ino +
@@ -294,8 +261,8 @@ int runner_check_stream(struct runner *r, const char *path, struct motion_plan_i
     static const _Atomic int never;
     k.stop = &never;
     k.cut.from_line = 1;
-    if ((st = new_interp(r, id.start, &in, &tt, err, errlen)) ||
-        (st = new_interp(r, id.start, &store, &store_tt, err, errlen)))
+    if ((st = runner_new_interp(r, id.start, &in, &tt, err, errlen)) ||
+        (st = runner_new_interp(r, id.start, &store, &store_tt, err, errlen)))
         goto out;
     k.store = store;
     if (motion_stream_create(r->motion, id.start, r->cancel, &k.ms, err, errlen) != MOTION_OK) {
@@ -385,7 +352,7 @@ int runner_stream_start(struct runner *r, const char *path, int from_line, char 
     snprintf(rs->path, sizeof rs->path, "%s", path);
     interp_destroy(r->interp);
     r->interp = NULL;
-    if ((st = new_interp(r, id.start, &r->interp, &rs->tt, err, errlen)))
+    if ((st = runner_new_interp(r, id.start, &r->interp, &rs->tt, err, errlen)))
         goto fail;
     pthread_mutex_lock(&r->settings_lock);
     runner_settings_free(r);

@@ -407,6 +407,32 @@ struct motion *motion_hal_get(const struct hal *h)
     return h ? hal_get_object(h, "motion") : NULL;
 }
 
+/* Before a program is handed to motion (under the plan lock): once the servo thread has
+ * run, the command is where the legs are, and a program planned from elsewhere would jump
+ * there in one period (legs whose lengths give no pose, such as drives that never answered,
+ * leave it to the start-up checks to say why); then the waits the wiring asks for. */
+static int motion_comp_prepare(struct motion_comp *c, struct hal *h,
+                               const double start[KINS_POSE_DIM], char *err, size_t errlen)
+{
+    double L[KINS_MAX_JOINTS];
+    if (c->updates > MOTION_FEEDBACK_SETTLE && motion_pose_known(c->m) &&
+        kins_inverse(hal_get_object(h, "kins"), start, L) == KINS_OK) {
+        for (int i = 0; i < c->nj; i++) {
+            double off = L[i] - c->last.joint_pos[i];
+            if (fabs(off) > MOTION_START_TOL_MM) {
+                if (err && errlen)
+                    snprintf(err, errlen, "the program was planned from a pose the machine is "
+                             "not at: leg %d ([JOINT_%d]) is %.4f mm from the program's start; "
+                             "plan it again from where the machine is", i + 1, i, -off);
+                return MOTION_ERR_STATE;
+            }
+        }
+    }
+    motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
+    motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
+    return MOTION_OK;
+}
+
 /* Plans prog and marks it to start when enabled. Call it while motion is idle (it refuses
  * otherwise), so the servo thread is not reading the plan being replaced. */
 int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, size_t errlen)
@@ -418,27 +444,12 @@ int motion_hal_load(struct hal *h, const struct canon_prog *prog, char *err, siz
         return MOTION_ERR_STATE;
     }
     pthread_mutex_lock(&c->plan_lock);
-    /* Once the servo thread has run, the command is where the legs are: a program planned
-     * from elsewhere would jump there in one period. (Legs whose lengths give no pose, such
-     * as drives that never answered, leave it to the start-up checks to say why.) */
-    double L[KINS_MAX_JOINTS];
-    if (c->updates > MOTION_FEEDBACK_SETTLE && motion_pose_known(c->m) &&
-        kins_inverse(hal_get_object(h, "kins"), prog->start, L) == KINS_OK) {
-        for (int i = 0; i < c->nj; i++) {
-            double off = L[i] - c->last.joint_pos[i];
-            if (fabs(off) > MOTION_START_TOL_MM) {
-                pthread_mutex_unlock(&c->plan_lock);
-                if (err && errlen)
-                    snprintf(err, errlen, "the program was planned from a pose the machine is "
-                             "not at: leg %d ([JOINT_%d]) is %.4f mm from the program's start; "
-                             "plan it again from where the machine is", i + 1, i, -off);
-                return MOTION_ERR_STATE;
-            }
-        }
+    int st = motion_comp_prepare(c, h, prog->start, err, errlen);
+    if (st != MOTION_OK) {
+        pthread_mutex_unlock(&c->plan_lock);
+        return st;
     }
-    motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
-    motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
-    int st = motion_load(c->m, prog, err, errlen);
+    st = motion_load(c->m, prog, err, errlen);
     c->start_pending = st == MOTION_OK && c->autostart;
     pthread_mutex_unlock(&c->plan_lock);
     return st;
@@ -459,23 +470,12 @@ int motion_hal_stream_begin(struct hal *h, const double start[KINS_POSE_DIM],
         return MOTION_ERR_STATE;
     }
     pthread_mutex_lock(&c->plan_lock);
-    double L[KINS_MAX_JOINTS];
-    if (c->updates > MOTION_FEEDBACK_SETTLE && motion_pose_known(c->m) &&
-        kins_inverse(hal_get_object(h, "kins"), start, L) == KINS_OK) {
-        for (int i = 0; i < c->nj; i++) {
-            double off = L[i] - c->last.joint_pos[i];
-            if (fabs(off) > MOTION_START_TOL_MM) {
-                pthread_mutex_unlock(&c->plan_lock);
-                snprintf(err, errlen, "the program was planned from a pose the machine is "
-                         "not at: leg %d ([JOINT_%d]) is %.4f mm from the program's start; "
-                         "plan it again from where the machine is", i + 1, i, -off);
-                return MOTION_ERR_STATE;
-            }
-        }
+    int st = motion_comp_prepare(c, h, start, err, errlen);
+    if (st != MOTION_OK) {
+        pthread_mutex_unlock(&c->plan_lock);
+        return st;
     }
-    motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
-    motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
-    int st = motion_stream_create(c->m, start, cancel, out, err, errlen);
+    st = motion_stream_create(c->m, start, cancel, out, err, errlen);
     if (st == MOTION_OK && (st = motion_stream_attach(c->m, *out, totals)) != MOTION_OK) {
         snprintf(err, errlen, "%s", motion_last_error(c->m));
         motion_stream_destroy(*out);
