@@ -204,6 +204,17 @@ const struct config_key config_keys[] = {
       "`hexcnc machine` (else /tmp/hexcnc-UID/hexcnc.sock)" },
     { "API", "GROUP", STR, "", "", 0, 0, "", "group allowed to use the socket (mode 0660); "
       "absent: its owner only (0600)" },
+    { "API", "HTTP", STR, "", "", 0, 0, "127.0.0.1:8080", "address and port of the "
+      "operator's station (`hexcnc web`, docs/ui.md); an address other than loopback needs "
+      "TOKEN_FILE" },
+    { "API", "TOKEN_FILE", PATH, "", "", 0, 0, "", "file (mode 600) whose first line is the "
+      "secret a browser must present to the station (16+ characters)" },
+    { "API", "ALLOWED_ORIGINS", STR, "", "", 0, 0, "", "further origins (scheme://host:port) "
+      "whose pages may open the station's WebSocket, besides its own address" },
+    { "API", "UI_DIR", PATH, "", "", 0, 0, "share/hexcnc/ui beside bin/", "folder of the "
+      "built page the station serves" },
+    { "DISPLAY", "PROGRAM_PREFIX", PATH, "", "", 0, 0, "the INI's folder", "folder programs "
+      "are opened from by relative paths (the station: only from here; uploads go here)" },
     { "TASK", "TASK", STR, "", "", 0, IGN, "", "LinuxCNC's task program" },
     { "TASK", "CYCLE_TIME", NUM, "s", "", 0, IGN, "", "LinuxCNC's task period" },
     { "DISPLAY", "OPEN_FILE", PATH, "", "", 0, 0, "", "program `hexcnc run` runs when none "

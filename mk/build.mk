@@ -10,6 +10,7 @@
 #   BENCHES     bench/NAME.c -> $(BUILD)/bench/NAME, run by `make bench`
 #   PLUGINS     shared objects under $(LIBDIR)/ (rules in the module.mk that adds them)
 #   EXTRA_BINS  further programs under $(BINDIR)/ (rules in the module.mk that adds them)
+#   UI_FILES    built files of the operator's page (web/module.mk), under $(O)/share/hexcnc/ui
 #   GEN_HDRS    generated headers that sources may include (built before any object)
 #   HAL_COMPS   built-in HAL component types: NAME means the library defines
 #               `const struct hal_comp_type hal_comp_NAME`; hal_create() registers them all
@@ -50,7 +51,7 @@ LDFLAGS  := $(SANFLAGS)
 # Ceres Solver (calib/) ships no .pc file; its CMake config (CeresTargets.cmake) links the
 # shared libceres with glog, gflags and threads.
 CERES_LIBS := -lceres -lglog -lgflags
-LDLIBS   := $(shell pkg-config --libs $(PKGS)) $(CERES_LIBS) -ldl -lpthread -lm -lstdc++
+LDLIBS   := $(shell pkg-config --libs $(PKGS)) $(CERES_LIBS) -lcivetweb -ldl -lpthread -lm -lstdc++
 CHECK_LIBS := $(shell pkg-config --libs check)
 
 # Quiet build: one short line per step; `make V=1` prints the full commands.
@@ -70,6 +71,7 @@ SCRIPT_TESTS :=
 BENCHES :=
 PLUGINS :=
 EXTRA_BINS :=
+UI_FILES :=
 GEN_HDRS :=
 HAL_COMPS :=
 
@@ -90,7 +92,7 @@ BENCH_BINS := $(BENCHES:%=$(BUILD)/bench/%)
 
 .PHONY: all test bench run experiment install fuzz
 .DEFAULT_GOAL := all
-all: $(HEXCNC) $(PLUGINS) $(EXTRA_BINS)
+all: $(HEXCNC) $(PLUGINS) $(EXTRA_BINS) $(UI_FILES)
 
 $(BUILD)/%.o: %.c | $(GEN_HDRS)
 	@mkdir -p $(@D)
@@ -145,5 +147,6 @@ install: all
 	[ ! -x scripts/hexcnc-start ] || install -m 755 scripts/hexcnc-start $(DESTDIR)$(PREFIX)/bin/
 	[ -z "$(PLUGINS)" ] || cp -r $(LIBDIR)/kins $(DESTDIR)$(PREFIX)/lib/hexcnc/
 	cp -r configs examples $(DESTDIR)$(PREFIX)/share/hexcnc/
+	[ -z "$(UI_FILES)" ] || cp -r $(O)/share/hexcnc/ui $(DESTDIR)$(PREFIX)/share/hexcnc/
 
 -include $(wildcard $(LIB_OBJS:.o=.d) $(CMD_OBJS:.o=.d))

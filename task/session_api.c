@@ -238,12 +238,16 @@ static int m_jog(struct session *s, struct session_client *c, json_t *p, json_t 
     if (has_dist && !(dist > 0))
         return perr(err, len, "distance", "must be positive (the direction is velocity's "
                     "sign)");
-    return session_jog(s, f, axis, vel, dist, err, len);
+    int st = session_jog(s, f, axis, vel, dist, err, len);
+    if (st == 0)
+        s->jogger = has_dist ? 0 : c->id;
+    return st;
 }
 
 static int m_jog_stop(struct session *s, struct session_client *c, json_t *p, json_t **r,
                       char *err, size_t len)
 {
+    s->jogger = 0;
     return session_jog_stop(s, err, len);
 }
 

@@ -78,6 +78,8 @@ struct session {
     struct session_client *cl[SESSION_MAX_CLIENTS];
     unsigned next_id;
     unsigned holder;             /* client id holding control, 0: none */
+    unsigned jogger;             /* client id whose continuous jog is the last one started,
+                                  * 0: none (it stops when that client disconnects) */
     /* program.check runs on its own thread, so that a long file stalls nobody; its answer
      * goes to the client that asked when it ends (session_check_poll) */
     pthread_t check_thread;

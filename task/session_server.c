@@ -97,6 +97,13 @@ static void drop_client(struct session *s, int i)
         s->holder = 0;
         session_message(s, "info", "api", "client %u disconnected: control released", c->id);
     }
+    if (s->jogger == c->id) {  /* a hold-to-jog whose button can no longer be released */
+        char err[200];
+        s->jogger = 0;
+        if (session_jog_stop(s, err, sizeof err) == 0 && s->state == SESS_ON)
+            session_message(s, "warning", "api", "client %u disconnected during a continuous "
+                            "jog: the jog is stopped", c->id);
+    }
     close(c->fd);
     free(c->in);
     free(c->out);

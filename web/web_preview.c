@@ -1,0 +1,165 @@
+/* web_preview.c: a program's path for the 3-D view, read by the interpreter as `hexcnc
+ * check` reads it (the machine's tool table, parameters and subroutine folders, the parameter
+ * file never written), from the machine's present pose. Each point is X Y Z A B C in
+ * thousandths (micrometres, millidegrees); arcs are chords of at most 1/64 turn. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/errbuf.h"
+#include "interp/canon.h"
+#include "interp/interp.h"
+#include "interp/interp_setup.h"
+#include "interp/tooltable.h"
+#include "web/web.h"
+
+#define RPC_FAILED -32005
+
+enum { KIND_RAPID = 0, KIND_FEED = 1, KIND_COMP = 2 };
+
+struct preview {
+    json_t *pts, *kind, *line;
+    size_t n, max;
+    double at[6];
+    double lo[3], hi[3];
+    bool truncated;
+};
+
+static void put(struct preview *p, const double x[6], int kind, int line)
+{
+    for (int i = 0; i < 6; i++)
+        json_array_append_new(p->pts, json_integer((json_int_t)llround(x[i] * 1000.0)));
+    for (int i = 0; i < 3; i++) {
+        if (x[i] < p->lo[i])
+            p->lo[i] = x[i];
+        if (x[i] > p->hi[i])
+            p->hi[i] = x[i];
+    }
+    json_array_append_new(p->kind, json_integer(kind));
+    json_array_append_new(p->line, json_integer(line));
+    memcpy(p->at, x, sizeof p->at);
+    p->n++;
+}
+
+static double dot(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross(const double *a, const double *b, double *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The arc from p->at to end as chords: the radius and the height along the normal change
+ * linearly with the angle (a helix, or an arc whose ends lie at different radii). */
+static void put_arc(struct preview *p, const struct canon_cmd *cmd, int kind)
+{
+    const struct canon_arc *a = &cmd->arc;
+    const double *n = a->normal;
+    double r0[3], r1[3], h0, h1, at0[6];
+    memcpy(at0, p->at, sizeof at0);   /* put() moves p->at on */
+    for (int i = 0; i < 3; i++) {
+        r0[i] = at0[i] - a->center[i];
+        r1[i] = cmd->end[i] - a->center[i];
+    }
+    h0 = dot(r0, n);
+    h1 = dot(r1, n);
+    for (int i = 0; i < 3; i++) {
+        r0[i] -= h0 * n[i];
+        r1[i] -= h1 * n[i];
+    }
+    double c[3];
+    cross(r0, r1, c);
+    double th = atan2(dot(n, c), dot(r0, r1));
+    if (a->rotation > 0 && th <= 1e-12)
+        th += 2 * M_PI;
+    if (a->rotation < 0 && th >= -1e-12)
+        th -= 2 * M_PI;
+    int turns = abs(a->rotation) - 1;
+    th += (a->rotation > 0 ? 1 : -1) * 2 * M_PI * (turns > 0 ? turns : 0);
+    double len0 = sqrt(dot(r0, r0)), len1 = sqrt(dot(r1, r1));
+    int steps = (int)ceil(fabs(th) / (2 * M_PI / 64));
+    if (steps < 1)
+        steps = 1;
+    double u[3], w[3];   /* r0's direction and the direction a quarter turn on */
+    for (int i = 0; i < 3; i++)
+        u[i] = len0 > 0 ? r0[i] / len0 : 0;
+    cross(n, u, w);
+    for (int s = 1; s < steps; s++) {
+        double f = (double)s / steps, phi = th * f, rad = len0 + (len1 - len0) * f;
+        double h = h0 + (h1 - h0) * f, x[6];
+        for (int i = 0; i < 3; i++)
+            x[i] = a->center[i] + rad * (u[i] * cos(phi) + w[i] * sin(phi)) + h * n[i];
+        for (int i = 3; i < 6; i++)
+            x[i] = at0[i] + (cmd->end[i] - at0[i]) * f;
+        put(p, x, kind, cmd->line);
+    }
+    put(p, cmd->end, kind, cmd->line);
+}
+
+static int sink(void *ctx, const struct canon_cmd *cmd)
+{
+    struct preview *p = ctx;
+    if (p->n >= p->max) {
+        p->truncated = true;
+        return 1;
+    }
+    int kind = cmd->compensated ? KIND_COMP : KIND_FEED;
+    if (cmd->type == CANON_TRAVERSE)
+        put(p, cmd->end, KIND_RAPID, cmd->line);
+    else if (cmd->type == CANON_FEED)
+        put(p, cmd->end, kind, cmd->line);
+    else if (cmd->type == CANON_ARC)
+        put_arc(p, cmd, kind);
+    return 0;
+}
+
+json_t *web_preview(const struct web_config *c, const char *path, const double start[6],
+                    size_t max_points, int *code, char *err, size_t errlen)
+{
+    struct interp *in = interp_create();
+    struct tooltable *tt = malloc(sizeof *tt);
+    struct preview p = { .pts = json_array(), .kind = json_array(), .line = json_array(),
+                         .max = max_points };
+    json_t *r = NULL;
+    char msg[1024];
+    *code = RPC_FAILED;
+    if (!in || !tt || !p.pts || !p.kind || !p.line) {
+        errbuf_set(err, errlen, -1, "out of memory");
+        goto out;
+    }
+    tooltable_init(tt);
+    interp_set_start(in, start);
+    if (interp_setup(in, tt, inifile_config_get, (void *)c->ini, inifile_dir(c->ini),
+                     INTERP_SETUP_PARAMS_READ_ONLY, msg, sizeof msg) != INTERP_OK) {
+        errbuf_set(err, errlen, -1, "%s", msg);
+        goto out;
+    }
+    for (int i = 0; i < 3; i++) {
+        p.lo[i] = HUGE_VAL;
+        p.hi[i] = -HUGE_VAL;
+    }
+    put(&p, start, KIND_RAPID, 0);
+    int st = interp_run_file(in, path, sink, &p);
+    const char *problem = NULL;
+    if (st != INTERP_OK && !p.truncated)
+        problem = interp_error_format(interp_last_error(in), msg, sizeof msg);
+    r = json_pack("{s:o, s:o, s:o, s:I, s:b, s:[fff], s:[fff]}", "pts_um", p.pts, "kind",
+                  p.kind, "line", p.line, "points", (json_int_t)p.n, "truncated",
+                  p.truncated, "min", p.lo[0], p.lo[1], p.lo[2], "max", p.hi[0], p.hi[1],
+                  p.hi[2]);
+    p.pts = p.kind = p.line = NULL;
+    json_object_set_new(r, "error", problem ? json_string(problem) : json_null());
+out:
+    json_decref(p.pts);
+    json_decref(p.kind);
+    json_decref(p.line);
+    interp_set_tooltable(in, NULL);
+    interp_destroy(in);
+    free(tt);
+    return r;
+}
