@@ -8,7 +8,7 @@
 #include "tools/cmd.h"
 
 const char cmd_web_usage[] =
-    "web [--listen ADDRESS:PORT] [--socket PATH] [--quiet] CONFIG.ini   serve the operator's "
+    "web [--listen ADDRESS:PORT] [--socket PATH] [--quiet] [--exit-with-parent] CONFIG.ini   serve the operator's "
     "station for the machine session (docs/ui.md)";
 
 int cmd_web(int argc, char **argv)

@@ -5,12 +5,14 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <unistd.h>
 
 #include "common/config.h"
 #include "web/web.h"
 
 static const char usage[] =
-    "web [--listen ADDRESS:PORT] [--socket PATH] [--quiet] CONFIG.ini   serve the operator's "
+    "web [--listen ADDRESS:PORT] [--socket PATH] [--quiet] [--exit-with-parent] CONFIG.ini   serve the operator's "
     "station for the machine session (docs/ui.md)";
 
 static volatile sig_atomic_t web_stop;
@@ -24,7 +26,7 @@ static void web_on_signal(int sig)
 int main(int argc, char **argv)
 {
     const char *ini_path = NULL, *listen = NULL, *sock = NULL;
-    bool quiet = false;
+    bool quiet = false, with_parent = false;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             printf("usage: hexcnc %s\n", usage);
@@ -32,6 +34,8 @@ int main(int argc, char **argv)
         }
         if (!strcmp(argv[i], "--quiet"))
             quiet = true;
+        else if (!strcmp(argv[i], "--exit-with-parent"))
+            with_parent = true;
         else if (!strcmp(argv[i], "--listen") && i + 1 < argc)
             listen = argv[++i];
         else if (!strcmp(argv[i], "--socket") && i + 1 < argc)
@@ -58,6 +62,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "hexcnc web: %s: %s\n", ini_path, err);
         goto out;
     }
+    /* started beside the session (scripts/hexcnc-start): ends when it does */
+    pid_t parent = getppid();
+    if (with_parent && (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || getppid() != parent))
+        goto out;
     struct sigaction sa = { .sa_handler = web_on_signal };
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);

@@ -90,20 +90,66 @@ static void track_control(struct client *cl, const char *line, size_t n)
     pthread_mutex_unlock(&cl->lock);
 }
 
-/* Session -> browser, line by line, until the session closes or the browser leaves. */
+/* Is this line a status notification? (They are the only ones that start so.) */
+static bool is_status(const char *line, size_t n)
+{
+    static const char pre[] = "{\"jsonrpc\":\"2.0\",\"method\":\"status\"";
+    return n > sizeof pre && !memcmp(line, pre, sizeof pre - 1);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* Session -> browser, line by line, until the session closes or the browser leaves. Status
+ * notifications come at the subscribed rate of machine time, which on the simulated clock
+ * runs many times faster than the wall: they reach the browser at most every
+ * WEB_STATUS_PERIOD_S of wall time, the latest one each time, so a browser never falls behind
+ * the machine and the session never sees this client stop reading. Everything else passes at
+ * once, after the status it followed. */
+#define WEB_STATUS_PERIOD_S 0.04
 static void *reader(void *arg)
 {
     struct client *cl = arg;
     size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
+    char *buf = malloc(cap), *held = NULL;   /* held: the latest status not yet sent */
+    size_t held_len = 0, held_cap = 0;
+    double last_status = 0;
     while (buf) {
-        char *nl;
-        while ((nl = memchr(buf, '\n', len))) {
-            size_t n = (size_t)(nl - buf);
-            track_control(cl, buf, n);
-            ws_send(cl, buf, n);
-            memmove(buf, nl + 1, len - n - 1);
-            len -= n + 1;
+        char *nl, *s = buf;
+        while ((nl = memchr(s, '\n', len - (size_t)(s - buf)))) {
+            size_t n = (size_t)(nl - s);
+            if (is_status(s, n)) {
+                if (n > held_cap) {
+                    char *h = realloc(held, n);
+                    if (!h)
+                        goto out;
+                    held = h;
+                    held_cap = n;
+                }
+                memcpy(held, s, n);
+                held_len = n;
+            } else {
+                if (held_len) {
+                    ws_send(cl, held, held_len);
+                    held_len = 0;
+                    last_status = now_s();
+                }
+                track_control(cl, s, n);
+                ws_send(cl, s, n);
+            }
+            s = nl + 1;
+        }
+        len -= (size_t)(s - buf);
+        memmove(buf, s, len);
+        double t = now_s();
+        if (held_len && t - last_status >= WEB_STATUS_PERIOD_S) {
+            ws_send(cl, held, held_len);
+            held_len = 0;
+            last_status = t;
         }
         if (len == cap) {
             char *b = cap < (64u << 20) ? realloc(buf, cap * 2) : NULL;
@@ -112,12 +158,23 @@ static void *reader(void *arg)
             buf = b;
             cap *= 2;
         }
+        struct pollfd pf = { cl->fd, POLLIN, 0 };
+        int wait_ms = held_len ? (int)((WEB_STATUS_PERIOD_S - (t - last_status)) * 1000) + 1 : -1;
+        int pr = poll(&pf, 1, wait_ms);
+        if (pr < 0 && errno == EINTR)
+            continue;
+        if (pr == 0)
+            continue;   /* time to send the held status */
         ssize_t r = read(cl->fd, buf + len, cap - len);
+        if (r < 0 && errno == EINTR)
+            continue;
         if (r <= 0)
             break;
         len += (size_t)r;
     }
+out:
     free(buf);
+    free(held);
     /* the session went away (or the browser did, and the close handler shut the socket) */
     ws_send_json(cl, json_pack("{s:s, s:s, s:{s:s}}", "jsonrpc", "2.0", "method",
                                "station.disconnected", "params", "reason",
@@ -147,6 +204,14 @@ static int ws_connect(const struct mg_connection *conn, void *cbdata)
         bool ok = false;
         for (int i = 0; i < c->norigins && !ok; i++)
             ok = !strcmp(origin, c->origins[i]);
+        /* behind a token (any address but loopback), the page's own origin is whatever
+         * name the operator reached it by: the Host it asked for. On loopback, where there
+         * is no token, only the fixed names count (a rebound DNS name must not). */
+        const char *host = mg_get_header(conn, "Host");
+        if (!ok && c->token[0] && host && !strncmp(origin, "http", 4)) {
+            const char *o = origin + (strncmp(origin, "https://", 8) ? 7 : 8);
+            ok = !strcmp(o, host);
+        }
         if (!ok) {
             if (!sv->quiet)
                 fprintf(stderr, "hexcnc web: refused a WebSocket from origin %s (not in "

@@ -251,7 +251,7 @@ export class MachineView {
       const box = new THREE.Box3().setFromBufferAttribute(new THREE.BufferAttribute(this.path.P, 3));
       box.applyMatrix4(this.path.parent.matrixWorld);
       target = box.getCenter(new THREE.Vector3());
-      dist = Math.max(box.getSize(new THREE.Vector3()).length() * 1.6, 50);
+      dist = Math.max(box.getSize(new THREE.Vector3()).length() * 1.6, 450);
       name = 'iso';
     }
     const dir = { iso: [1, -1.3, 0.9], top: [0, -0.001, 1], front: [0, -1, 0.001], side: [1, 0, 0.001] }[name] || [1, -1.3, 0.9];
