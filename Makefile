@@ -10,13 +10,15 @@
 #   make bench      run the benchmarks
 #   make calibration the simulated kinematic calibration (docs/calibration.md)
 #   make run        run the simulated TMU hexapod on the paper's programs
+#   make station    the simulated TMU hexapod as a running machine, its operator's station
+#                   at http://127.0.0.1:8080/ (docs/ui.md); Ctrl-C ends it
 #   make ini-doc    write docs/ini.md from the INI key table (common/config_keys.c)
 #   make install PREFIX=/usr/local
 
 PREFIX ?= /usr/local
 BUILD_MAKE = $(MAKE) --no-print-directory -f mk/build.mk
 
-.PHONY: all deps test sanitize bench run experiment calibration install clean fuzz ini-doc
+.PHONY: all deps test sanitize bench run station experiment calibration install clean fuzz ini-doc
 all: deps
 	@$(BUILD_MAKE) all
 deps:
@@ -29,6 +31,8 @@ bench: deps
 	@$(BUILD_MAKE) bench
 run: deps
 	@$(BUILD_MAKE) run
+station: all
+	scripts/hexcnc-start --realtime configs/sim/tmu-hexapod.ini
 experiment: deps
 	@$(BUILD_MAKE) experiment
 calibration: deps

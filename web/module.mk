@@ -14,3 +14,4 @@ $(WEB_BIN): $(BUILD)/web/web_main.o $(LIBDIR)/libhexcnc.a
 	$(call say,LINK,$@)
 	$(Q)$(CC) $(LDFLAGS) $^ $(filter-out $(CERES_LIBS),$(LDLIBS)) -o $@
 SCRIPT_TESTS += tests/e2e/web_station.sh
+TESTS += test_web
