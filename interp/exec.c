@@ -401,6 +401,8 @@ static int exec_comp5(struct interp *in, int g)
     cb.unit_mm = interp_len_mm(in, 1.0);
     for (int i = 0; i < 3; i++)
         cb.prog_off_mm[i] = in->g5x[i] + in->g92[i] + in->tool[i];
+    if (in->contour_fn)
+        in->contour_fn(in->contour_ctx, in->line, !in->comp.active, in->pos, cb.point);
     int rc = comp5_block(&in->comp, &cb, in->pos, in->sink, in->sink_ctx);
     if (rc) {
         int col = rc == COMP5_ERR_RADIUS ? (W('w') ? W('w') : W('d')) : 0;

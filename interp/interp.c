@@ -313,6 +313,12 @@ void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx)
     in->input_ctx = ctx;
 }
 
+void interp_set_contour_fn(struct interp *in, interp_contour_fn fn, void *ctx)
+{
+    in->contour_fn = fn;
+    in->contour_ctx = ctx;
+}
+
 void interp_set_param(struct interp *in, int n, double v)
 {
     if (n >= 1 && n < INTERP_NPARAMS)

@@ -106,6 +106,12 @@ const struct interp_error *interp_last_error(const struct interp *in);
  * fn may block until the machine has reached the wait. NULL (the default): 0, as rs274. */
 typedef double (*interp_input_fn)(void *ctx, const struct canon_cmd *wait);
 void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx);
+/* G141/G142, for displays: fn gets each block's programmed contour point (machine frame, mm
+ * and deg) before the compensation offsets it; first is 1 for a run's first block, whose
+ * contour starts at from. NULL (the default): nothing is called. */
+typedef void (*interp_contour_fn)(void *ctx, int line, int first, const double from[6],
+                                  const double point[6]);
+void interp_set_contour_fn(struct interp *in, interp_contour_fn fn, void *ctx);
 /* Sets numbered parameter #n (1..5602) (the session: #5399 after an MDI line's M66). */
 void interp_set_param(struct interp *in, int n, double v);
 /* MDI: lines come one at a time (a run need not end with M2 or M30). */

@@ -147,6 +147,8 @@ struct interp {
     int text_mapped;             /* the program text is a file mapping (interp_run_file) */
     interp_input_fn input_fn;    /* M66's answer (NULL: 0) */
     void *input_ctx;
+    interp_contour_fn contour_fn; /* G141/G142's programmed points, for displays (NULL: none) */
+    void *contour_ctx;
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */
     const volatile sig_atomic_t *cancel; /* the operator's stop request, or NULL */

@@ -255,6 +255,37 @@ START_TEST(test_preview)
     json_decref(r);
     json_decref(p);
 
+    /* G141: the tool path (kind 2) offset by the radius to the right of travel, and the
+     * programmed contour beside it */
+    write_file("progs/c.ngc", "G21 G90\nG0 X70 Y-100 Z630\nG141 X50 Y-80 Z630 W10 F100\n"
+               "G141 X50 Y-20\nM2\n", 0644);
+    p = json_pack("{s:s, s:[ffffff]}", "path", "c.ngc", "start", 0.0, 0.0, 645.0, 0.0, 0.0,
+                  0.0);
+    r = web_local_call(&c, "program.preview", p, false, &code, err, sizeof err);
+    ck_assert_msg(r != NULL, "%s", err);
+    ck_assert(json_is_null(json_object_get(r, "error")));
+    json_t *cu = json_object_get(r, "contour_um"), *cf = json_object_get(r, "contour_first");
+    ck_assert_int_eq(json_array_size(cu), 18);
+    ck_assert(json_is_true(json_array_get(cf, 0)) && json_is_false(json_array_get(cf, 1)));
+    ck_assert_int_eq(json_integer_value(json_array_get(cu, 0)), 70000);   /* from */
+    ck_assert_int_eq(json_integer_value(json_array_get(cu, 1)), -100000);
+    ck_assert_int_eq(json_integer_value(json_array_get(cu, 6)), 50000);   /* line 3 */
+    ck_assert_int_eq(json_integer_value(json_array_get(cu, 7)), -80000);
+    ck_assert_int_eq(json_integer_value(json_array_get(cu, 13)), -20000); /* line 4 */
+    ck_assert_int_eq(json_integer_value(json_array_get(json_object_get(r, "contour_line"), 2)),
+                     4);
+    size_t n = (size_t)json_integer_value(json_object_get(r, "points")), comp = 0;
+    kind = json_object_get(r, "kind");
+    for (size_t i = 0; i < n; i++)
+        if (json_integer_value(json_array_get(kind, i)) == 2) {
+            comp++;
+            if (json_integer_value(json_array_get(json_object_get(r, "line"), i)) == 4)
+                ck_assert_double_eq_tol(pt(r, i, 0), 60.0, 1e-3);  /* along the wall */
+        }
+    ck_assert_uint_ge(comp, 1);
+    json_decref(r);
+    json_decref(p);
+
     /* a program error: the path up to it, and the interpreter's message naming file and line */
     write_file("progs/bad.ngc", "G0 X1\nG1 X2 Q\nM2\n", 0644);
     p = json_pack("{s:s, s:[ffffff]}", "path", "bad.ngc", "start", 0.0, 0.0, 0.0, 0.0, 0.0,

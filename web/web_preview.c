@@ -20,6 +20,7 @@ enum { KIND_RAPID = 0, KIND_FEED = 1, KIND_COMP = 2 };
 
 struct preview {
     json_t *pts, *kind, *line;
+    json_t *contour, *contour_line, *contour_first;  /* G141/G142's programmed contour */
     size_t n, max;
     double at[6];
     double lo[3], hi[3];
@@ -101,6 +102,25 @@ static void put_arc(struct preview *p, const struct canon_cmd *cmd, int kind)
     put(p, cmd->end, kind, cmd->line);
 }
 
+static void contour_point(struct preview *p, const double x[6], int line, int first)
+{
+    for (int i = 0; i < 6; i++)
+        json_array_append_new(p->contour, json_integer((json_int_t)llround(x[i] * 1000.0)));
+    json_array_append_new(p->contour_line, json_integer(line));
+    json_array_append_new(p->contour_first, json_boolean(first));
+}
+
+/* The contour a G141/G142 block programs, beside the tool path the compensation makes. */
+static void contour(void *ctx, int line, int first, const double from[6], const double point[6])
+{
+    struct preview *p = ctx;
+    if (p->n >= p->max)
+        return;
+    if (first)
+        contour_point(p, from, line, 1);
+    contour_point(p, point, line, 0);
+}
+
 static int sink(void *ctx, const struct canon_cmd *cmd)
 {
     struct preview *p = ctx;
@@ -124,11 +144,13 @@ json_t *web_preview(const struct web_config *c, const char *path, const double s
     struct interp *in = interp_create();
     struct tooltable *tt = malloc(sizeof *tt);
     struct preview p = { .pts = json_array(), .kind = json_array(), .line = json_array(),
-                         .max = max_points };
+                         .contour = json_array(), .contour_line = json_array(),
+                         .contour_first = json_array(), .max = max_points };
     json_t *r = NULL;
     char msg[1024];
     *code = RPC_FAILED;
-    if (!in || !tt || !p.pts || !p.kind || !p.line) {
+    if (!in || !tt || !p.pts || !p.kind || !p.line || !p.contour || !p.contour_line ||
+        !p.contour_first) {
         errbuf_set(err, errlen, -1, "out of memory");
         goto out;
     }
@@ -144,6 +166,7 @@ json_t *web_preview(const struct web_config *c, const char *path, const double s
         p.hi[i] = -HUGE_VAL;
     }
     put(&p, start, KIND_RAPID, 0);
+    interp_set_contour_fn(in, contour, &p);
     int st = interp_run_file(in, path, sink, &p);
     const char *problem = NULL;
     if (st != INTERP_OK && !p.truncated)
@@ -152,12 +175,18 @@ json_t *web_preview(const struct web_config *c, const char *path, const double s
                   p.kind, "line", p.line, "points", (json_int_t)p.n, "truncated",
                   p.truncated, "min", p.lo[0], p.lo[1], p.lo[2], "max", p.hi[0], p.hi[1],
                   p.hi[2]);
-    p.pts = p.kind = p.line = NULL;
+    json_object_set_new(r, "contour_um", p.contour);
+    json_object_set_new(r, "contour_line", p.contour_line);
+    json_object_set_new(r, "contour_first", p.contour_first);
+    p.pts = p.kind = p.line = p.contour = p.contour_line = p.contour_first = NULL;
     json_object_set_new(r, "error", problem ? json_string(problem) : json_null());
 out:
     json_decref(p.pts);
     json_decref(p.kind);
     json_decref(p.line);
+    json_decref(p.contour);
+    json_decref(p.contour_line);
+    json_decref(p.contour_first);
     interp_set_tooltable(in, NULL);
     interp_destroy(in);
     free(tt);

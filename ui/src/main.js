@@ -283,7 +283,8 @@ async function openProgram(name) {
   const pv = await call('program.preview', { path: name, start });
   view.setPath(pv);
   view.setView('fit');
-  $('view-note').textContent = pv.truncated ? `path shown up to ${pv.points} points` : '';
+  const legend = pv.contour_line && pv.contour_line.length ? 'orange: G141/G142 tool path, magenta: its contour' : '';
+  $('view-note').textContent = [pv.truncated ? `path shown up to ${pv.points} points` : '', legend].filter(Boolean).join('; ');
   if (pv.error) message('warning', `preview: ${pv.error}`);
 }
 $('program-open').onclick = () => openProgram($('program-file').value).catch(() => {});

@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
 const DEG = Math.PI / 180;
-const COLORS = { feed: 0x4fb3ff, comp: 0xffa040, rapid: 0xd0d0d0, done: 0x4a5560,
+const COLORS = { feed: 0x4fb3ff, comp: 0xffa040, contour: 0xff60ff, rapid: 0xd0d0d0, done: 0x4a5560,
   current: 0xffff40, problem: 0xff3030 };
 
 // Platform orientation as the kinematics has it: R = Rz(C)·Ry(B)·Rx(A).
@@ -168,17 +168,21 @@ export class MachineView {
     if (!pv || pv.points < 2) { this.draw(); return; }
     const g = this.geo, onPlatform = !g || g.carries !== 'spindle';
     const tip = g ? new THREE.Vector3(...g.tool_tip) : new THREE.Vector3();
-    const n = pv.points, P = new Float32Array(n * 3);
-    const v = new THREE.Vector3();
-    for (let i = 0; i < n; i++) {
-      const q = pv.pts_um.slice(i * 6, i * 6 + 6).map((x, k) => x / (k < 3 ? 1000 : 1000));
-      const R = rotation(q[3], q[4], q[5]);
-      const t = new THREE.Vector3(q[0], q[1], q[2]);
-      if (!g) v.copy(t);
-      else if (onPlatform) v.copy(tip).sub(t).applyMatrix4(R.clone().transpose());  // tip on the work
-      else v.copy(tip).applyMatrix4(R).add(t);                                      // tip in the frame
-      P[i * 3] = v.x; P[i * 3 + 1] = v.y; P[i * 3 + 2] = v.z;
-    }
+    // a pose (X Y Z A B C in thousandths) to where the tool tip draws it
+    const place = (um, n) => {
+      const out = new Float32Array(n * 3), v = new THREE.Vector3();
+      for (let i = 0; i < n; i++) {
+        const q = um.slice(i * 6, i * 6 + 6).map((x) => x / 1000);
+        const R = rotation(q[3], q[4], q[5]);
+        const t = new THREE.Vector3(q[0], q[1], q[2]);
+        if (!g) v.copy(t);
+        else if (onPlatform) v.copy(tip).sub(t).applyMatrix4(R.clone().transpose());  // tip on the work
+        else v.copy(tip).applyMatrix4(R).add(t);                                      // tip in the frame
+        out[i * 3] = v.x; out[i * 3 + 1] = v.y; out[i * 3 + 2] = v.z;
+      }
+      return out;
+    };
+    const n = pv.points, P = place(pv.pts_um, n);
     const seg = (kindWanted) => {
       const idx = [];
       for (let i = 1; i < n; i++) if (kindWanted(pv.kind[i])) idx.push(i);
@@ -201,6 +205,18 @@ export class MachineView {
     const hl = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: COLORS.current }));
     const parent = onPlatform ? this.pathPlatform : this.pathWorld;
     parent.add(rl, cl, hl);
+    // G141/G142: the programmed contour beside the tool path the compensation made
+    const nc = (pv.contour_line || []).length;
+    if (nc > 1) {
+      const C = place(pv.contour_um, nc), pos = [];
+      for (let i = 1; i < nc; i++) {
+        if (pv.contour_first[i]) continue;   // a new run starts here
+        pos.push(...C.subarray((i - 1) * 3, i * 3), ...C.subarray(i * 3, i * 3 + 3));
+      }
+      const geom = new THREE.BufferGeometry();
+      geom.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pos), 3));
+      parent.add(new THREE.LineSegments(geom, new THREE.LineBasicMaterial({ color: COLORS.contour })));
+    }
     // which segments belong to each line, for highlighting
     const byLine = new Map();
     for (let i = 1; i < n; i++) {
