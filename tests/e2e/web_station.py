@@ -19,6 +19,7 @@ import urllib.request
 
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
@@ -73,6 +74,50 @@ def session_call(sock, method, **params):
                 s.close()
                 return m
     
+
+class MessageListener:
+    """A client of the session of its own, subscribed to its messages."""
+
+    def __init__(self, sock):
+        self.s = socket.socket(socket.AF_UNIX)
+        self.s.connect(sock)
+        self.s.sendall(b'{"jsonrpc":"2.0","id":1,"method":"messages.subscribe"}\n')
+        self.s.setblocking(False)
+        self.buf, self.seen = b"", []
+
+    def read(self):
+        try:
+            while True:
+                chunk = self.s.recv(1 << 16)
+                if not chunk:
+                    break
+                self.buf += chunk
+        except BlockingIOError:
+            pass
+        *lines, self.buf = self.buf.split(b"\n")
+        for line in lines:
+            m = json.loads(line)
+            if m.get("method") == "message":
+                self.seen.append(m["params"]["text"])
+        return self.seen
+
+    def close(self):
+        self.s.close()
+
+
+def settled(read, hold=0.5, timeout=20):
+    """Waits until read() stays the same for `hold` seconds."""
+    end = time.time() + timeout
+    last, since = read(), time.time()
+    while time.time() < end:
+        time.sleep(0.05)
+        v = read()
+        if v != last:
+            last, since = v, time.time()
+        elif time.time() - since >= hold:
+            return True
+    return False
+
 
 def browser():
     o = webdriver.ChromeOptions()
@@ -215,6 +260,42 @@ def main(tmp, shots):
                      abs(dro(a, "X") - (x0 + 1)) < 5e-4, 20), (x0, text(a, "dro-X")))
     check("the watching browser's DRO follows", wait_until(lambda: abs(dro(b, "X") - (x0 + 1)) < 5e-4))
 
+    # continuous jog: held, it moves; released, it stops
+    Select(tid(a, "jog-step")).select_by_value("0")
+    sp = a.find_element(By.ID, "jog-speed")
+    sp.clear()
+    sp.send_keys("0.2")
+    y0 = dro(a, "Y")
+    ActionChains(a).click_and_hold(tid(a, "jog-Y+")).perform()
+    moved = wait_until(lambda: dro(a, "Y") > y0 + 0.01, 20)
+    ActionChains(a).release().perform()
+    check("continuous jog Y+: moves while the button is held", moved, (y0, text(a, "dro-Y")))
+    check("... and stops when it is released", settled(lambda: dro(a, "Y")), text(a, "dro-Y"))
+    # held while the connection is lost (the station's process dies): the session stops the
+    # jog of the client it lost. (A page that is closed or reloaded stops its jog itself.)
+    listener = MessageListener(sock)
+    ActionChains(a).click_and_hold(tid(a, "jog-Y-")).perform()
+    wait_until(lambda: session_call(sock, "status.get")["result"]["motion"] == "jogging", 10)
+    web.kill()
+    web.wait()
+    said = wait_until(lambda: any("disconnected during a continuous jog" in m for m in listener.read()), 10)
+    check("a continuous jog whose page is gone is stopped by the session, which says why", said,
+          listener.seen)
+    check("... and the machine comes to rest",
+          wait_until(lambda: session_call(sock, "status.get")["result"]["motion"] != "jogging", 10),
+          session_call(sock, "status.get")["result"]["motion"])
+    listener.close()
+    check("the page says the connection is lost", wait_until(
+        lambda: "disconnected" in a.find_element(By.ID, "conn").text, 10))
+    web = start([BIN, "web", "--quiet", "--listen", "127.0.0.1:%d" % port, "--socket", sock, ini])
+    check("the station back: the page connects again by itself",
+          wait_until(lambda: a.find_element(By.ID, "conn").text == "connected", 20))
+    ActionChains(a).release().perform()
+    a.get_log("browser")   # the refused reconnections of the outage are not the page's errors
+    wait_until(lambda: text(a, "state").startswith("on"))
+    tid(a, "take-control").click()
+    wait_until(lambda: a.find_element(By.ID, "control-state").text == "in control")
+
     # MDI
     tab(a, "mdi")
     tid(a, "mdi-input").send_keys("G0 X10 Y5")
@@ -246,7 +327,7 @@ def main(tmp, shots):
           (text(a, "line"), text(a, "state")))
     tid(a, "pause").click()
     check("pause: the state says paused", wait_until(lambda: "paused" in text(a, "state"), 20), text(a, "state"))
-    wait_until(lambda: False, 0.5)
+    wait_until(lambda: "motion paused" in a.find_element(By.ID, "modal").text, 20)
     held = [dro(a, k) for k in "XYZ"]
     time.sleep(0.6)
     check("paused: the DRO holds still", held == [dro(a, k) for k in "XYZ"], (held, [dro(a, k) for k in "XYZ"]))
@@ -255,7 +336,8 @@ def main(tmp, shots):
         s.focus(); s.value = '200'; s.dispatchEvent(new Event('input')); s.blur();""")
     tid(a, "resume").click()
     # 80 min of machine time at 200 %: the simulated clock runs it in about 20 s
-    end = wait_until(lambda: "reading" not in text(a, "state") and "paused" not in text(a, "state"), 180)
+    end = wait_until(lambda: "program finished" in text(a, "messages") and
+                     not re.search("reading|paused|waiting", text(a, "state")), 180)
     check("resume: the program runs to its end", end, text(a, "state"))
     # the compensated end of the paper's path (examples/paper/prog10_g141_d20.ngc's header)
     want = {"X": 59.975641, "Y": -20.0, "Z": 630.697565, "A": 0.0, "B": -4.0, "C": 0.0}
