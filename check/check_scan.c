@@ -99,6 +99,15 @@ static void leg_problem(struct check_machine *mc, const struct canon_cmd *c, enu
     struct check_problem p = { .kind = k, .line = c->line, .leg = worst, .time_s = -1,
                                .count = 1 };
     snprintf(p.file, sizeof p.file, "%s", c->file ? c->file : "");
+    char why[300];
+    if (worst < 0 && kins_describe(mc->kins, pose, why, sizeof why) == KINS_ERR_WORKSPACE) {
+        snprintf(p.message, sizeof p.message, "%s X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f, outside "
+                 "the workspace: %s", k == CHECK_UNREACHABLE ? "the programmed point is"
+                 : "the move passes through", pose[0], pose[1], pose[2], pose[3], pose[4],
+                 pose[5], why);
+        check_add_problem(r, &p);
+        return;
+    }
     if (worst < 0) {
         snprintf(p.message, sizeof p.message, "the kinematics cannot compute the legs at X%.3f "
                  "Y%.3f Z%.3f A%.3f B%.3f C%.3f", pose[0], pose[1], pose[2], pose[3], pose[4],

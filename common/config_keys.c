@@ -92,6 +92,15 @@ const struct config_key config_keys[] = {
       "limit" },
     { "KINS", "SINGULAR_CONDITION", NUM, "", "1..1e15", 0, 0, "100", "Jacobian condition "
       "number above which a pose counts as near-singular" },
+    { "KINS", "BASE_JOINT_MAX_ANGLE", NUM, "deg", "(0..89.9]", 0, 0, "", "largest angle "
+      "between a leg and its base joint's axis (the base normal); absent: not limited" },
+    { "KINS", "PLATFORM_JOINT_MAX_ANGLE", NUM, "deg", "(0..89.9]", 0, 0, "", "largest angle "
+      "between a leg and its platform joint's axis (the platform normal); absent: not "
+      "limited" },
+    { "KINS", "LEG_DIAMETER", NUM, "mm", "(0..1000]", 0, 0, "", "legs' outer diameter: two "
+      "legs' axes stay LEG_DIAMETER + LEG_CLEARANCE apart; absent: not checked" },
+    { "KINS", "LEG_CLEARANCE", NUM, "mm", "0..1000", 0, 0, "0", "gap kept between two legs' "
+      "surfaces (needs LEG_DIAMETER)" },
     { "KINS", "CHARACTERISTIC_LENGTH", NUM, "mm", "0.001..1e6", 0, 0, "platform joint "
       "radius", "lever arm that scales rotations against lengths in the condition number" },
 

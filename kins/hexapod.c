@@ -6,6 +6,7 @@
 
 #include "kins/hexapod.h"
 #include "kins/hexapod_math.h"
+#include "kins/kins_cfg.h"
 #include "kins/kins_svd.h"
 
 /* Splits a pose (mm, deg) into the platform origin and its orientation. */
@@ -38,7 +39,8 @@ static int hexapod_lengths_of(const struct kins *k, const struct hexapod_legs *l
     return st;
 }
 
-/* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i. */
+/* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i; then the workspace's other
+ * limits (hexapod_workspace.c). */
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
 {
     const struct hexapod *h = (const struct hexapod *)k;
@@ -48,7 +50,35 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
     if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
-    return hexapod_lengths_of(k, &lg, joints);
+    int st = hexapod_lengths_of(k, &lg, joints);
+    return st != KINS_OK ? st : hexapod_workspace(h, &o, &lg, NULL, 0);
+}
+
+/* Why a pose is outside the workspace: a leg's length first, then the other limits. */
+static int hexapod_describe(struct kins *k, const double pose[KINS_POSE_DIM], char *msg,
+                            size_t len)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], joints[HEXAPOD_LEGS];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    if (hexapod_lengths_of(k, &lg, joints) != KINS_OK) {
+        for (int i = 0; i < HEXAPOD_LEGS; i++) {
+            double over = joints[i] - k->joint_max[i], under = k->joint_min[i] - joints[i];
+            if (over > 0 || under > 0) {
+                snprintf(msg, len, "leg %d ([JOINT_%d]) would be %.3f mm long, %.3f mm %s its "
+                         "%s of %.3f mm", i + 1, i, joints[i], over > 0 ? over : under,
+                         over > 0 ? "beyond" : "below", over > 0 ? "maximum" : "minimum",
+                         over > 0 ? k->joint_max[i] : k->joint_min[i]);
+                break;
+            }
+        }
+        return KINS_ERR_UNREACHABLE;
+    }
+    return hexapod_workspace(h, &o, &lg, msg, len);
 }
 
 /* Leg rates (mm/s) = J · pose velocity of legs already evaluated at the pose. */
@@ -96,6 +126,8 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
+    if (st == KINS_OK)
+        st = hexapod_workspace(h, &o, &lg, NULL, 0);
     if (st != KINS_OK)
         return st;
     for (int j = 0; j < KINS_POSE_DIM; j++)
@@ -131,6 +163,8 @@ static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
         }
         hexapod_jac_row(&o, &lg, i, h->inv_char_len, &jac[i * KINS_POSE_DIM]);
     }
+    if (hexapod_workspace(h, &o, &lg, NULL, 0) != KINS_OK)
+        out->reachable = 0;
     if (kins_svd_condition(jac, HEXAPOD_LEGS, KINS_POSE_DIM, &out->condition) != 0)
         out->condition = INFINITY;
     out->near_singular = !(out->condition <= h->singular_condition);
@@ -193,6 +227,12 @@ static int hexapod_create(const struct kins_config *cfg, struct kins **out, char
     if (st != KINS_OK)
         goto fail;
     double legs[HEXAPOD_LEGS];
+    char why[300];
+    if (hexapod_describe(&h->base, h->base.home, why, sizeof why) == KINS_ERR_WORKSPACE) {
+        st = kins_cfg_error(err, errlen, "KINS", "HOME", "the home pose is outside the "
+                            "workspace: %s", why);
+        goto fail;
+    }
     if (hexapod_inverse(&h->base, h->base.home, legs) != KINS_OK) {
         st = KINS_ERR_CONFIG;
         for (int i = 0; i < HEXAPOD_LEGS && err && errlen; i++)
@@ -221,4 +261,5 @@ const struct kins_ops kins_hexapod_ops = {
     .check = hexapod_check,
     .tool_point = hexapod_tool_point,
     .inverse_rates = hexapod_inverse_rates,
+    .describe = hexapod_describe,
 };

@@ -31,7 +31,23 @@ struct hexapod {
     enum hexapod_carries carries;      /* what the platform carries */
     double tool_tip_mm[3];             /* tool tip (gauge point + length along the tool axis):
                                         * base frame if the tool is fixed, else platform frame */
+    /* The workspace beyond leg lengths (hexapod_workspace.c, docs/kinematics.md). */
+    double base_max_deg, plat_max_deg; /* [KINS] BASE_/PLATFORM_JOINT_MAX_ANGLE; 0: none */
+    double base_cos_max, plat_cos_max; /* their cosines (-2 when there is no limit) */
+    double leg_diameter_mm;            /* [KINS] LEG_DIAMETER; 0: collisions not checked */
+    double leg_clearance_mm;           /* [KINS] LEG_CLEARANCE, kept between two legs */
 };
+
+struct hexapod_rot;
+struct hexapod_legs;
+
+/* The workspace limits at a pose whose legs are evaluated (hexapod_workspace.c): KINS_OK,
+ * or KINS_ERR_WORKSPACE with, when msg is given, what is violated, by how much and where. */
+int hexapod_workspace(const struct hexapod *h, const struct hexapod_rot *o,
+                      const struct hexapod_legs *lg, char *msg, size_t len);
+/* Reads BASE_/PLATFORM_JOINT_MAX_ANGLE, LEG_DIAMETER and LEG_CLEARANCE. */
+int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, char *err,
+                           size_t errlen);
 
 /* Reads geometry, leg limits, solver settings and tool data from cfg into h (hexapod_geom.c).
  * On failure err names the section and key. */

@@ -234,6 +234,8 @@ int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *er
         st = hexapod_read_solver(h, cfg, err, errlen);
     if (st == KINS_OK)
         st = hexapod_read_tool(h, cfg, err, errlen);
+    if (st == KINS_OK)
+        st = hexapod_read_workspace(h, cfg, err, errlen);
     if (st != KINS_OK)
         return st;
     for (int i = 0; i < HEXAPOD_LEGS; i++)

@@ -27,6 +27,8 @@ static const struct {
     { KINS_ERR_SINGULAR, "singular configuration: the legs cannot hold or move the platform" },
     { KINS_ERR_NO_CONVERGE, "forward kinematics did not converge within its iteration limit" },
     { KINS_ERR_ARG, "bad argument (not a number, or wrong count)" },
+    { KINS_ERR_WORKSPACE, "pose outside the workspace: a joint angle, leg clearance or "
+      "assembly limit" },
 };
 
 /* Text of a kinematics status, for messages. */
@@ -164,4 +166,13 @@ void kins_free(struct kins *k)
     k->ops->destroy(k);
     if (handle)
         dlclose(handle);
+}
+
+int kins_describe(struct kins *k, const double *pose, char *msg, size_t len)
+{
+    if (msg && len)
+        msg[0] = '\0';
+    if (!k->ops->describe)
+        return KINS_OK;
+    return k->ops->describe(k, pose, msg, len);
 }

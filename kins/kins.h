@@ -24,6 +24,9 @@ enum kins_status {
                               * configured threshold instead of failing) */
     KINS_ERR_NO_CONVERGE,    /* forward solve hit its iteration limit without converging */
     KINS_ERR_ARG,            /* bad argument (NaN, wrong count) */
+    KINS_ERR_WORKSPACE,      /* legs in range, but the pose breaks another limit of the
+                              * workspace: a joint's angle, two legs too close, the mirror
+                              * assembly (describe() says which) */
     KINS_STATUS_COUNT
 };
 const char *kins_strerror(int status);
@@ -80,6 +83,10 @@ struct kins_ops {
      * NULL: kins_inverse_rates() calls inverse, then leg_rates. */
     int (*inverse_rates)(struct kins *k, const double pose[KINS_POSE_DIM],
                          const double pose_vel[KINS_POSE_DIM], double *joints, double *rates);
+    /* Optional: why a pose is outside the workspace, in words for a machinist (which limit,
+     * by how much, which joint or legs), or "" and KINS_OK when it is inside. NULL: the
+     * model has no limits beyond the joints'. */
+    int (*describe)(struct kins *k, const double pose[KINS_POSE_DIM], char *msg, size_t len);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -123,6 +130,8 @@ static inline int kins_forward(struct kins *k, const double *joints, double *pos
 static inline int kins_leg_rates(struct kins *k, const double *pose, const double *vel,
                                  double *rates)
 { return k->ops->leg_rates(k, pose, vel, rates); }
+/* Why pose is outside the workspace (see kins_ops.describe); "" when it is not. */
+int kins_describe(struct kins *k, const double *pose, char *msg, size_t len);
 static inline int kins_check_pose(struct kins *k, const double *pose, struct kins_check *out)
 { return k->ops->check(k, pose, out); }
 /* Leg lengths and leg rates of a pose and its velocity, in one evaluation where the model

@@ -1,10 +1,12 @@
 # kins/: kinematics models behind struct kins_ops, linked into the library for tests and
 # tools, and built as lib/kins/<name>.so for loading by name ([KINS] KINEMATICS).
-KINS_HEXAPOD_SRCS := kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c kins/kins_cfg.c \
+KINS_HEXAPOD_SRCS := kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c \
+                     kins/hexapod_workspace.c kins/kins_cfg.c \
                      common/config_value.c
 KINS_TRIVIAL_SRCS := kins/trivial.c kins/kins_cfg.c common/config_value.c
 
 LIB_SRCS += kins/kins.c kins/kins_cfg.c kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c \
+            kins/hexapod_workspace.c \
             kins/trivial.c
 LIB_CXXSRCS += kins/kins_svd.cpp
 PLUGINS += $(LIBDIR)/kins/hexapod.so $(LIBDIR)/kins/trivial.so
@@ -24,3 +26,4 @@ $(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
 
 TESTS += test_kins test_kins_plugin
 BENCHES += bench_kins
+SCRIPT_TESTS += tests/e2e/workspace_cli.sh

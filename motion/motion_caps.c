@@ -204,6 +204,14 @@ static int unreachable(struct motion *m, const struct motion_seg *sg,
             return MOTION_ERR_UNREACHABLE;
         }
     }
+    char why[300];
+    if (st == KINS_ERR_WORKSPACE && kins_describe(m->kins, P, why, sizeof why) ==
+        KINS_ERR_WORKSPACE) {
+        snprintf(err, errlen, "%s:%d: the move leaves the machine's workspace: %s, at X%.3f "
+                 "Y%.3f Z%.3f A%.3f B%.3f C%.3f", f, sg->line, why, P[0], P[1], P[2], P[3],
+                 P[4], P[5]);
+        return MOTION_ERR_UNREACHABLE;
+    }
     snprintf(err, errlen, "%s:%d: the kinematics cannot follow the move (%s) at X%.3f Y%.3f "
              "Z%.3f A%.3f B%.3f C%.3f", f, sg->line, kins_strerror(st), P[0], P[1], P[2], P[3],
              P[4], P[5]);

@@ -174,6 +174,11 @@ static void edge_note(struct motion *m, double s)
             return;
         }
     }
+    char why[300];
+    if (st == KINS_ERR_WORKSPACE && kins_describe(m->kins, p, why, sizeof why) != KINS_OK) {
+        motion_note(m, "jog stopped at the workspace edge: %s", why);
+        return;
+    }
     motion_note(m, "jog stopped at the edge of the reachable workspace (%s)",
                 kins_strerror(st));
 }

@@ -403,6 +403,99 @@ START_TEST(test_config_errors)
 }
 END_TEST
 
+/* The workspace beyond the legs: the mirror assembly, the joints' angles, leg clearance. */
+START_TEST(test_workspace)
+{
+    char err[512], why[300];
+    double legs[6], home_legs[6];
+    struct tk_cfg *c = tk_hexapod(500, 300, 10, 10, 520, 980);
+    tk_set(c, "KINS", "HOME", "0 0 645 0 0 0");
+    struct kins *k = make_kins(c);
+    const double home[6] = { 0, 0, 645, 0, 0, 0 }, mirror[6] = { 0, 0, -645, 0, 0, 0 };
+    ck_assert_int_eq(kins_inverse(k, home, home_legs), KINS_OK);
+    /* mirrored through the base: every leg as long as at HOME, and no machine gets there */
+    ck_assert_int_eq(kins_inverse(k, mirror, legs), KINS_ERR_WORKSPACE);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(legs[i], home_legs[i], 1e-9);
+    ck_assert_int_eq(kins_describe(k, mirror, why, sizeof why), KINS_ERR_WORKSPACE);
+    ck_assert_msg(strstr(why, "mirror assembly") && strstr(why, "645.000 mm below"), "%s", why);
+    struct kins_check chk;
+    ck_assert_int_eq(kins_check_pose(k, mirror, &chk), KINS_OK);
+    ck_assert_int_eq(chk.reachable, 0);
+    const double flipped[6] = { 0, 0, 645, 180, 0, 0 };   /* upside down */
+    ck_assert_int_ne(kins_inverse(k, flipped, legs), KINS_OK);
+    ck_assert_int_eq(kins_describe(k, home, why, sizeof why), KINS_OK);
+    ck_assert_str_eq(why, "");
+    kins_free(k);
+
+    /* joint angles: at the level HOME every leg leans acos(645 / L) = 27.2322 deg from both
+     * joints' axes (the base and platform planes are parallel) */
+    double lean = acos(645.0 / (home_legs[0])) / DEG;
+    ck_assert_double_eq_tol(lean, 27.232230608, 1e-6);
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "27.2");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] HOME: the home pose "
+                                 "is outside the workspace: leg 1's base joint would turn 27.23 "
+                                 "deg from its axis, 0.03 deg beyond [KINS] "
+                                 "BASE_JOINT_MAX_ANGLE = 27.2 deg"));
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "27.3");
+    tk_set(c, "KINS", "PLATFORM_JOINT_MAX_ANGLE", "27.2");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "platform joint would turn "
+                                 "27.23 deg"));
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "40");
+    tk_set(c, "KINS", "PLATFORM_JOINT_MAX_ANGLE", "45");
+    k = make_kins(c);
+    const double tilt10[6] = { 0, 0, 645, 0, 10, 0 }, tilt20[6] = { 0, 0, 645, 0, 20, 0 };
+    ck_assert_int_eq(kins_inverse(k, tilt10, legs), KINS_OK);
+    ck_assert_int_eq(kins_inverse(k, tilt20, legs), KINS_ERR_WORKSPACE);
+    for (int i = 0; i < 6; i++)      /* the legs themselves are in range there */
+        ck_assert(legs[i] > 520 && legs[i] < 980);
+    ck_assert_int_eq(kins_describe(k, tilt20, why, sizeof why), KINS_ERR_WORKSPACE);
+    ck_assert_msg(strstr(why, "PLATFORM_JOINT_MAX_ANGLE = 45 deg"), "%s", why);
+    double rates[6], vel[6] = { 0 };
+    ck_assert_int_eq(kins_inverse_rates(k, tilt20, vel, legs, rates), KINS_ERR_WORKSPACE);
+    kins_free(k);
+
+    /* leg clearance: at the level HOME, legs 1 and 2 come closest where they meet their
+     * platform pair, 2 * 300 * sin(10 deg) = 104.189 mm apart */
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", NULL);
+    tk_set(c, "KINS", "PLATFORM_JOINT_MAX_ANGLE", NULL);
+    tk_set(c, "KINS", "LEG_DIAMETER", "100");
+    tk_set(c, "KINS", "LEG_CLEARANCE", "5");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "legs 1 and 2 would pass "
+                                 "104.19 mm apart (axis to axis), 0.81 mm closer than [KINS] "
+                                 "LEG_DIAMETER 100 mm + LEG_CLEARANCE 5 mm"));
+    tk_set(c, "KINS", "LEG_DIAMETER", "95");
+    k = make_kins(c);
+    /* turned about Z, the legs of a platform pair close in: stopped at 100 mm */
+    double turn[6] = { 0, 0, 645, 0, 0, 0 };
+    int st = KINS_OK;
+    for (turn[5] = 0; turn[5] < 90 && st == KINS_OK; turn[5] += 1)
+        st = kins_inverse(k, turn, legs);
+    ck_assert_int_eq(st, KINS_ERR_WORKSPACE);
+    turn[5] -= 1;
+    ck_assert_double_eq_tol(turn[5], 67, 1e-9);   /* `hexcnc kins ... workspace`: 66.74 deg */
+    ck_assert_int_eq(kins_describe(k, turn, why, sizeof why), KINS_ERR_WORKSPACE);
+    ck_assert_msg(strstr(why, "legs 1 and 2 would pass 99.") &&
+                  strstr(why, "LEG_DIAMETER 95 mm + LEG_CLEARANCE 5 mm"), "%s", why);
+    kins_free(k);
+    /* the same turn without the clearance check is within the legs' lengths */
+    tk_set(c, "KINS", "LEG_DIAMETER", NULL);
+    tk_set(c, "KINS", "LEG_CLEARANCE", NULL);
+    k = make_kins(c);
+    ck_assert_int_eq(kins_inverse(k, turn, legs), KINS_OK);
+    kins_free(k);
+
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "95");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[KINS] BASE_JOINT_MAX_ANGLE: 95 is outside (0..89.9");
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", NULL);
+    tk_set(c, "KINS", "LEG_CLEARANCE", "5");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] LEG_CLEARANCE: needs "
+                                 "LEG_DIAMETER"));
+    free(c);
+}
+END_TEST
+
 /* Two machines in one process keep their own geometry. */
 START_TEST(test_two_instances)
 {
@@ -560,6 +653,7 @@ static Suite *kins_suite(void)
     tcase_add_test(tc, test_rotation_order);
     tcase_add_test(tc, test_trivial_static);
     tcase_add_test(tc, test_strerror);
+    tcase_add_test(tc, test_workspace);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -9,7 +9,8 @@
 #include "tools/cmd.h"
 
 const char cmd_kins_usage[] =
-    "kins CONFIG.ini inverse X Y Z A B C | forward L1..L6   pose (mm, deg) <-> legs (mm)";
+    "kins CONFIG.ini inverse X Y Z A B C | forward L1..L6 | workspace [A B C]   pose (mm, deg) "
+    "<-> legs (mm); how far the machine reaches from HOME";
 
 /* Parses n command-line numbers; prints which one is wrong. */
 static int kins_parse_args(char **argv, int n, const char *const *names, double *out)
@@ -47,6 +48,73 @@ static void kins_report_legs(const struct kins *k, const double *legs, const cha
     }
 }
 
+/* How far the pose can go from `from` along axis j in direction sign (mm or deg), every pose
+ * on the way reachable, to within 0.01; `why` says what stops it there. */
+static double kins_reach(struct kins *k, const double from[KINS_POSE_DIM], int j, int sign,
+                         char *why, size_t len)
+{
+    double step = j < 3 ? 1.0 : 0.1, limit = j < 3 ? 3000.0 : 180.0, ok = 0, bad = -1;
+    double pose[KINS_POSE_DIM], legs[KINS_MAX_JOINTS];
+    memcpy(pose, from, sizeof pose);
+    for (double d = step; d <= limit + 1e-9; d += step) {
+        pose[j] = from[j] + sign * d;
+        if (kins_inverse(k, pose, legs) != KINS_OK) {
+            bad = d;
+            break;
+        }
+        ok = d;
+    }
+    if (bad < 0) {
+        snprintf(why, len, "nothing within %g %s", limit, j < 3 ? "mm" : "deg");
+        return ok;
+    }
+    while (bad - ok > 0.005) {
+        double mid = 0.5 * (ok + bad);
+        pose[j] = from[j] + sign * mid;
+        if (kins_inverse(k, pose, legs) == KINS_OK)
+            ok = mid;
+        else
+            bad = mid;
+    }
+    pose[j] = from[j] + sign * bad;
+    int st = kins_describe(k, pose, why, len);
+    if (!why[0])
+        snprintf(why, len, "%s", kins_strerror(st == KINS_OK ? kins_inverse(k, pose, legs)
+                                                             : st));
+    return ok;
+}
+
+/* `workspace [A B C]`: the reach from HOME along each axis, and what limits it. */
+static int kins_workspace(struct kins *k, char **args, int nargs)
+{
+    static const char *const names[] = { "X", "Y", "Z", "A", "B", "C" };
+    double from[KINS_POSE_DIM], legs[KINS_MAX_JOINTS];
+    memcpy(from, k->home, sizeof from);
+    if (nargs != 0 && nargs != 3) {
+        fprintf(stderr, "hexcnc kins: workspace takes no argument or the orientation A B C\n");
+        return 2;
+    }
+    if (nargs == 3 && kins_parse_args(args, 3, names + 3, from + 3) != 0)
+        return 2;
+    char why[300];
+    if (kins_inverse(k, from, legs) != KINS_OK) {
+        kins_describe(k, from, why, sizeof why);
+        fprintf(stderr, "hexcnc kins: HOME's position at A%g B%g C%g is outside the workspace: "
+                "%s\n", from[3], from[4], from[5], why[0] ? why : "unreachable");
+        return 1;
+    }
+    printf("reach from X%g Y%g Z%g A%g B%g C%g, every pose on the way reachable:\n",
+           from[0], from[1], from[2], from[3], from[4], from[5]);
+    printf("%-4s %12s   %s\n", "axis", "reach", "limited by");
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        for (int sign = 1; sign >= -1; sign -= 2) {
+            double r = kins_reach(k, from, j, sign, why, sizeof why);
+            printf("%s%-3s %9.2f %-3s  %s\n", sign > 0 ? "+" : "-", names[j], r,
+                   j < 3 ? "mm" : "deg", why);
+        }
+    return 0;
+}
+
 /* Runs one inverse or forward and prints the result; returns the exit status. */
 static int kins_run(struct kins *k, const char *mode, char **args, int nargs)
 {
@@ -63,6 +131,11 @@ static int kins_run(struct kins *k, const char *mode, char **args, int nargs)
         int st = kins_inverse(k, in, out);
         if (st == KINS_ERR_UNREACHABLE) {
             kins_report_legs(k, out, "pose unreachable", "would be");
+            return 1;
+        }
+        char why[300];
+        if (st == KINS_ERR_WORKSPACE && kins_describe(k, in, why, sizeof why) != KINS_OK) {
+            fprintf(stderr, "hexcnc kins: pose outside the workspace: %s\n", why);
             return 1;
         }
         if (st != KINS_OK) {
@@ -93,7 +166,10 @@ static int kins_run(struct kins *k, const char *mode, char **args, int nargs)
         kins_print(out, KINS_POSE_DIM);
         return 0;
     }
-    fprintf(stderr, "hexcnc kins: unknown mode '%s' (expected inverse or forward)\n", mode);
+    if (!strcmp(mode, "workspace"))
+        return kins_workspace(k, args, nargs);
+    fprintf(stderr, "hexcnc kins: unknown mode '%s' (expected inverse, forward or workspace)\n",
+            mode);
     return 2;
 }
 

@@ -1,0 +1,122 @@
+/* hexapod_workspace.c: the hexapod's workspace beyond its legs' lengths: the passive joints'
+ * angles, the clearance between legs, and the assembly (platform above its base, facing up).
+ * The checks run in every inverse solve; the angles and the clearance only when configured. */
+#include <math.h>
+#include <stdio.h>
+
+#include "kins/hexapod.h"
+#include "kins/hexapod_math.h"
+#include "kins/kins_cfg.h"
+
+int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, char *err,
+                           size_t errlen)
+{
+    static const char *const keys[] = { "BASE_JOINT_MAX_ANGLE", "PLATFORM_JOINT_MAX_ANGLE",
+                                        "LEG_DIAMETER", "LEG_CLEARANCE" };
+    double *out[] = { &h->base_max_deg, &h->plat_max_deg, &h->leg_diameter_mm,
+                      &h->leg_clearance_mm };
+    static const double hi[] = { 89.9, 89.9, 1000, 1000 };
+    for (int i = 0; i < 4; i++) {
+        int found;
+        *out[i] = 0;
+        int st = kins_cfg_numbers(cfg, "KINS", keys[i], out[i], 1, &found, err, errlen);
+        if (st != KINS_OK)
+            return st;
+        if (found && !(*out[i] > 0 && *out[i] <= hi[i]) && !(i == 3 && *out[i] == 0))
+            return kins_cfg_error(err, errlen, "KINS", keys[i], "%g is outside %s..%g", *out[i],
+                                  i == 3 ? "0" : "(0", hi[i]);
+    }
+    if (h->leg_clearance_mm > 0 && h->leg_diameter_mm == 0)
+        return kins_cfg_error(err, errlen, "KINS", "LEG_CLEARANCE", "needs LEG_DIAMETER (the "
+                              "legs' outer diameter) to mean anything");
+    h->base_cos_max = h->base_max_deg > 0 ? cos(h->base_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
+    h->plat_cos_max = h->plat_max_deg > 0 ? cos(h->plat_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
+    return KINS_OK;
+}
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double clamp01(double x)
+{
+    return x < 0 ? 0 : x > 1 ? 1 : x;
+}
+
+/* Shortest distance between segments p0 + s·d1 and q0 + t·d2, s, t in [0, 1]. */
+static double segment_distance(const double p0[3], const double d1[3], const double q0[3],
+                               const double d2[3])
+{
+    double r[3] = { p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2] };
+    double a = dot3(d1, d1), e = dot3(d2, d2), f = dot3(d2, r), c = dot3(d1, r);
+    double b = dot3(d1, d2), den = a * e - b * b, s, t;
+    s = den > 1e-12 * a * e ? clamp01((b * f - c * e) / den) : 0;
+    t = (b * s + f) / e;
+    if (t < 0) {
+        t = 0;
+        s = clamp01(-c / a);
+    } else if (t > 1) {
+        t = 1;
+        s = clamp01((b - c) / a);
+    }
+    double w[3];
+    for (int j = 0; j < 3; j++)
+        w[j] = r[j] + s * d1[j] - t * d2[j];
+    return sqrt(dot3(w, w));
+}
+
+#define FAIL(...) do { if (msg) snprintf(msg, len, __VA_ARGS__); return KINS_ERR_WORKSPACE; } \
+                  while (0)
+
+int hexapod_workspace(const struct hexapod *h, const struct hexapod_rot *o,
+                      const struct hexapod_legs *lg, char *msg, size_t len)
+{
+    /* the platform faces up (its normal R·z has a positive Z) and every platform joint is
+     * above its base joint: the other assembly, mirrored through the base, has the same
+     * leg lengths and no machine can get there */
+    if (o->r[2][2] <= 0)
+        FAIL("the platform would face down (tilted %.1f deg from level): that is the mirror "
+             "assembly, which the machine cannot reach", acos(fmax(-1, o->r[2][2])) *
+             HEXAPOD_DEG_PER_RAD);
+    for (int i = 0; i < HEXAPOD_LEGS; i++)
+        if (lg->u[i][2] <= 0)
+            FAIL("leg %d's platform joint would be %.3f mm below its base joint: that is the "
+                 "mirror assembly, with the platform on the wrong side of the base, which the "
+                 "machine cannot reach", i + 1, -lg->u[i][2] * lg->len_mm[i]);
+    /* the base joints' axes are the base normal (+Z); the platform joints' the platform
+     * normal, turned with the platform: cos(angle) = u·n */
+    double pz[3] = { o->r[0][2], o->r[1][2], o->r[2][2] };
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        double cb = lg->u[i][2], cp = dot3(lg->u[i], pz);
+        if (cb < h->base_cos_max) {
+            double a = acos(fmax(-1, fmin(1, cb))) * HEXAPOD_DEG_PER_RAD;
+            FAIL("leg %d's base joint would turn %.2f deg from its axis, %.2f deg beyond [KINS] "
+                 "BASE_JOINT_MAX_ANGLE = %g deg", i + 1, a, a - h->base_max_deg,
+                 h->base_max_deg);
+        }
+        if (cp < h->plat_cos_max) {
+            double a = acos(fmax(-1, fmin(1, cp))) * HEXAPOD_DEG_PER_RAD;
+            FAIL("leg %d's platform joint would turn %.2f deg from its axis, %.2f deg beyond "
+                 "[KINS] PLATFORM_JOINT_MAX_ANGLE = %g deg", i + 1, a, a - h->plat_max_deg,
+                 h->plat_max_deg);
+        }
+    }
+    if (h->leg_diameter_mm > 0) {
+        double need = h->leg_diameter_mm + h->leg_clearance_mm, v[HEXAPOD_LEGS][3];
+        for (int i = 0; i < HEXAPOD_LEGS; i++)
+            for (int j = 0; j < 3; j++)
+                v[i][j] = lg->u[i][j] * lg->len_mm[i];
+        for (int i = 0; i < HEXAPOD_LEGS; i++)
+            for (int j = i + 1; j < HEXAPOD_LEGS; j++) {
+                double d = segment_distance(h->b_mm[i], v[i], h->b_mm[j], v[j]);
+                if (d < need)
+                    FAIL("legs %d and %d would pass %.2f mm apart (axis to axis), %.2f mm "
+                         "closer than [KINS] LEG_DIAMETER %g mm + LEG_CLEARANCE %g mm", i + 1,
+                         j + 1, d, need - d, h->leg_diameter_mm, h->leg_clearance_mm);
+            }
+    }
+    if (msg && len)
+        msg[0] = '\0';
+    return KINS_OK;
+}
