@@ -39,6 +39,18 @@ const struct config_section config_sections[] = {
     { "MODBUS_SIM", CONFIG_STRICT, "the simulated Modbus drives" },
     { "CAN", CONFIG_STRICT, "CANopen bus and CiA 402 master (docs/can.md)" },
     { "CAN_NODE_#", CONFIG_STRICT, "one CiA 402 drive, joint #" },
+    { "AXIS_X", CONFIG_STRICT, "the pose's X in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
+    { "AXIS_Y", CONFIG_STRICT, "the pose's Y in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
+    { "AXIS_Z", CONFIG_STRICT, "the pose's Z in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
+    { "AXIS_A", CONFIG_STRICT, "the pose's A in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
+    { "AXIS_B", CONFIG_STRICT, "the pose's B in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
+    { "AXIS_C", CONFIG_STRICT, "the pose's C in machine coordinates: soft limits; "
+      "LinuxCNC's axis speeds here are accepted and ignored" },
     /* Other programs' sections, accepted and ignored so a LinuxCNC INI can be used. */
     { "HALUI", CONFIG_FOREIGN, "LinuxCNC's halui" },
     { "FILTER", CONFIG_FOREIGN, "LinuxCNC's program filters" },
@@ -185,6 +197,56 @@ const struct config_key config_keys[] = {
     { "JOINT_#", "HOME_USE_INDEX", BOOL, "", "", 0, IGN, "", "LinuxCNC's encoder index "
       "homing (not used)" },
     { "JOINT_#", "TYPE", STR, "", "", 0, IGN, "", "LinuxCNC's joint type; legs are linear" },
+
+    /* [AXIS_X] .. [AXIS_C]: soft limits of the pose (kins/hexapod_workspace.c) */
+    { "AXIS_X", "MIN_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's X in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_X", "MAX_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's X stays at or below it; absent: none" },
+    { "AXIS_Y", "MIN_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's Y in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_Y", "MAX_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's Y stays at or below it; absent: none" },
+    { "AXIS_Z", "MIN_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's Z in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_Z", "MAX_LIMIT", NUM, "mm", "", 0, 0, "", "soft limit: the pose's Z stays at or below it; absent: none" },
+    { "AXIS_A", "MIN_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's A in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_A", "MAX_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's A stays at or below it; absent: none" },
+    { "AXIS_B", "MIN_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's B in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_B", "MAX_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's B stays at or below it; absent: none" },
+    { "AXIS_C", "MIN_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's C in machine coordinates stays at or above it (jog, MDI, check, run); absent: none" },
+    { "AXIS_C", "MAX_LIMIT", NUM, "deg", "", 0, 0, "", "soft limit: the pose's C stays at or below it; absent: none" },
+    { "AXIS_X", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_X", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_X", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_X", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_X", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_X", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
+    { "AXIS_Y", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_Y", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_Y", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_Y", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_Y", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_Y", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
+    { "AXIS_Z", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_Z", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_Z", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_Z", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_Z", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_Z", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
+    { "AXIS_A", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_A", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_A", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_A", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_A", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_A", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
+    { "AXIS_B", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_B", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_B", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_B", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_B", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_B", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
+    { "AXIS_C", "MAX_VELOCITY", NUM, "", "", 0, IGN, "", "LinuxCNC's axis speed (hexcnc: [TRAJ] and the legs)" },
+    { "AXIS_C", "MAX_ACCELERATION", NUM, "", "", 0, IGN, "", "LinuxCNC's axis acceleration" },
+    { "AXIS_C", "MAX_JERK", NUM, "", "", 0, IGN, "", "LinuxCNC's axis jerk" },
+    { "AXIS_C", "OFFSET_AV_RATIO", NUM, "", "", 0, IGN, "", "LinuxCNC's external offsets share" },
+    { "AXIS_C", "WRAPPED_ROTARY", STR, "", "", 0, IGN, "", "LinuxCNC's wrapped rotary axis" },
+    { "AXIS_C", "LOCKING_INDEXER_JOINT", STR, "", "", 0, IGN, "", "LinuxCNC's locking indexer" },
 
     /* [RS274NGC] */
     { "RS274NGC", "FEED_UNITS", ENUM, "", "mm/min|m/min", 0, 0, "mm/min", "unit of F in G21 "

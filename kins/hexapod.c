@@ -51,7 +51,7 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
-    return st != KINS_OK ? st : hexapod_workspace(h, &o, &lg, NULL, 0);
+    return st != KINS_OK ? st : hexapod_workspace(h, pose, &o, &lg, NULL, 0);
 }
 
 /* Why a pose is outside the workspace: a leg's length first, then the other limits. */
@@ -78,7 +78,7 @@ static int hexapod_describe(struct kins *k, const double pose[KINS_POSE_DIM], ch
         }
         return KINS_ERR_UNREACHABLE;
     }
-    return hexapod_workspace(h, &o, &lg, msg, len);
+    return hexapod_workspace(h, pose, &o, &lg, msg, len);
 }
 
 /* Leg rates (mm/s) = J · pose velocity of legs already evaluated at the pose. */
@@ -127,7 +127,7 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
     hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
     if (st == KINS_OK)
-        st = hexapod_workspace(h, &o, &lg, NULL, 0);
+        st = hexapod_workspace(h, pose, &o, &lg, NULL, 0);
     if (st != KINS_OK)
         return st;
     for (int j = 0; j < KINS_POSE_DIM; j++)
@@ -163,7 +163,7 @@ static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
         }
         hexapod_jac_row(&o, &lg, i, h->inv_char_len, &jac[i * KINS_POSE_DIM]);
     }
-    if (hexapod_workspace(h, &o, &lg, NULL, 0) != KINS_OK)
+    if (hexapod_workspace(h, pose, &o, &lg, NULL, 0) != KINS_OK)
         out->reachable = 0;
     if (kins_svd_condition(jac, HEXAPOD_LEGS, KINS_POSE_DIM, &out->condition) != 0)
         out->condition = INFINITY;

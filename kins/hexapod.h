@@ -36,6 +36,8 @@ struct hexapod {
     double base_cos_max, plat_cos_max; /* their cosines (-2 when there is no limit) */
     double leg_diameter_mm;            /* [KINS] LEG_DIAMETER; 0: collisions not checked */
     double leg_clearance_mm;           /* [KINS] LEG_CLEARANCE, kept between two legs */
+    double axis_min[KINS_POSE_DIM];    /* [AXIS_X..C] MIN_LIMIT, MAX_LIMIT: the pose's soft */
+    double axis_max[KINS_POSE_DIM];    /* limits, machine coordinates (+-inf: none) */
 };
 
 struct hexapod_rot;
@@ -43,8 +45,9 @@ struct hexapod_legs;
 
 /* The workspace limits at a pose whose legs are evaluated (hexapod_workspace.c): KINS_OK,
  * or KINS_ERR_WORKSPACE with, when msg is given, what is violated, by how much and where. */
-int hexapod_workspace(const struct hexapod *h, const struct hexapod_rot *o,
-                      const struct hexapod_legs *lg, char *msg, size_t len);
+int hexapod_workspace(const struct hexapod *h, const double pose[KINS_POSE_DIM],
+                      const struct hexapod_rot *o, const struct hexapod_legs *lg, char *msg,
+                      size_t len);
 /* Reads BASE_/PLATFORM_JOINT_MAX_ANGLE, LEG_DIAMETER and LEG_CLEARANCE. */
 int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, char *err,
                            size_t errlen);

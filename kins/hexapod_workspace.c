@@ -1,6 +1,7 @@
-/* hexapod_workspace.c: the hexapod's workspace beyond its legs' lengths: the passive joints'
- * angles, the clearance between legs, and the assembly (platform above its base, facing up).
- * The checks run in every inverse solve; the angles and the clearance only when configured. */
+/* hexapod_workspace.c: the hexapod's workspace beyond its legs' lengths: the pose's soft
+ * limits ([AXIS_X..C] MIN_LIMIT/MAX_LIMIT), the passive joints' angles, the clearance between
+ * legs, and the assembly (platform above its base, facing up). The checks run in every
+ * inverse solve; all but the assembly only when configured. */
 #include <math.h>
 #include <stdio.h>
 
@@ -29,6 +30,21 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
     if (h->leg_clearance_mm > 0 && h->leg_diameter_mm == 0)
         return kins_cfg_error(err, errlen, "KINS", "LEG_CLEARANCE", "needs LEG_DIAMETER (the "
                               "legs' outer diameter) to mean anything");
+    static const char *const axes[] = { "AXIS_X", "AXIS_Y", "AXIS_Z", "AXIS_A", "AXIS_B",
+                                        "AXIS_C" };
+    for (int j = 0; j < KINS_POSE_DIM; j++) {
+        int fmin_found, fmax_found, st;
+        h->axis_min[j] = -INFINITY;
+        h->axis_max[j] = INFINITY;
+        if ((st = kins_cfg_numbers(cfg, axes[j], "MIN_LIMIT", &h->axis_min[j], 1, &fmin_found,
+                                   err, errlen)) ||
+            (st = kins_cfg_numbers(cfg, axes[j], "MAX_LIMIT", &h->axis_max[j], 1, &fmax_found,
+                                   err, errlen)))
+            return st;
+        if (!(h->axis_min[j] < h->axis_max[j]))
+            return kins_cfg_error(err, errlen, axes[j], "MAX_LIMIT", "%g is not above "
+                                  "MIN_LIMIT %g", h->axis_max[j], h->axis_min[j]);
+    }
     h->base_cos_max = h->base_max_deg > 0 ? cos(h->base_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
     h->plat_cos_max = h->plat_max_deg > 0 ? cos(h->plat_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
     return KINS_OK;
@@ -69,9 +85,19 @@ static double segment_distance(const double p0[3], const double d1[3], const dou
 #define FAIL(...) do { if (msg) snprintf(msg, len, __VA_ARGS__); return KINS_ERR_WORKSPACE; } \
                   while (0)
 
-int hexapod_workspace(const struct hexapod *h, const struct hexapod_rot *o,
-                      const struct hexapod_legs *lg, char *msg, size_t len)
+int hexapod_workspace(const struct hexapod *h, const double pose[KINS_POSE_DIM],
+                      const struct hexapod_rot *o, const struct hexapod_legs *lg, char *msg,
+                      size_t len)
 {
+    static const char names[] = "XYZABC";
+    for (int j = 0; j < KINS_POSE_DIM; j++) {
+        if (pose[j] < h->axis_min[j])
+            FAIL("%c%.3f is %.3f %s below [AXIS_%c] MIN_LIMIT = %g", names[j], pose[j],
+                 h->axis_min[j] - pose[j], j < 3 ? "mm" : "deg", names[j], h->axis_min[j]);
+        if (pose[j] > h->axis_max[j])
+            FAIL("%c%.3f is %.3f %s above [AXIS_%c] MAX_LIMIT = %g", names[j], pose[j],
+                 pose[j] - h->axis_max[j], j < 3 ? "mm" : "deg", names[j], h->axis_max[j]);
+    }
     /* the platform faces up (its normal R·z has a positive Z) and every platform joint is
      * above its base joint: the other assembly, mirrored through the base, has the same
      * leg lengths and no machine can get there */

@@ -485,6 +485,29 @@ START_TEST(test_workspace)
     ck_assert_int_eq(kins_inverse(k, turn, legs), KINS_OK);
     kins_free(k);
 
+    /* soft limits of the pose, machine coordinates, as LinuxCNC's [AXIS_n] writes them */
+    tk_set(c, "AXIS_Z", "MAX_LIMIT", "700");
+    tk_set(c, "AXIS_B", "MIN_LIMIT", "-5");
+    k = make_kins(c);
+    ck_assert_int_eq(kins_inverse(k, (double[6]){ 0, 0, 700, 0, 0, 0 }, legs), KINS_OK);
+    ck_assert_int_eq(kins_inverse(k, (double[6]){ 0, 0, 701, 0, 0, 0 }, legs),
+                     KINS_ERR_WORKSPACE);
+    kins_describe(k, (double[6]){ 0, 0, 701, 0, 0, 0 }, why, sizeof why);
+    ck_assert_str_eq(why, "Z701.000 is 1.000 mm above [AXIS_Z] MAX_LIMIT = 700");
+    kins_describe(k, (double[6]){ 0, 0, 645, 0, -7.5, 0 }, why, sizeof why);
+    ck_assert_str_eq(why, "B-7.500 is 2.500 deg below [AXIS_B] MIN_LIMIT = -5");
+    kins_free(k);
+    tk_set(c, "AXIS_Z", "MAX_LIMIT", "600");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] HOME: the home pose "
+                                 "is outside the workspace: Z645.000 is 45.000 mm above "
+                                 "[AXIS_Z] MAX_LIMIT = 600"));
+    tk_set(c, "AXIS_B", "MAX_LIMIT", "-6");
+    ck_assert_str_eq(create_err(c, err, sizeof err),
+                     "[AXIS_B] MAX_LIMIT: -6 is not above MIN_LIMIT -5");
+    tk_set(c, "AXIS_B", "MAX_LIMIT", NULL);
+    tk_set(c, "AXIS_B", "MIN_LIMIT", NULL);
+    tk_set(c, "AXIS_Z", "MAX_LIMIT", NULL);
+
     tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "95");
     ck_assert_str_eq(create_err(c, err, sizeof err),
                      "[KINS] BASE_JOINT_MAX_ANGLE: 95 is outside (0..89.9");

@@ -41,5 +41,16 @@ check "workspace: twelve directions" [ "$(grep -c '^[+-][XYZABC] ' "$tmp/ws")" -
 "$bin" kins "$root/configs/sim/tmu-hexapod.ini" workspace > "$tmp/ws0" 2>&1
 check "without the joint limits, +X reaches 439.86 mm (leg 2 at its maximum)" has "$tmp/ws0" \
     "^+X      439.86 mm   leg 2 (\[JOINT_1\]) would be 980"
+# soft limits: [AXIS_Z] MAX_LIMIT, beside LinuxCNC's other [AXIS_Z] keys (ignored)
+cp "$root/configs/sim/tmu-hexapod.ini" "$tmp/soft.ini"
+printf '\n[AXIS_Z]\nMIN_LIMIT = 560\nMAX_LIMIT = 660\nMAX_VELOCITY = 30\n' >> "$tmp/soft.ini"
+printf 'G21 G90\nG0 X0 Y0 Z650\nG1 Z670 F100\nM2\n' > "$tmp/high.ngc"
+"$bin" check "$tmp/soft.ini" "$tmp/high.ngc" > "$tmp/out" 2>&1
+check "check refuses a move above [AXIS_Z] MAX_LIMIT (exit 1)" [ $? -eq 1 ]
+check "... naming line 3, the amount and the key" has "$tmp/out" \
+    "high.ngc:3: .*Z670.000 is 10.000 mm above \[AXIS_Z\] MAX_LIMIT = 660"
+printf 'MAX_LIMITS = 660\n' >> "$tmp/soft.ini"
+"$bin" check "$tmp/soft.ini" "$tmp/high.ngc" > "$tmp/out" 2>&1
+check "a misspelt soft limit is an error naming it" has "$tmp/out" 'AXIS_Z\] MAX_LIMITS: unknown key'
 echo "workspace_cli: $fails failed"
 [ "$fails" -eq 0 ]
