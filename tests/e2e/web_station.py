@@ -294,7 +294,8 @@ def main(tmp, shots):
     a.get_log("browser")   # the refused reconnections of the outage are not the page's errors
     wait_until(lambda: text(a, "state").startswith("on"))
     tid(a, "take-control").click()
-    wait_until(lambda: a.find_element(By.ID, "control-state").text == "in control")
+    check("(control taken again)", wait_until(lambda: a.find_element(By.ID, "control-state").text ==
+                                              "in control"))
 
     # MDI
     tab(a, "mdi")
@@ -358,7 +359,8 @@ def main(tmp, shots):
     # a fault from outside: the e-stop chain's fault input, set by another client of the
     # session (the page gives control up for it: commands need control or nobody holding it)
     tid(a, "take-control").click()
-    wait_until(lambda: a.find_element(By.ID, "control-state").text == "watching")
+    check("(control given up)", wait_until(lambda: a.find_element(By.ID, "control-state").text ==
+                                           "watching"))
     r = session_call(sock, "hal.set", name="estop-latch.0.fault-in", value=True)
     check("(the fault input is set)", "result" in r, r)
     check("a fault: the page shows e-stop and the fault's cause",
@@ -370,7 +372,8 @@ def main(tmp, shots):
     a.save_screenshot(os.path.join(shots, "station-fault.png"))
     session_call(sock, "hal.set", name="estop-latch.0.fault-in", value=False)
     tid(a, "take-control").click()
-    wait_until(lambda: a.find_element(By.ID, "control-state").text == "in control")
+    check("(control taken again)", wait_until(lambda: a.find_element(By.ID, "control-state").text ==
+                                              "in control"))
     tid(a, "estop").click()
     check("after the fault, e-stop reset: state off", wait_until(lambda: text(a, "state").startswith("off"), 20),
           text(a, "state"))

@@ -46,6 +46,8 @@ const act = (method, params) => call(method, params).catch(() => {});
 async function onOpen() {
   $('conn').textContent = 'connected';
   $('conn').className = 'conn ok';
+  haveControl = false;   // a new connection holds nothing (before any await: a click may follow)
+  controlUi();
   try {
     info = await rpc.call('station.info');
     $('machine-name').textContent = info.machine;
@@ -56,8 +58,6 @@ async function onOpen() {
     await rpc.call('messages.subscribe');
     onStatus(await rpc.call('status.get'));
     await refreshPrograms();
-    haveControl = false;
-    controlUi();
   } catch (e) {
     message('error', `station: ${e.message}`);
   }
