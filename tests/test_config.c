@@ -167,7 +167,8 @@ START_TEST(test_foreign_sections_accepted)
                                 "[DISPLAY]\nDISPLAY = axis\nCYCLE_TIME = 0.1\n"
                                 "[EMCIO]\nEMCIO = io\nTOOL_TABLE = t.tbl\n"
                                 "[HALUI]\nMDI_COMMAND = G0 X0\n[FILTER]\nPROGRAM_EXTENSION = "
-                                ".py Python\n[AXIS_X]\nMAX_VELOCITY = 5\nWHATEVER = 1\n"
+                                ".py Python\n[AXIS_X]\nMAX_VELOCITY = 5\nMIN_LIMIT = -200\n"
+                                "[AXIS_U]\nWHATEVER = 1\n"
                                 "[SPINDLE_0]\nMAX_FORWARD_VELOCITY = 100\n"
                                 "[EMCMOT]\nEMCMOT = motmod\nBASE_PERIOD = 50000\n"
                                 "[TASK]\nTASK = milltask\nCYCLE_TIME = 0.010\n"
@@ -177,6 +178,9 @@ START_TEST(test_foreign_sections_accepted)
     /* ... but a key LinuxCNC does not have either is still an error in hexcnc's sections */
     expect_error("[EMCMOT]\nBASE_PERIODE = 50000\n", CONFIG_ERR_UNKNOWN, 16,
                  "[EMCMOT] BASE_PERIODE: unknown key; did you mean BASE_PERIOD?");
+    /* [AXIS_X..C] hold the pose's soft limits: checked like hexcnc's own sections */
+    expect_error("[AXIS_Z]\nMAX_LIMITS = 700\n", CONFIG_ERR_UNKNOWN, 16,
+                 "[AXIS_Z] MAX_LIMITS: unknown key; did you mean MAX_LIMIT?");
 }
 END_TEST
 
