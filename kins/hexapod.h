@@ -2,6 +2,7 @@
 #ifndef HEXCNC_HEXAPOD_H
 #define HEXCNC_HEXAPOD_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "kins/kins.h"
@@ -38,6 +39,8 @@ struct hexapod {
     double leg_clearance_mm;           /* [KINS] LEG_CLEARANCE, kept between two legs */
     double axis_min[KINS_POSE_DIM];    /* [AXIS_X..C] MIN_LIMIT, MAX_LIMIT: the pose's soft */
     double axis_max[KINS_POSE_DIM];    /* limits, machine coordinates (+-inf: none) */
+    bool axis_limited;                 /* any of them set */
+    bool ws_extra;                     /* any workspace limit beyond the assembly set */
 };
 
 struct hexapod_rot;

@@ -30,6 +30,7 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
     if (h->leg_clearance_mm > 0 && h->leg_diameter_mm == 0)
         return kins_cfg_error(err, errlen, "KINS", "LEG_CLEARANCE", "needs LEG_DIAMETER (the "
                               "legs' outer diameter) to mean anything");
+    h->axis_limited = false;
     static const char *const axes[] = { "AXIS_X", "AXIS_Y", "AXIS_Z", "AXIS_A", "AXIS_B",
                                         "AXIS_C" };
     for (int j = 0; j < KINS_POSE_DIM; j++) {
@@ -41,10 +42,13 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
             (st = kins_cfg_numbers(cfg, axes[j], "MAX_LIMIT", &h->axis_max[j], 1, &fmax_found,
                                    err, errlen)))
             return st;
+        h->axis_limited |= fmin_found || fmax_found;
         if (!(h->axis_min[j] < h->axis_max[j]))
             return kins_cfg_error(err, errlen, axes[j], "MAX_LIMIT", "%g is not above "
                                   "MIN_LIMIT %g", h->axis_max[j], h->axis_min[j]);
     }
+    h->ws_extra = h->axis_limited || h->base_max_deg > 0 || h->plat_max_deg > 0 ||
+                  h->leg_diameter_mm > 0;
     h->base_cos_max = h->base_max_deg > 0 ? cos(h->base_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
     h->plat_cos_max = h->plat_max_deg > 0 ? cos(h->plat_max_deg * HEXAPOD_RAD_PER_DEG) : -2;
     return KINS_OK;
@@ -90,7 +94,7 @@ int hexapod_workspace(const struct hexapod *h, const double pose[KINS_POSE_DIM],
                       size_t len)
 {
     static const char names[] = "XYZABC";
-    for (int j = 0; j < KINS_POSE_DIM; j++) {
+    for (int j = 0; j < KINS_POSE_DIM && h->axis_limited; j++) {
         if (pose[j] < h->axis_min[j])
             FAIL("%c%.3f is %.3f %s below [AXIS_%c] MIN_LIMIT = %g", names[j], pose[j],
                  h->axis_min[j] - pose[j], j < 3 ? "mm" : "deg", names[j], h->axis_min[j]);
@@ -113,7 +117,7 @@ int hexapod_workspace(const struct hexapod *h, const double pose[KINS_POSE_DIM],
     /* the base joints' axes are the base normal (+Z); the platform joints' the platform
      * normal, turned with the platform: cos(angle) = u·n */
     double pz[3] = { o->r[0][2], o->r[1][2], o->r[2][2] };
-    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+    for (int i = 0; i < HEXAPOD_LEGS && (h->base_max_deg > 0 || h->plat_max_deg > 0); i++) {
         double cb = lg->u[i][2], cp = dot3(lg->u[i], pz);
         if (cb < h->base_cos_max) {
             double a = acos(fmax(-1, fmin(1, cb))) * HEXAPOD_DEG_PER_RAD;
