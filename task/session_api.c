@@ -357,10 +357,10 @@ static int m_tooltable_get(struct session *s, struct session_client *c, json_t *
     json_t *a = json_array();
     for (int i = 0; i < s->mdi_tt.count; i++) {
         const struct tool_entry *t = &s->mdi_tt.tools[i];
-        json_array_append_new(a, json_pack("{s:i, s:i, s:f, s:f, s:s}", "tool", t->tool,
+        json_array_append_new(a, json_pack("{s:i, s:i, s:f, s:f, s:f, s:s}", "tool", t->tool,
                                            "pocket", t->pocket, "length", t->z_offset_mm,
-                                           "diameter", t->diameter_mm, "comment",
-                                           t->comment));
+                                           "diameter", t->diameter_mm, "wear", t->wear_mm,
+                                           "comment", t->comment));
     }
     *r = json_pack("{s:o, s:s}", "tools", a, "path", s->mdi_tt.path);
     return 0;
@@ -377,6 +377,7 @@ static int m_tooltable_set(struct session *s, struct session_client *c, json_t *
         (rc = get_int(p, "pocket", false, 0, 99999, &pocket, &hp, err, len)) ||
         (rc = get_num(p, "length", false, &e.length, &e.has_length, err, len)) ||
         (rc = get_num(p, "diameter", false, &e.diameter, &e.has_diameter, err, len)) ||
+        (rc = get_num(p, "wear", false, &e.wear, &e.has_wear, err, len)) ||
         (hc && (rc = get_str(p, "comment", &e.comment, err, len))))
         return rc;
     if (e.has_diameter && e.diameter < 0)

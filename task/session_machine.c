@@ -173,6 +173,8 @@ int session_tooltable_set(struct session *s, const struct session_tool_edit *e, 
     if (e->comment)
         snprintf(ent.comment, sizeof ent.comment, "%s", e->comment);
     char msg[600];
+    if (e->has_wear)
+        ent.wear_mm = e->wear;
     int st = tooltable_set(tt, &ent);
     if (st == TOOLTABLE_OK)
         st = tooltable_save(tt, tt->path, msg, sizeof msg);

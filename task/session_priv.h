@@ -113,8 +113,9 @@ int session_tool_changed(struct session *s, char *err, size_t len);
 struct session_tool_edit {
     int tool;
     int pocket;                  /* -1: keep (a new tool: its number) */
-    bool has_length, has_diameter;
+    bool has_length, has_diameter, has_wear;
     double length, diameter;     /* mm */
+    double wear;                 /* diameter wear, mm (negative as the tool wears down) */
     const char *comment;         /* NULL: keep */
 };
 int session_tooltable_set(struct session *s, const struct session_tool_edit *e, char *err,

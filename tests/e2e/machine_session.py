@@ -587,6 +587,13 @@ def homing_session(tmp):
     line = [l for l in open(tbl) if l.startswith("T2 ")]
     check("... and the file has it", line and "Z+12.5" in line[0] and "D11.8" in line[0] and
           "re-ground" in line[0], line)
+    c.ok("tooltable.set", tool=2, wear=-0.04)
+    tools = {t["tool"]: t for t in c.ok("tooltable.get")["tools"]}
+    check("tooltable.set wear: shown, the rest kept", tools[2]["wear"] == -0.04 and
+          tools[2]["diameter"] == 11.8, tools.get(2))
+    line = [l for l in open(tbl) if l.startswith("T10002 ")]
+    check("... and saved as LinuxCNC's wear entry T10002 (D-0.04)", line and "D-0.04" in line[0],
+          line)
     c.ok("mdi.execute", line="G43 H2")
     st = c.status()
     check("... and MDI uses it at once (G43 H2: tool length 12.5)",

@@ -348,6 +348,22 @@ def main(tmp, shots):
     msgs = text(a, "messages")
     check("messages tell of the program's start and end", "finished" in msgs or "ended" in msgs, msgs[:400])
 
+    # the tool table editor: a wear value saved through the page reaches the table
+    tab(a, "tools")
+    rows = wait_until(lambda: a.find_elements(By.CSS_SELECTOR, "#tools tbody tr"), 10)
+    check("the tool table is listed", rows)
+    if rows:
+        inputs = rows[0].find_elements(By.TAG_NAME, "input")
+        tool = int(inputs[0].get_attribute("value"))
+        inputs[4].clear()
+        inputs[4].send_keys("-0.03")
+        rows[0].find_element(By.TAG_NAME, "button").click()
+        saved = wait_until(lambda: [t for t in session_call(sock, "tooltable.get")["result"]["tools"]
+                                    if t["tool"] == tool and abs(t["wear"] + 0.03) < 1e-9], 10)
+        check("a tool's wear edited on the page is saved in the table (T%d wear -0.03)" % tool,
+              saved, session_call(sock, "tooltable.get")["result"]["tools"][:3])
+    tab(a, "program")
+
     # hostile requests through the page's own WebSocket
     r = raw_ws(a, [{"jsonrpc": "2.0", "id": 1, "method": "machine.shutdown"},
                    {"jsonrpc": "2.0", "id": 2, "method": "program.open", "params": {"path": "../tmu-hexapod.ini"}},

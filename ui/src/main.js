@@ -395,18 +395,19 @@ function toolRow(t) {
   const tr = $('tools').tBodies[0].insertRow();
   const num = (v) => `<input type="number" step="0.001" value="${v}">`;
   tr.innerHTML = `<td><input type="number" min="1" value="${t.tool}"></td><td><input type="number" min="0" value="${t.pocket}"></td>` +
-    `<td>${num(t.length)}</td><td>${num(t.diameter)}</td><td><input class="c" value=""></td><td><button>Save</button></td>`;
-  tr.cells[4].firstChild.value = t.comment || '';
+    `<td>${num(t.length)}</td><td>${num(t.diameter)}</td><td>${num(t.wear || 0)}</td>` +
+    '<td><input class="c" value=""></td><td><button>Save</button></td>';
+  tr.cells[5].firstChild.value = t.comment || '';
   tr.querySelector('button').onclick = async () => {
     const v = [...tr.querySelectorAll('input')].map((i) => i.value);
     try {
       await call('tooltable.set', { tool: parseInt(v[0], 10), pocket: parseInt(v[1], 10), length: parseFloat(v[2]),
-        diameter: parseFloat(v[3]), comment: v[4] });
+        diameter: parseFloat(v[3]), wear: parseFloat(v[4]), comment: v[5] });
       message('info', `tool ${v[0]} saved`);
     } catch (e) { /* shown */ }
   };
 }
-$('tool-add').onclick = () => toolRow({ tool: '', pocket: '', length: 0, diameter: 0, comment: '' });
+$('tool-add').onclick = () => toolRow({ tool: '', pocket: '', length: 0, diameter: 0, wear: 0, comment: '' });
 
 // ---- plot -----------------------------------------------------------------------------
 let plotQueued = false;
