@@ -77,11 +77,14 @@ static double rig_run(struct rig *r, double max_s, double stop_after_s)
 
 /* The TMU hexapod with legs of vmax mm/s and amax mm/s^2; joints homed at once (no
  * switches) unless switches is set, and at its home pose. */
-static void rig_open(struct rig *r, double vmax, double amax, int switches)
+static void rig_open_with(struct rig *r, double vmax, double amax, int switches,
+                          const char *sec_, const char *key, const char *val)
 {
     memset(r, 0, sizeof *r);
     struct tk_cfg *c = tm_hexapod_cfg();
     ck_assert_ptr_nonnull(c);
+    if (sec_)
+        tk_set(c, sec_, key, val);
     for (int i = 0; i < 6; i++) {
         char sec[24], v[32], a[32];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
@@ -102,6 +105,11 @@ static void rig_open(struct rig *r, double vmax, double amax, int switches)
     r->use_switches = switches;
     r->sw_at = 760;
     motion_step(r->mc.m, DT, &r->prev);
+}
+
+static void rig_open(struct rig *r, double vmax, double amax, int switches)
+{
+    rig_open_with(r, vmax, amax, switches, NULL, NULL, NULL);
 }
 
 /* Homes every leg; without switches that takes no motion beyond the move to HOME. */
@@ -219,6 +227,25 @@ START_TEST(test_jog_stops_at_workspace_edge)
 }
 END_TEST
 
+/* A jog into a soft limit of the pose ([AXIS_X] MAX_LIMIT) stops at it, and the note names
+ * the limit as kins_describe() words it. */
+START_TEST(test_jog_stops_at_soft_limit)
+{
+    struct rig r;
+    rig_open_with(&r, 100, 1000, 0, "AXIS_X", "MAX_LIMIT", "50");
+    rig_home(&r);
+    ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 0, 20, 0), MOTION_OK);
+    double t = rig_run(&r, 60, 0);
+    ck_assert_msg(t < 60, "the jog never stopped");
+    const double *pose = r.o.pose;   /* the last commanded pose */
+    ck_assert_msg(pose[0] <= 50.0 && pose[0] > 49.0, "stopped at X%.4f", pose[0]);
+    const char *note = motion_manual_note(r.mc.m, NULL);
+    ck_assert_msg(strstr(note, "jog stopped at the workspace edge: X50.0") &&
+                  strstr(note, "above [AXIS_X] MAX_LIMIT = 50"), "note: %s", note);
+    tm_close(&r.mc);
+}
+END_TEST
+
 /* World jogs need homed legs; a leg jog does not. */
 START_TEST(test_world_jog_needs_homing)
 {
@@ -277,6 +304,7 @@ static Suite *motion_manual_suite(void)
     tcase_add_test(tc, test_rotary_and_tool_jog_within_leg_limits);
     tcase_add_test(tc, test_incremental_jog_exact);
     tcase_add_test(tc, test_jog_stops_at_workspace_edge);
+    tcase_add_test(tc, test_jog_stops_at_soft_limit);
     tcase_add_test(tc, test_world_jog_needs_homing);
     tcase_add_test(tc, test_homing_with_switches_finds_offsets);
     suite_add_tcase(s, tc);
