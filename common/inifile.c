@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *const inifile_msgs[INIFILE_STATUS_COUNT] = {
     [INIFILE_OK] = "ok",
@@ -194,6 +195,25 @@ const char *inifile_path(const struct inifile *ini)
 const char *inifile_dir(const struct inifile *ini)
 {
     return ini->dir;
+}
+
+int inifile_resolve(const char *dir, const char *value, char *out, size_t len)
+{
+    int n = value[0] == '/' || !dir || !dir[0] ? snprintf(out, len, "%s", value)
+                                               : snprintf(out, len, "%s/%s", dir, value);
+    return n < 0 || (size_t)n >= len ? -1 : 0;
+}
+
+int inifile_api_socket(const char *value, const char *dir, char *out, size_t len)
+{
+    const char *xdg = getenv("XDG_RUNTIME_DIR");
+    if (value && value[0])
+        return inifile_resolve(dir, value, out, len) ? -1 : INIFILE_SOCKET_INI;
+    int n = xdg && xdg[0] ? snprintf(out, len, "%s/hexcnc.sock", xdg)
+                          : snprintf(out, len, "/tmp/hexcnc-%u/hexcnc.sock", (unsigned)getuid());
+    if (n < 0 || (size_t)n >= len)
+        return -1;
+    return xdg && xdg[0] ? INIFILE_SOCKET_XDG : INIFILE_SOCKET_TMP;
 }
 
 /* inifile_get for callers that hold the file as a void *. */

@@ -47,6 +47,16 @@ int inifile_line(const struct inifile *ini, const char *section, const char *key
 /* The path loaded and its folder, NULL before a load. */
 const char *inifile_path(const struct inifile *ini);
 const char *inifile_dir(const struct inifile *ini);
+/* A path as an INI writes it: value itself when absolute or dir is NULL or "", else
+ * dir/value. Returns 0, or -1 when out (len bytes) cannot hold it. */
+int inifile_resolve(const char *dir, const char *value, char *out, size_t len);
+
+/* The machine session's socket: [API] SOCKET (value, relative to dir), else
+ * $XDG_RUNTIME_DIR/hexcnc.sock, else /tmp/hexcnc-UID/hexcnc.sock. Which one it is, or -1
+ * when out cannot hold it; for the last, the folder (which `hexcnc machine` creates) is
+ * /tmp/hexcnc-UID. value may be NULL. */
+enum inifile_socket { INIFILE_SOCKET_INI, INIFILE_SOCKET_XDG, INIFILE_SOCKET_TMP };
+int inifile_api_socket(const char *value, const char *dir, char *out, size_t len);
 
 /* inifile_get with an untyped context (a struct inifile *): the get() of struct kins_config
  * and of interp_setup(). */

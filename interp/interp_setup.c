@@ -18,9 +18,7 @@ static int setup_path(const char *section, const char *key, const char *value, c
     out[0] = '\0';
     if (!value || !value[0])
         return INTERP_OK;
-    int n = value[0] == '/' || !dir || !dir[0] ? snprintf(out, len, "%s", value)
-                                               : snprintf(out, len, "%s/%s", dir, value);
-    if (n < 0 || (size_t)n >= len)
+    if (inifile_resolve(dir, value, out, len))
         return errbuf_set(err, errlen, INTERP_ERR_CONFIG, "[%s] %s = %s: the path is longer "
                           "than %zu characters", section, key, value, len - 1);
     return INTERP_OK;

@@ -39,11 +39,7 @@ const char *runner_strerror(int status)
 /* A path from the INI, made relative to the INI's folder unless absolute. */
 void runner_ini_path(const struct runner *r, const char *value, char *out, size_t len)
 {
-    const char *dir = hal_ini_dir(r->hal);
-    if (value[0] == '/' || !dir || !dir[0])
-        snprintf(out, len, "%s", value);
-    else
-        snprintf(out, len, "%s/%s", dir, value);
+    inifile_resolve(hal_ini_dir(r->hal), value, out, len);
 }
 
 /* Clock choice and servo period from the options and [EMCMOT]. */

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "common/errbuf.h"
+#include "common/inifile.h"
 #include "interp/interp.h"
 #include "motion/motion_hal.h"
 
@@ -269,16 +270,11 @@ void session_tick(struct session *s)
 static int default_socket(struct session *s, char *out, size_t len, char *err, size_t errlen)
 {
     const char *ini = hal_ini_get(s->hal, "API", "SOCKET");
-    const char *xdg = getenv("XDG_RUNTIME_DIR");
-    if (ini && ini[0]) {
-        const char *dir = hal_ini_dir(s->hal);
-        if (ini[0] == '/' || !dir || !dir[0])
-            snprintf(out, len, "%s", ini);
-        else
-            snprintf(out, len, "%s/%s", dir, ini);
-    } else if (xdg && xdg[0]) {
-        snprintf(out, len, "%s/hexcnc.sock", xdg);
-    } else {
+    int where = inifile_api_socket(ini, hal_ini_dir(s->hal), out, len);
+    if (where < 0)
+        return errbuf_set(err, errlen, 1, "the session's socket path is longer than %zu "
+                          "characters: set a shorter [API] SOCKET", len - 1);
+    if (where == INIFILE_SOCKET_TMP) {   /* the folder is ours to make, and must be ours */
         char dir[64];
         snprintf(dir, sizeof dir, "/tmp/hexcnc-%u", (unsigned)getuid());
         if (mkdir(dir, 0700) != 0 && errno != EEXIST)
@@ -287,7 +283,6 @@ static int default_socket(struct session *s, char *out, size_t len, char *err, s
         if (lstat(dir, &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid())
             return errbuf_set(err, errlen, 1, "%s: not a folder of this user; set [API] SOCKET "
                         "or XDG_RUNTIME_DIR", dir);
-        snprintf(out, len, "%s/hexcnc.sock", dir);
     }
     return 0;
 }

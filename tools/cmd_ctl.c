@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "common/inifile.h"
 #include "tools/cmd.h"
 
 const char cmd_ctl_usage[] =
@@ -28,10 +29,7 @@ struct ctl_conn {
 
 static int ctl_default_socket(char *out, size_t len)
 {
-    const char *xdg = getenv("XDG_RUNTIME_DIR");
-    if (xdg && xdg[0])
-        return snprintf(out, len, "%s/hexcnc.sock", xdg) >= (int)len;
-    return snprintf(out, len, "/tmp/hexcnc-%u/hexcnc.sock", (unsigned)getuid()) >= (int)len;
+    return inifile_api_socket(NULL, NULL, out, len) < 0;
 }
 
 static int ctl_connect(struct ctl_conn *c, const char *path)

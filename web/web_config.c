@@ -108,20 +108,22 @@ static int read_origins(struct web_config *c, const char *list, char *err, size_
     return 0;
 }
 
-/* A path from the INI, relative to the INI's folder. */
-static void ini_path(const struct inifile *ini, const char *v, char *out, size_t len)
+/* A path from the INI, relative to the INI's folder; an over-long one is an error naming it. */
+static int ini_path(const struct inifile *ini, const char *key, const char *v, char *out,
+                    size_t len, char *err, size_t errlen)
 {
-    if (v[0] == '/')
-        snprintf(out, len, "%s", v);
-    else
-        snprintf(out, len, "%s/%s", inifile_dir(ini), v);
+    if (inifile_resolve(inifile_dir(ini), v, out, len))
+        return errbuf_set(err, errlen, -1, "%s = %s: the path is longer than %zu characters",
+                          key, v, len - 1);
+    return 0;
 }
 
 /* The built page: [API] UI_DIR, else share/hexcnc/ui beside the program's bin/. */
 static int find_ui(struct web_config *c, const char *v, char *err, size_t errlen)
 {
     if (v) {
-        ini_path(c->ini, v, c->ui_dir, sizeof c->ui_dir);
+        if (ini_path(c->ini, "[API] UI_DIR", v, c->ui_dir, sizeof c->ui_dir, err, errlen))
+            return -1;
     } else {
         char exe[PATH_MAX - 64];
         ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -144,15 +146,6 @@ static int find_ui(struct web_config *c, const char *v, char *err, size_t errlen
     return 0;
 }
 
-static void default_socket(char *out, size_t len)
-{
-    const char *xdg = getenv("XDG_RUNTIME_DIR");
-    if (xdg && xdg[0])
-        snprintf(out, len, "%s/hexcnc.sock", xdg);
-    else
-        snprintf(out, len, "/tmp/hexcnc-%u/hexcnc.sock", (unsigned)getuid());
-}
-
 int web_config_read(struct web_config *c, const struct inifile *ini, const char *listen,
                     const char *sock, char *err, size_t errlen)
 {
@@ -163,9 +156,9 @@ int web_config_read(struct web_config *c, const struct inifile *ini, const char 
         return -1;
     const char *tok = inifile_get(ini, "API", "TOKEN_FILE");
     if (tok) {
-        char p[1024];
-        ini_path(ini, tok, p, sizeof p);
-        if (read_token(c, p, err, errlen))
+        char p[PATH_MAX];
+        if (ini_path(ini, "[API] TOKEN_FILE", tok, p, sizeof p, err, errlen) ||
+            read_token(c, p, err, errlen))
             return -1;
     } else if (!c->loopback) {
         return errbuf_set(err, errlen, -1, "[API] HTTP = %s:%d is reachable from other "
@@ -177,20 +170,19 @@ int web_config_read(struct web_config *c, const struct inifile *ini, const char 
         find_ui(c, inifile_get(ini, "API", "UI_DIR"), err, errlen))
         return -1;
     const char *pre = inifile_get(ini, "DISPLAY", "PROGRAM_PREFIX");
-    if (pre)
-        ini_path(ini, pre, c->prefix, sizeof c->prefix);
-    else
-        snprintf(c->prefix, sizeof c->prefix, "%s", inifile_dir(ini));
+    if (ini_path(ini, "[DISPLAY] PROGRAM_PREFIX", pre ? pre : ".", c->prefix, sizeof c->prefix,
+                 err, errlen))
+        return -1;
     char real[PATH_MAX];
     if (!realpath(c->prefix, real))
         return errbuf_set(err, errlen, -1, "[DISPLAY] PROGRAM_PREFIX = %s: %s", c->prefix,
                           strerror(errno));
     memcpy(c->prefix, real, strlen(real) + 1);
-    const char *s = sock ? sock : inifile_get(ini, "API", "SOCKET");
-    if (s)
-        ini_path(ini, s, c->socket, sizeof c->socket);
-    else
-        default_socket(c->socket, sizeof c->socket);
+    if (inifile_api_socket(sock ? sock : inifile_get(ini, "API", "SOCKET"), inifile_dir(ini),
+                           c->socket, sizeof c->socket) < 0)
+        return errbuf_set(err, errlen, -1, "the session's socket path is longer than %zu "
+                          "characters: set a shorter [API] SOCKET or --socket",
+                          sizeof c->socket - 1);
     return 0;
 }
 
