@@ -39,8 +39,9 @@ static int hexapod_lengths_of(const struct kins *k, const struct hexapod_legs *l
     return st;
 }
 
-/* Every workspace limit, the legs evaluated afresh (kept out of line: the inverse's own leg
- * evaluation then need not compute the unit vectors it does not use). */
+/* Every workspace limit for the inverse, the legs evaluated afresh (out of line: the
+ * inverse's own evaluation then need not compute the unit vectors it does not use). Callers
+ * that have them (inverse_rates, check) call hexapod_workspace() with their own. */
 static __attribute__((noinline)) int hexapod_ws_full(const struct hexapod *h,
                                                      const double *pose)
 {
@@ -53,19 +54,18 @@ static __attribute__((noinline)) int hexapod_ws_full(const struct hexapod *h,
     return hexapod_workspace(h, pose, &o, &lg, NULL, 0);
 }
 
-/* The workspace beyond the legs (hexapod_workspace.c), its common case inline: no limit but
- * the assembly configured, and the platform above its base joints, facing up. */
-static inline int hexapod_ws(const struct hexapod *h, const double *pose,
-                             const struct hexapod_rot *o, const struct hexapod_legs *lg)
+/* The common case of the workspace (hexapod_workspace.c), inline: no limit but the assembly
+ * configured, and the platform above its base joints, facing up. A platform joint is above
+ * its base joint when t_z + (R p)_z - b_z > 0: no division, so the inverse, which needs no
+ * unit vectors, does not compute them for this. */
+static inline bool hexapod_ws_plain(const struct hexapod *h, const double *pose,
+                                    const struct hexapod_rot *o,
+                                    const struct hexapod_legs *lg)
 {
-    /* a platform joint above its base joint: t_z + (R p)_z - b_z > 0 (no division needed,
-     * so the unit vectors stay unused and the compiler drops them from the inverse) */
     bool up = o->r[2][2] > 0;
     for (int i = 0; i < HEXAPOD_LEGS; i++)
         up &= pose[KINS_Z] + lg->rp_mm[i][2] - h->b_mm[i][2] > 0;
-    if (!h->ws_extra && up)
-        return KINS_OK;
-    return hexapod_ws_full(h, pose);
+    return !h->ws_extra && up;
 }
 
 /* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i; then the workspace's other
@@ -80,7 +80,9 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
-    return st != KINS_OK ? st : hexapod_ws(h, pose, &o, &lg);
+    if (st != KINS_OK || hexapod_ws_plain(h, pose, &o, &lg))
+        return st;
+    return hexapod_ws_full(h, pose);
 }
 
 /* Why a pose is outside the workspace: a leg's length first, then the other limits. */
@@ -155,8 +157,8 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
-    if (st == KINS_OK)
-        st = hexapod_ws(h, pose, &o, &lg);
+    if (st == KINS_OK && !hexapod_ws_plain(h, pose, &o, &lg))
+        st = hexapod_workspace(h, pose, &o, &lg, NULL, 0);
     if (st != KINS_OK)
         return st;
     for (int j = 0; j < KINS_POSE_DIM; j++)
@@ -192,7 +194,7 @@ static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
         }
         hexapod_jac_row(&o, &lg, i, h->inv_char_len, &jac[i * KINS_POSE_DIM]);
     }
-    if (hexapod_ws(h, pose, &o, &lg) != KINS_OK)
+    if (hexapod_workspace(h, pose, &o, &lg, NULL, 0) != KINS_OK)
         out->reachable = 0;
     if (kins_svd_condition(jac, HEXAPOD_LEGS, KINS_POSE_DIM, &out->condition) != 0)
         out->condition = INFINITY;

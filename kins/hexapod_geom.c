@@ -203,8 +203,10 @@ static int hexapod_read_tool(struct hexapod *h, const struct kins_config *cfg, c
     double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
     if (n < 1e-9)
         return kins_cfg_error(err, errlen, "KINS", "TOOL_AXIS", "the direction is zero");
-    for (int j = 0; j < 3; j++)
-        h->tool_tip_mm[j] = gauge[j] + len_mm * axis[j] / n;
+    for (int j = 0; j < 3; j++) {
+        h->tool_axis[j] = axis[j] / n;
+        h->tool_tip_mm[j] = gauge[j] + len_mm * h->tool_axis[j];
+    }
     return KINS_OK;
 }
 

@@ -85,11 +85,7 @@ static json_t *station_info(const struct web_config *c)
     json_t *geo = json_pack("{s:o, s:o, s:s, s:o}", "base", base, "platform", plat,
                             "carries", h->carries == HEXAPOD_CARRIES_SPINDLE ? "spindle"
                             : "workpiece", "tool_tip", vec3(h->tool_tip_mm));
-    const char *axis = inifile_get(ini, "KINS", "TOOL_AXIS");
-    double ax[3] = { 0, 0, -1 };
-    if (axis)
-        sscanf(axis, "%lf %lf %lf", &ax[0], &ax[1], &ax[2]);
-    json_object_set_new(geo, "tool_axis", vec3(ax));
+    json_object_set_new(geo, "tool_axis", vec3(h->tool_axis));
     kins_free(k);
     json_object_set_new(r, "geometry", geo);
     return r;
