@@ -106,21 +106,36 @@ static json_t *program_list(const struct web_config *c, int *code, char *err, si
         errbuf_set(err, errlen, -1, "%s: %s", c->prefix, strerror(errno));
         return NULL;
     }
-    json_t *items[4096];
-    size_t n = 0;
+    json_t **items = NULL;   /* every file: a folder of any size is listed whole */
+    size_t n = 0, cap = 0;
     struct dirent *e;
-    while ((e = readdir(d)) && n < sizeof items / sizeof items[0]) {
+    while ((e = readdir(d))) {
         struct stat st;
         if (e->d_name[0] == '.' || fstatat(dirfd(d), e->d_name, &st, 0) || !S_ISREG(st.st_mode))
             continue;
+        if (n == cap) {
+            json_t **more = realloc(items, (cap = cap ? 2 * cap : 256) * sizeof *items);
+            if (!more) {
+                for (size_t i = 0; i < n; i++)
+                    json_decref(items[i]);
+                free(items);
+                closedir(d);
+                *code = RPC_FAILED;
+                errbuf_set(err, errlen, -1, "%s: out of memory listing it", c->prefix);
+                return NULL;
+            }
+            items = more;
+        }
         items[n++] = json_pack("{s:s, s:I, s:I}", "name", e->d_name, "size",
                                (json_int_t)st.st_size, "mtime", (json_int_t)st.st_mtime);
     }
     closedir(d);
-    qsort(items, n, sizeof items[0], by_name);
+    if (n)
+        qsort(items, n, sizeof items[0], by_name);
     json_t *files = json_array();
     for (size_t i = 0; i < n; i++)
         json_array_append_new(files, items[i]);
+    free(items);
     return json_pack("{s:s, s:o}", "folder", c->prefix, "files", files);
 }
 

@@ -88,7 +88,6 @@ function initTables() {
   const legs = $('legs').tBodies[0];
   for (let i = 1; i <= 6; i++) {
     const tr = legs.insertRow();
-    tr.dataset.testid = `leg-${i}`;
     tr.setAttribute('data-testid', `leg-${i}`);
     tr.innerHTML = `<td>${i}</td><td id="leg-len-${i}">—</td><td><span class="bar"><i id="leg-bar-${i}"></i></span></td>` +
       `<td id="leg-rate-${i}">—</td><td id="leg-fe-${i}">—</td>`;
