@@ -326,51 +326,68 @@ int runner_load_canon(struct runner *r, const struct canon_prog *prog, char *err
 }
 
 /* Whether a command is a move or another command that happens on the path. */
-static bool runner_is_motion(enum canon_type t)
+void runner_cut_init(struct runner_cut *cut, int from_line, const double start[KINS_POSE_DIM])
 {
-    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC || t == CANON_DWELL ||
-           t == CANON_PAUSE || t == CANON_SETTING;
+    memset(cut, 0, sizeof *cut);
+    cut->from_line = from_line > 1 ? from_line : 1;
+    memcpy(cut->at, start, sizeof cut->at);
 }
 
-/* The program from line from_line on (see runner.h): modal commands of the lines before it
- * stay, their moves and settings go; a rapid to the start of from_line comes first. */
+int runner_cut_step(struct runner_cut *cut, const struct canon_cmd *c, struct canon_cmd *go,
+                    char *err, size_t errlen)
+{
+    if (cut->started)
+        return RUNNER_CUT_KEEP;
+    if (c->line >= cut->from_line && c->type != CANON_OFFSETS) {
+        cut->started = true;
+        if (cut->from_line == 1)
+            return RUNNER_CUT_KEEP;
+        if ((c->type == CANON_FEED || c->type == CANON_ARC) && c->compensated &&
+            cut->last_comp)
+            return errbuf_set(err, errlen, -1, "%s:%d: the program cannot start inside a "
+                              "G141/G142 run: start at the line that begins it", c->file,
+                              c->line);
+        *go = *c;
+        go->type = CANON_TRAVERSE;
+        memcpy(go->end, cut->at, sizeof go->end);
+        go->compensated = 0;
+        go->setting = NULL;
+        go->text = NULL;
+        return RUNNER_CUT_RAPID_FIRST;
+    }
+    switch (c->type) {
+    case CANON_TRAVERSE:
+    case CANON_FEED:
+    case CANON_ARC:
+        memcpy(cut->at, c->end, sizeof cut->at);
+        cut->last_comp = c->compensated;
+        return RUNNER_CUT_DROP;
+    case CANON_DWELL:
+    case CANON_PAUSE:
+    case CANON_SETTING:
+        return RUNNER_CUT_DROP;
+    default:
+        return RUNNER_CUT_KEEP;
+    }
+}
+
+/* The program from line from_line on (see runner.h), whole, through runner_cut_step. */
 static int runner_cut_before(const struct canon_prog *in, int from_line, struct canon_prog *out,
                              char *err, size_t errlen)
 {
-    double at[KINS_POSE_DIM];
-    memcpy(at, in->start, sizeof at);
-    memcpy(out->start, in->start, sizeof at);
-    bool started = false;
-    int last_comp = 0;
+    struct runner_cut cut;
+    runner_cut_init(&cut, from_line, in->start);
+    memcpy(out->start, in->start, sizeof out->start);
     for (size_t i = 0; i < in->count; i++) {
-        const struct canon_cmd *c = &in->cmds[i];
-        if (!started && c->line >= from_line && c->type != CANON_OFFSETS) {
-            started = true;
-            if ((c->type == CANON_FEED || c->type == CANON_ARC) && c->compensated &&
-                last_comp)
-                return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "%s:%d: the program cannot "
-                                  "start inside a G141/G142 run: start at the line that "
-                                  "begins it", c->file, c->line);
-            struct canon_cmd go = *c;
-            go.type = CANON_TRAVERSE;
-            memcpy(go.end, at, sizeof go.end);
-            go.compensated = 0;
-            go.setting = NULL;
-            go.text = NULL;
-            if (canon_prog_sink(out, &go) != 0)
-                return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
-        }
-        if (!started && runner_is_motion(c->type)) {
-            if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC) {
-                memcpy(at, c->end, sizeof at);
-                last_comp = c->compensated;
-            }
-            continue;
-        }
-        if (canon_prog_sink(out, c) != 0)
+        struct canon_cmd go;
+        int act = runner_cut_step(&cut, &in->cmds[i], &go, err, errlen);
+        if (act < 0)
+            return RUNNER_ERR_PROGRAM;
+        if ((act == RUNNER_CUT_RAPID_FIRST && canon_prog_sink(out, &go) != 0) ||
+            (act != RUNNER_CUT_DROP && canon_prog_sink(out, &in->cmds[i]) != 0))
             return errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "out of memory");
     }
-    if (!started)
+    if (!cut.started)
         return errbuf_set(err, errlen, RUNNER_ERR_PROGRAM, "the program has no line %d or "
                           "later to start from", from_line);
     return RUNNER_OK;

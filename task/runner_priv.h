@@ -27,6 +27,22 @@ struct runner_check {
 };
 struct runner_stream;
 
+/* Running from a line: the modal commands of the lines before from_line pass, their moves
+ * and settings do not, and a rapid to where they would have left the machine comes first.
+ * One command at a time, for the whole-program load (runner.c) and the stream alike. */
+struct runner_cut {
+    int from_line;                      /* 1: the whole program, nothing cut */
+    bool started;                       /* from_line (or a later line) reached */
+    double at[KINS_POSE_DIM];           /* where the cut moves would have ended */
+    int last_comp;                      /* the last cut move was G141/G142's */
+};
+enum runner_cut_action { RUNNER_CUT_DROP, RUNNER_CUT_KEEP, RUNNER_CUT_RAPID_FIRST };
+void runner_cut_init(struct runner_cut *cut, int from_line, const double start[KINS_POSE_DIM]);
+/* What becomes of c; for RUNNER_CUT_RAPID_FIRST, *go is the rapid to put before c. Returns
+ * an action, or -1 with the message in err (a start inside a G141/G142 run). */
+int runner_cut_step(struct runner_cut *cut, const struct canon_cmd *c, struct canon_cmd *go,
+                    char *err, size_t errlen);
+
 /* The machine, the program and what the monitor has seen. */
 struct runner {
     struct hal *hal;                    /* the runtime (owns kins and motion) */

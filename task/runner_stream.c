@@ -18,21 +18,11 @@
 /* Chunks the planner may have ahead of the machine (each about STREAM_WINDOW moves). */
 #define RUNNER_STREAM_AHEAD 3
 
-/* The program from line from_line on, as runner_cut_before makes it, one command at a time:
- * modal commands of the lines before it pass, their moves and settings do not; a rapid to
- * the start of from_line comes first. */
-struct stream_cut {
-    int from_line;
-    bool started;
-    double at[KINS_POSE_DIM];
-    int last_comp;
-};
-
 /* What the interpreter's commands go through, in both passes. */
 struct stream_sink {
     struct runner *r;
     struct motion_stream *ms;
-    struct stream_cut cut;
+    struct runner_cut cut;
     struct interp *store;            /* check pass: the settings' files are checked on it */
     bool run;                        /* run pass: settings are kept for runner_settings_apply,
                                       * the planner waits for the machine */
@@ -55,12 +45,6 @@ struct runner_stream {
     _Atomic int first_ready;         /* the first chunk is planned, or the producer ended */
     _Atomic int done;                /* the producer has ended (sink.status says how) */
 };
-
-static bool is_path_cmd(enum canon_type t)
-{
-    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC || t == CANON_DWELL ||
-           t == CANON_PAUSE || t == CANON_SETTING;
-}
 
 static void sleep_ms(double ms)
 {
@@ -148,36 +132,16 @@ static double input_answer(void *ctx, const struct canon_cmd *w)
 static int sink(void *ctx, const struct canon_cmd *c)
 {
     struct stream_sink *k = ctx;
-    struct stream_cut *cut = &k->cut;
     if (k->status)
         return -1;
-    if (!cut->started && c->line >= cut->from_line && c->type != CANON_OFFSETS) {
-        cut->started = true;
-        if (cut->from_line > 1) {
-            if ((c->type == CANON_FEED || c->type == CANON_ARC) && c->compensated &&
-                cut->last_comp) {
-                return sink_fail(k, RUNNER_ERR_PROGRAM, "%s:%d: the program cannot start "
-                                 "inside a G141/G142 run: start at the line that begins it",
-                                 c->file, c->line);
-            }
-            struct canon_cmd go = *c;
-            go.type = CANON_TRAVERSE;
-            memcpy(go.end, cut->at, sizeof go.end);
-            go.compensated = 0;
-            go.setting = NULL;
-            go.text = NULL;
-            if (take(k, &go))
-                return -1;
-        }
-    }
-    if (!cut->started && is_path_cmd(c->type)) {
-        if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC) {
-            memcpy(cut->at, c->end, sizeof cut->at);
-            cut->last_comp = c->compensated;
-        }
-        return 0;
-    }
-    return take(k, c);
+    struct canon_cmd go;
+    char msg[600];
+    int act = runner_cut_step(&k->cut, c, &go, msg, sizeof msg);
+    if (act < 0)
+        return sink_fail(k, RUNNER_ERR_PROGRAM, "%s", msg);
+    if (act == RUNNER_CUT_RAPID_FIRST && take(k, &go))
+        return -1;
+    return act == RUNNER_CUT_DROP ? 0 : take(k, c);
 }
 
 /* The interpreter's outcome, after the sink's. */
@@ -260,7 +224,7 @@ int runner_check_stream(struct runner *r, const char *path, struct motion_plan_i
     struct stream_sink k = { .r = r };
     static const _Atomic int never;
     k.stop = &never;
-    k.cut.from_line = 1;
+    runner_cut_init(&k.cut, 1, id.start);
     if ((st = runner_new_interp(r, id.start, &in, &tt, err, errlen)) ||
         (st = runner_new_interp(r, id.start, &store, &store_tt, err, errlen)))
         goto out;
@@ -370,7 +334,7 @@ int runner_stream_start(struct runner *r, const char *path, int from_line, char 
     rs->sink.run = true;
     rs->sink.stop = &rs->stop;
     rs->sink.first_ready = &rs->first_ready;
-    rs->sink.cut.from_line = from_line > 1 ? from_line : 1;
+    runner_cut_init(&rs->sink.cut, from_line, id.start);
     interp_set_input_fn(r->interp, input_answer, &rs->sink);
     if (pthread_create(&rs->thread, NULL, producer, r) != 0) {
         st = errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "cannot start the planner's thread");

@@ -299,6 +299,18 @@ def plain_session(tmp):
     c.ok("program.run", from_line=8)
     st = c.wait()
     check("runs again from a line after the e-stop", st["motion"] == "done", st["motion"])
+    # run from a line that no move comes before: it starts where the machine stands
+    here = c.status()["machine_pose"]["commanded"]
+    prog = os.path.join(tmp, "nomove.ngc")
+    open(prog, "w").write("G21 G90\nF600\n(nothing moves before line 4)\n"
+                          "G1 X[%.4f + 2]\nM2\n" % here[0])
+    c.ok("program.open", path=prog)
+    r = c.call("program.run", from_line=4)
+    st = c.wait()
+    end = st["machine_pose"]["commanded"]
+    check("run from line 4 with no move before it: from where the machine stands, to X+2",
+          "result" in r and st["motion"] == "done" and abs(end[0] - here[0] - 2) < 1e-6 and
+          max(abs(a - b) for a, b in zip(end[1:], here[1:])) < 1e-6, (r, here, end))
 
     # M66: a time-out, a wait until an input is set, an analog input read at once; the
     # branches after each take the machine's answer (#5399)
