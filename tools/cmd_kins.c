@@ -77,10 +77,8 @@ static double kins_reach(struct kins *k, const double from[KINS_POSE_DIM], int j
             bad = mid;
     }
     pose[j] = from[j] + sign * bad;
-    int st = kins_describe(k, pose, why, len);
-    if (!why[0])
-        snprintf(why, len, "%s", kins_strerror(st == KINS_OK ? kins_inverse(k, pose, legs)
-                                                             : st));
+    if (kins_describe(k, pose, why, len) == KINS_OK || !why[0])   /* a model without words */
+        snprintf(why, len, "%s", kins_strerror(kins_inverse(k, pose, legs)));
     return ok;
 }
 
