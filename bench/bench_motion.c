@@ -35,22 +35,79 @@ static int deviation(const double *S, const double *E, double T, double tol_mm, 
     return st ? -1 : 0;
 }
 
-/* A long program of short five-axis moves (a raster with tilts), n blocks, G64. */
-static void long_program(struct canon_prog *p, int n)
+/* A long program of short five-axis moves (a raster with tilts), n blocks, G64. With tf,
+ * the same raster is the tool tip's under G43.4 (tool length 60 mm, the tip 80 mm above
+ * the TMU platform instead of the platform at 640 mm). */
+static void long_program_tcp(struct canon_prog *p, int n, const struct kins_tool_frame *tf)
 {
     canon_prog_init(p);
-    double s[6] = {-50, -50, 640, 0, 0, 0};
-    memcpy(p->start, s, sizeof s);
+    double s[6] = {-50, -50, tf ? 80 : 640, 0, 0, 0};
+    if (tf)
+        kins_tcp_to_pose(tf, 60, s, p->start);
+    else
+        memcpy(p->start, s, sizeof s);
     struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "long.ngc", .value = 0.01};
     canon_prog_sink(p, &pm);
     for (int i = 0; i < n; i++) {
         double e[6], t = i * 0.01;
         e[0] = -50 + fmod(i * 0.5, 100.0);
         e[1] = -50 + (double)((i / 200) % 100);
-        e[2] = 640 + 2 * sin(t);
+        e[2] = (tf ? 80 : 640) + 2 * sin(t);
         e[3] = 3 * sin(0.7 * t), e[4] = 3 * cos(0.5 * t), e[5] = 5 * sin(0.3 * t);
         tm_add(p, CANON_FEED, i + 2, e, 3000, 0);
+        if (tf) {
+            p->cmds[p->count - 1].tcp = 1;
+            p->cmds[p->count - 1].tool_len_mm = 60;
+        }
     }
+}
+
+static void long_program(struct canon_prog *p, int n)
+{
+    long_program_tcp(p, n, NULL);
+}
+
+/* Tool centre point control's cost: load and motion_step per servo period on the raster as
+ * platform poses and as the tool tip's (G43.4), in one run. */
+static int tcp_figures(void)
+{
+    double load_s[2], step_ns[2];
+    size_t samples[2];
+    for (int k = 0; k < 2; k++) {
+        struct tm_machine mc;
+        if (tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops))
+            return 1;
+        struct kins_tool_frame tf;
+        if (kins_get_tool_frame(mc.kins, &tf) != KINS_OK)
+            return 1;
+        struct canon_prog p;
+        long_program_tcp(&p, 50000, k ? &tf : NULL);
+        char err[512];
+        double t0 = now_s();
+        if (motion_load(mc.m, &p, err, sizeof err)) {
+            fprintf(stderr, "bench_motion: %s\n", err);
+            return 1;
+        }
+        load_s[k] = now_s() - t0;
+        struct motion_plan_info info;
+        motion_plan_info(mc.m, &info);
+        samples[k] = info.samples;
+        motion_start(mc.m);
+        struct motion_out o;
+        int steps = 200000;
+        t0 = now_s();
+        for (int i = 0; i < steps; i++)
+            motion_step(mc.m, 0.001, &o);
+        step_ns[k] = 1e9 * (now_s() - t0) / steps;
+        canon_prog_free(&p);
+        tm_close(&mc);
+    }
+    printf("tool centre point control (G43.4), 50000 short five-axis blocks on the TMU hexapod:\n"
+           "  motion_step per servo period: platform poses %.0f ns, tool tip %.0f ns: ratio %.2f\n"
+           "  load (plan): platform poses %.3f s (%zu samples), tool tip %.3f s (%zu samples): "
+           "ratio %.2f\n", step_ns[0], step_ns[1], step_ns[1] / step_ns[0], load_s[0], samples[0],
+           load_s[1], samples[1], load_s[1] / load_s[0]);
+    return 0;
 }
 
 /* Simulated run time (1 kHz) of the polyline pts[0..n-1] at feed_mm_min on the TMU hexapod,
@@ -230,5 +287,5 @@ int main(void)
            "(%s)\n", 1e9 * t_step, 1e9 * t_ik, t_step / t_ik, sink != 0 ? "ok" : "?");
     canon_prog_free(&p);
     tm_close(&mc);
-    return blend_figures() || chord_figures() ? 1 : 0;
+    return blend_figures() || chord_figures() || tcp_figures() ? 1 : 0;
 }

@@ -14,6 +14,7 @@ static const char *const kind_names[CHECK_KIND_COUNT] = {
     [CHECK_LEG_ACCELERATION] = "leg_acceleration",
     [CHECK_SINGULAR] = "singular",
     [CHECK_PLAN] = "plan",
+    [CHECK_TIP_DEVIATION] = "tip_deviation",
 };
 
 /* JSON name of a problem kind. */
@@ -40,15 +41,17 @@ void check_result_init(struct check_result *r)
 void check_result_free(struct check_result *r)
 {
     free(r->problems);
-    r->problems = NULL;
-    r->nproblems = r->capproblems = 0;
+    free(r->warnings);
+    r->problems = r->warnings = NULL;
+    r->nproblems = r->capproblems = r->nwarnings = r->capwarnings = 0;
 }
 
-/* Adds or merges a problem (same kind, file, line and leg). */
-int check_add_problem(struct check_result *r, const struct check_problem *p)
+/* Adds or merges a problem (same kind, file, line and leg) in a list. */
+static int add_to(struct check_problem **list, size_t *n, size_t *capn,
+                  const struct check_problem *p)
 {
-    for (size_t i = 0; i < r->nproblems; i++) {
-        struct check_problem *q = &r->problems[i];
+    for (size_t i = 0; i < *n; i++) {
+        struct check_problem *q = &(*list)[i];
         if (q->kind != p->kind || q->line != p->line || q->leg != p->leg ||
             strcmp(q->file, p->file) != 0)
             continue;
@@ -58,15 +61,25 @@ int check_add_problem(struct check_result *r, const struct check_problem *p)
         q->count = count;
         return CHECK_OK;
     }
-    if (r->nproblems == r->capproblems) {
-        size_t cap = r->capproblems ? 2 * r->capproblems : 16;
-        struct check_problem *np = realloc(r->problems, cap * sizeof *np);
+    if (*n == *capn) {
+        size_t cap = *capn ? 2 * *capn : 16;
+        struct check_problem *np = realloc(*list, cap * sizeof *np);
         if (!np)
             return CHECK_ERR_NOMEM;
-        r->problems = np, r->capproblems = cap;
+        *list = np, *capn = cap;
     }
-    r->problems[r->nproblems++] = *p;
+    (*list)[(*n)++] = *p;
     return CHECK_OK;
+}
+
+int check_add_problem(struct check_result *r, const struct check_problem *p)
+{
+    return add_to(&r->problems, &r->nproblems, &r->capproblems, p);
+}
+
+int check_add_warning(struct check_result *r, const struct check_problem *p)
+{
+    return add_to(&r->warnings, &r->nwarnings, &r->capwarnings, p);
 }
 
 /* The line number in a "file:line: ..." message from motion, 0 when there is none. */

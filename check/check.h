@@ -44,6 +44,8 @@ enum check_kind {
     CHECK_LEG_ACCELERATION,  /* a leg accelerates harder than [JOINT_n] MAX_ACCELERATION */
     CHECK_SINGULAR,          /* a pose whose condition number exceeds SINGULAR_CONDITION */
     CHECK_PLAN,              /* the planner refused the program for another reason */
+    CHECK_TIP_DEVIATION,     /* a warning: the tool tip leaves a straight feed's line
+                              * beyond KINEMATIC_TOLERANCE (A B C turned without G43.4) */
     CHECK_KIND_COUNT
 };
 const char *check_kind_name(enum check_kind k);
@@ -90,6 +92,10 @@ void check_opts_default(struct check_opts *o);
 struct check_result {
     struct check_problem *problems;  /* in the order found */
     size_t nproblems, capproblems;
+    struct check_problem *warnings;  /* what may not be meant but the machine can do (the
+                                      * tool tip's swing without G43.4): reported, the
+                                      * program still passes */
+    size_t nwarnings, capwarnings;
     int simulated;                   /* 1 if the program was run through motion */
     char program[256];               /* program path */
     char config[256];                /* INI path */
@@ -103,6 +109,14 @@ struct check_result {
     double max_deviation_mm;         /* largest kinematic deviation from the programmed path */
     int max_deviation_line;          /* its program line */
     double max_deviation_deg;        /* same for the orientation, deg */
+    int tip_measured;                /* the kinematics has a tool: the tip was measured */
+    double max_tip_deviation_mm;     /* the tool tip's largest deviation from its path: a
+                                      * straight feed's line between the tip's positions at
+                                      * its ends (the programmed line under G43.4), else the
+                                      * chord between set points; by forward kinematics of
+                                      * the legs interpolated between set points, and every
+                                      * period from the commanded pose */
+    int max_tip_deviation_line;
     double kin_tol_mm;               /* [TRAJ] KINEMATIC_TOLERANCE, for reference */
     long deviation_evals;            /* forward solves spent on the deviation */
     double max_condition;            /* largest condition number seen */
@@ -152,6 +166,8 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
 
 /* Adds a problem, merging it with one of the same kind, line and leg (keeps the worst). */
 int check_add_problem(struct check_result *r, const struct check_problem *p);
+/* The same for a warning. */
+int check_add_warning(struct check_result *r, const struct check_problem *p);
 
 /* Human table and machine-readable JSON (schema in docs/verification.md). */
 void check_print_table(const struct check_result *r, FILE *f);

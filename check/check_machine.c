@@ -192,6 +192,7 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
         return CHECK_ERR_NOMEM;
     }
     interp_set_start(in, mc->kins->home);
+    interp_use_kins(in, mc->kins);       /* G43.4 and [KINS] PROGRAM_POINT */
     memcpy(prog->start, mc->kins->home, sizeof prog->start);
     mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
     /* the runner's settings, but the machine's parameter file is never written */

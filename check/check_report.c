@@ -60,12 +60,12 @@ static void json_legs(const struct check_result *r, FILE *f)
     fputc(']', f);
 }
 
-/* The problems, in the order found. */
-static void json_problems(const struct check_result *r, FILE *f)
+/* The problems (or warnings), in the order found. */
+static void json_problems(const char *name, const struct check_problem *list, size_t n, FILE *f)
 {
-    fputs(",\"problems\":[", f);
-    for (size_t i = 0; i < r->nproblems; i++) {
-        const struct check_problem *p = &r->problems[i];
+    fprintf(f, ",\"%s\":[", name);
+    for (size_t i = 0; i < n; i++) {
+        const struct check_problem *p = &list[i];
         fprintf(f, "%s{\"kind\":\"%s\",\"file\":", i ? "," : "", check_kind_name(p->kind));
         json_str(f, p->file);
         fprintf(f, ",\"line\":%d,\"column\":%d,\"leg\":%d", p->line, p->column,
@@ -93,6 +93,10 @@ void check_print_json(const struct check_result *r, FILE *f)
     json_field(f, "machining_time_s", r->machining_time_s, 0);
     json_field(f, "planned_time_s", r->planned_time_s, 0);
     json_field(f, "length_mm", r->length_mm, 0);
+    if (r->tip_measured) {
+        json_field(f, "tip_deviation_mm", r->max_tip_deviation_mm, 0);
+        fprintf(f, ",\"tip_deviation_line\":%d", r->max_tip_deviation_line);
+    }
     fprintf(f, ",\"periods\":%ld,\"deviation\":{", r->periods);
     json_field(f, "max_mm", r->max_deviation_mm, 1);
     fprintf(f, ",\"line\":%d", r->max_deviation_line);
@@ -106,7 +110,8 @@ void check_print_json(const struct check_result *r, FILE *f)
     json_field(f, "every_s", r->condition_every_s, 0);
     fprintf(f, ",\"evaluations\":%ld}", r->condition_evals);
     json_legs(r, f);
-    json_problems(r, f);
+    json_problems("problems", r->problems, r->nproblems, f);
+    json_problems("warnings", r->warnings, r->nwarnings, f);
     fputs("}\n", f);
 }
 
@@ -142,6 +147,9 @@ void check_print_table(const struct check_result *r, FILE *f)
         fprintf(f, "deviation       %.4g um max (line %d), %.3g deg; tolerance %g um; "
                 "measured %s\n", r->max_deviation_mm * 1e3, r->max_deviation_line,
                 r->max_deviation_deg, r->kin_tol_mm * 1e3, when);
+        if (r->tip_measured)
+            fprintf(f, "tool tip        %.4g um max from its path (line %d)\n",
+                    r->max_tip_deviation_mm * 1e3, r->max_tip_deviation_line);
         schedule(when, sizeof when, r->condition_every_s);
         fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
                 r->max_condition, r->max_condition_line, r->condition_limit, when);
@@ -157,6 +165,15 @@ void check_print_table(const struct check_result *r, FILE *f)
     } else {
         fputs("not run through motion: the program cannot start (see below)\n\n", f);
     }
+    for (size_t i = 0; i < r->nwarnings; i++) {
+        const struct check_problem *p = &r->warnings[i];
+        if (i == 0)
+            fprintf(f, "%zu warning%s:\n", r->nwarnings, r->nwarnings == 1 ? "" : "s");
+        fprintf(f, "  %s:%d: %s [%s]\n", p->file, p->line, p->message,
+                check_kind_name(p->kind));
+    }
+    if (r->nwarnings)
+        fputc('\n', f);
     if (!r->nproblems) {
         fputs("no problems: the program can be cut on this machine\n", f);
         return;

@@ -84,6 +84,26 @@ static int move_samples(const double from[KINS_POSE_DIM], const struct canon_cmd
     return n < 1 ? 1 : n > SCAN_MAX_SAMPLES ? SCAN_MAX_SAMPLES : (int)ceil(n);
 }
 
+/* The platform's pose of a command's pose: under G43.4 the command's pose is the tool tip. */
+static void platform_of(struct check_machine *mc, int tcp, double len_mm, const double *P,
+                        double *out)
+{
+    struct kins_tool_frame tf;
+    if (tcp && kins_get_tool_frame(mc->kins, &tf) == KINS_OK)
+        kins_tcp_to_pose(&tf, len_mm, P, out);
+    else
+        memmove(out, P, KINS_POSE_DIM * sizeof *out);
+}
+
+/* The command pose's legs (kins_inverse's status). */
+static int cmd_inverse(struct check_machine *mc, const struct canon_cmd *c, const double *P,
+                       double *L)
+{
+    double q[KINS_POSE_DIM];
+    platform_of(mc, c->tcp, c->tool_len_mm, P, q);
+    return kins_inverse(mc->kins, q, L);
+}
+
 /* Records the worst leg outside its range at a pose as a problem of kind k. */
 static void leg_problem(struct check_machine *mc, const struct canon_cmd *c, enum check_kind k,
                         const double *pose, const double *L, struct check_result *r)
@@ -100,7 +120,9 @@ static void leg_problem(struct check_machine *mc, const struct canon_cmd *c, enu
                                .count = 1 };
     snprintf(p.file, sizeof p.file, "%s", c->file ? c->file : "");
     char why[300];
-    if (worst < 0 && kins_describe(mc->kins, pose, why, sizeof why) == KINS_ERR_WORKSPACE) {
+    double plat[KINS_POSE_DIM];
+    platform_of(mc, c->tcp, c->tool_len_mm, pose, plat);
+    if (worst < 0 && kins_describe(mc->kins, plat, why, sizeof why) == KINS_ERR_WORKSPACE) {
         snprintf(p.message, sizeof p.message, "%s X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f, outside "
                  "the workspace: %s", k == CHECK_UNREACHABLE ? "the programmed point is"
                  : "the move passes through", pose[0], pose[1], pose[2], pose[3], pose[4],
@@ -145,7 +167,7 @@ static void scan_move(struct check_machine *mc, const double from[KINS_POSE_DIM]
     int n = move_samples(from, c);
     for (int j = 1; j < n; j++) {
         check_move_pose(from, c, (double)j / n, pose);
-        if (kins_inverse(mc->kins, pose, L) == KINS_OK)
+        if (cmd_inverse(mc, c, pose, L) == KINS_OK)
             continue;
         double e = leg_excess(mc->kins, L);
         if (e > worst) {
@@ -162,14 +184,22 @@ static void scan_move(struct check_machine *mc, const double from[KINS_POSE_DIM]
 int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r)
 {
-    double from[KINS_POSE_DIM], L[KINS_MAX_JOINTS];
+    double from[KINS_POSE_DIM], L[KINS_MAX_JOINTS], from_len = prog->start_tool_len_mm;
+    int from_tcp = prog->start_tcp;
     size_t before = r->nproblems;
     memcpy(from, prog->start, sizeof from);
     for (size_t k = 0; k < prog->count; k++) {
         const struct canon_cmd *c = &prog->cmds[k];
         if (!check_is_motion(c->type))
             continue;
-        if (kins_inverse(mc->kins, c->end, L) != KINS_OK)
+        if (c->tcp != from_tcp || c->tool_len_mm != from_len) {  /* G43.4 / G49: re-express */
+            struct kins_tool_frame tf;
+            platform_of(mc, from_tcp, from_len, from, from);
+            if (c->tcp && kins_get_tool_frame(mc->kins, &tf) == KINS_OK)
+                kins_tcp_from_pose(&tf, c->tool_len_mm, from, from);
+            from_tcp = c->tcp, from_len = c->tool_len_mm;
+        }
+        if (cmd_inverse(mc, c, c->end, L) != KINS_OK)
             leg_problem(mc, c, CHECK_UNREACHABLE, c->end, L, r);
         else
             scan_move(mc, from, c, r);

@@ -26,6 +26,17 @@ struct sim {
     int line;                          /* program line of the previous period */
     const char *file;
     double next_dev_s, next_cond_s;    /* machine time of the next scheduled measure */
+    struct kins_tool_frame tf;         /* the machine's tool: the tip's deviation */
+    int have_tf;
+    int tip_line;                      /* a straight feed's tip line, its ends t0 t1 (the */
+    double tip_key[KINS_POSE_DIM];     /* move's start, to know when the move changes) */
+    double tip_t0[3], tip_t1[3];
+    int tip_fresh;                     /* the move began this period */
+    int tip_swing;                     /* the move turns A B C (the tip may leave the line
+                                        * the platform follows) and is not under G43.4 */
+    double blk_tip_max;                /* the tip's largest deviation in this move, its line */
+    int blk_tip_line;
+    const char *blk_tip_file;
     long trace_every, trace_count;
 };
 
@@ -81,6 +92,100 @@ static void legs_period(struct sim *s, const struct motion_out *out)
     }
 }
 
+/* The tool tip in the workpiece's frame (G43.4's program frame) at a platform pose, with
+ * the tool of this period (G43.4's length, else [KINS] TOOL_LENGTH). */
+static void tip_of(const struct sim *s, const struct motion_out *out, const double pose[6],
+                   double tip[3])
+{
+    double prog[KINS_POSE_DIM];
+    kins_tcp_from_pose(&s->tf, out->tcp ? out->tool_len_mm : s->tf.length_mm, pose, prog);
+    memcpy(tip, prog, 3 * sizeof *tip);
+}
+
+/* Distance of p from the segment a..b (from a when they coincide). */
+static double dist_seg(const double p[3], const double a[3], const double b[3])
+{
+    double d[3], w[3], n2 = 0, u = 0, e2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], w[i] = p[i] - a[i], n2 += d[i] * d[i], u += w[i] * d[i];
+    u = n2 > 1e-24 ? fmin(1, fmax(0, u / n2)) : 0;
+    for (int i = 0; i < 3; i++)
+        e2 += (w[i] - u * d[i]) * (w[i] - u * d[i]);
+    return sqrt(e2);
+}
+
+/* The largest tip deviation of the move just left, as a problem when beyond the tolerance. */
+static void tip_flush(struct sim *s)
+{
+    struct check_result *r = s->r;
+    if (s->blk_tip_max > r->kin_tol_mm && r->kin_tol_mm > 0) {
+        struct check_problem p = { .kind = CHECK_TIP_DEVIATION, .line = s->blk_tip_line,
+                                   .leg = -1, .value = s->blk_tip_max, .limit = r->kin_tol_mm,
+                                   .time_s = -1, .count = 1 };
+        snprintf(p.file, sizeof p.file, "%s", s->blk_tip_file ? s->blk_tip_file : "");
+        snprintf(p.message, sizeof p.message, "the tool tip leaves the straight line between "
+                 "its positions at the move's ends by %.3f mm, over the tolerance of %.3f mm "
+                 "([TRAJ] KINEMATIC_TOLERANCE): the move turns A B C about the platform, not "
+                 "about the tip; program the tip under G43.4 to keep it on the line",
+                 s->blk_tip_max, r->kin_tol_mm);
+        check_add_warning(r, &p);
+    }
+    s->blk_tip_max = 0;
+}
+
+/* The straight feed being followed: its tip line (from the kinematics' tool at its ends, or
+ * the programmed tip under G43.4), computed once per move. */
+static void tip_move(struct sim *s, const struct motion_out *out)
+{
+    if (out->seg_kind != 1) {
+        if (s->tip_line)
+            tip_flush(s);
+        s->tip_line = 0;
+        return;
+    }
+    s->tip_fresh = 0;
+    if (s->tip_line && !memcmp(s->tip_key, out->seg_from, sizeof s->tip_key))
+        return;
+    s->tip_fresh = 1;
+    if (s->tip_line)
+        tip_flush(s);
+    s->tip_line = 1;
+    memcpy(s->tip_key, out->seg_from, sizeof s->tip_key);
+    if (out->tcp) {
+        memcpy(s->tip_t0, out->seg_from, sizeof s->tip_t0);
+        memcpy(s->tip_t1, out->seg_to, sizeof s->tip_t1);
+    } else {
+        tip_of(s, out, out->seg_from, s->tip_t0);
+        tip_of(s, out, out->seg_to, s->tip_t1);
+    }
+    s->tip_swing = !out->tcp && (out->seg_from[3] != out->seg_to[3] ||
+                                 out->seg_from[4] != out->seg_to[4] ||
+                                 out->seg_from[5] != out->seg_to[5]);
+    s->blk_tip_line = out->line, s->blk_tip_file = out->file;
+}
+
+/* The tip's deviation d of this period from its move's line, into the figures. */
+static void tip_record(struct sim *s, const struct motion_out *out, double d)
+{
+    struct check_result *r = s->r;
+    if (d > r->max_tip_deviation_mm)
+        r->max_tip_deviation_mm = d, r->max_tip_deviation_line = out->line;
+    if (d > s->blk_tip_max)
+        s->blk_tip_max = d;
+}
+
+/* Every period of a straight feed that turns A B C without G43.4: the commanded tip against
+ * the line between the tip's positions at the move's ends. */
+static void tip_period(struct sim *s, const struct motion_out *out)
+{
+    tip_move(s, out);
+    if (!s->tip_line || !s->tip_swing)
+        return;
+    double tip[3];
+    tip_of(s, out, out->pose, tip);
+    tip_record(s, out, dist_seg(tip, s->tip_t0, s->tip_t1));
+}
+
 /* Kinematic deviation between the previous set point and this one: the legs at mid-chord
  * (where linear leg motion strays furthest) through the forward kinematics, distance from
  * the commanded chord. Returns the distance, mm, or -1 when the forward solve failed. */
@@ -108,6 +213,18 @@ static double deviation(struct sim *s, const struct motion_out *out, double *ang
     *ang_deg = 0;
     for (int i = 3; i < 6; i++)
         *ang_deg = fmax(*ang_deg, fabs(P[i] - s->p0[i] - u * (out->pose[i] - s->p0[i])));
+    if (s->have_tf) {   /* the tip of the interpolated legs: from its move's line, or (arcs,
+                         * rapids) from the chord between the tips of the two set points */
+        double tm[3], t0[3], t1[3];
+        tip_of(s, out, P, tm);
+        if (s->tip_line && !s->tip_fresh) {
+            tip_record(s, out, dist_seg(tm, s->tip_t0, s->tip_t1));
+        } else if (out->seg_kind) {
+            tip_of(s, out, s->p0, t0);
+            tip_of(s, out, out->pose, t1);
+            tip_record(s, out, dist_seg(tm, t0, t1));
+        }
+    }
     return sqrt(e2);
 }
 
@@ -184,6 +301,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
 {
     struct sim s = { .mc = mc, .o = o, .r = r, .nj = mc->kins->njoints,
                      .T = mc->mcfg.servo_period_s, .inv_T = 1 / mc->mcfg.servo_period_s };
+    s.have_tf = kins_get_tool_frame(mc->kins, &s.tf) == KINS_OK;
+    r->tip_measured = s.have_tf;
     struct motion_out out;
     struct motion_plan_info info;
     motion_plan_info(mc->motion, &info);
@@ -201,6 +320,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         st = motion_step(mc->motion, s.T, &out);
         r->periods++;
         legs_period(&s, &out);
+        if (s.have_tf)
+            tip_period(&s, &out);
         measures(&s, &out);
         if (o->trace && ++s.trace_count >= s.trace_every) {
             check_trace_add(o->trace, out.time_elapsed_s, s.nj, out.joint_pos, s.v0, out.pose);
@@ -214,6 +335,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         if (out.state == MOTION_PAUSED)   /* M0/M1: the operator would press resume */
             motion_resume(mc->motion);
     }
+    if (s.tip_line)
+        tip_flush(&s);
     r->machining_time_s = out.time_elapsed_s;
     r->length_mm = out.distance_total_mm;
     return st == MOTION_OK && out.state == MOTION_DONE ? CHECK_OK : CHECK_ERR_CONFIG;

@@ -17,15 +17,21 @@
  * and (11) order them. Paper values in mm; run 2 has no d1 in the paper. */
 static const struct exp_run_def runs[] = {
     { "1", DIR "/run1_g141.ngc", DIR "/tmu-path1.ini", 1, 141, { 3, 1 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.8, 7.7, 7.7 }, NULL },
+      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.8, 7.7, 7.7 }, NULL, 0 },
     { "2", DIR "/run2_g141.ngc", DIR "/tmu-path1.ini", 1, 141, { 3, 2 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { NAN, 8.1, 8.3, 8.2 }, NULL },
+      { { -80, -20 }, { -30, 20 } }, { NAN, 8.1, 8.3, 8.2 }, NULL, 0 },
     { "3", DIR "/run3_g141.ngc", DIR "/tmu-path2.ini", 2, 141, { 3, 1 }, 30, 658, -8,
-      { { -100, -20 }, { -30, 50 } }, { NAN, 8.2, 7.9, 7.9 }, NULL },
+      { { -100, -20 }, { -30, 50 } }, { NAN, 8.2, 7.9, 7.9 }, NULL, 0 },
     { "4", DIR "/run4_g141.ngc", DIR "/tmu-path2.ini", 2, 141, { 3, 2 }, 30, 658, -8,
-      { { -100, -20 }, { -30, 50 } }, { NAN, 8.0, 7.8, 7.9 }, NULL },
+      { { -100, -20 }, { -30, 50 } }, { NAN, 8.0, 7.8, 7.9 }, NULL, 0 },
     { "G142", DIR "/run1_g142.ngc", DIR "/tmu-path1.ini", 1, 142, { 3, 1 }, 50, 630, -4,
-      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.7, 7.9, 8.1 }, NULL },
+      { { -80, -20 }, { -30, 20 } }, { 8.0, 7.7, 7.9, 8.1 }, NULL, 0 },
+    /* run 1 programmed at the tool tip (G43.4): on the paper's machine, and on the machine
+     * with its head vertical (a wall drafted 4 deg: 5 tan 4 deg = 0.35 mm on the top face) */
+    { "1tcp", DIR "/run1_tcp_g141.ngc", DIR "/tmu-path1.ini", 1, 141, { 3, 1 }, -40, 93, -4,
+      { { 80, 20 }, { 30, -20 } }, { 8.0, 7.8, 7.7, 7.7 }, NULL, 1 },
+    { "1tcpv", DIR "/run1_tcpv_g141.ngc", "configs/sim/tmu-hexapod.ini", 1, 141, { 3, 1 },
+      -40, 93, -4, { { 80, 20 }, { 30, -20 } }, { 8.0, 7.8, 7.7, 7.7 }, NULL, 1 },
 };
 
 /* The run table. */
@@ -38,6 +44,10 @@ const struct exp_run_def *exp_runs(int *count)
 /* The contour point (tool tip in the workpiece frame) at program Y on the run's path. */
 static int contour_at(struct check_machine *mc, const struct exp_run_def *d, double y, double p[3])
 {
+    if (d->tcp) {              /* G43.4: the program is the contour */
+        p[0] = d->x_mm, p[1] = y, p[2] = d->z_mm;
+        return CHECK_OK;
+    }
     double pose[KINS_POSE_DIM] = { d->x_mm, y, d->z_mm, 0, d->b_deg, 0 };
     return cut_tip_in_workpiece(mc, pose, p);
 }

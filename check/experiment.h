@@ -34,6 +34,8 @@ struct exp_run_def {
     double paper_d_mm[4];    /* the paper's d1..d4 (NAN where it gives none) */
     const char *real_ini;    /* the machine as built, when its geometry differs from the
                               * controller's (path as given; NULL: the same machine) */
+    int tcp;                 /* programmed at the tool tip (G43.4): x_mm, z_mm and the part's
+                              * Y are the contour in the workpiece's frame, not a pose */
 };
 /* The five runs: Table 1's runs 1..4 and the G142 run. */
 const struct exp_run_def *exp_runs(int *count);

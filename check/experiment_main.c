@@ -49,7 +49,7 @@ int main(int argc, char **argv)
     printf("The paper's experiment in the cutting simulation (TMU hexapod, stepgens, 1 kHz).\n"
            "d = distance of the wall from the reference line 30 mm in from the block's edge, mm,\n"
            "at the top face; d1, d2 on the first tool's part, d3, d4 on the second's.\n\n");
-    printf("run  path tools  code |     simulated d1..d4 (mm)          | paper d1..d4 (mm)"
+    printf("run   path tools  code |     simulated d1..d4 (mm)          | paper d1..d4 (mm)"
            "               | agree, um   | without compensation d1..d4 (mm)  step\n");
     for (int i = 0; i < n; i++) {
         const struct exp_run_def *d = &runs[i];
@@ -60,7 +60,7 @@ int main(int argc, char **argv)
             failed = 1;
             continue;
         }
-        printf("%-4s %4d  %2.0f-%2.0f  G%d |", d->name, d->path, 2 * r.radius_mm[1],
+        printf("%-5s %4d  %2.0f-%2.0f  G%d |", d->name, d->path, 2 * r.radius_mm[1],
                2 * r.radius_mm[0], d->side);
         for (int k = 0; k < 4; k++)
             printf(" %8.4f", r.d_mm[k]);

@@ -98,6 +98,9 @@ const struct config_key config_keys[] = {
       "length but zero)" },
     { "KINS", "TOOL_LENGTH", NUM, "mm", "", 0, 0, "0", "tool tip beyond TOOL_POINT along "
       "TOOL_AXIS" },
+    { "KINS", "PROGRAM_POINT", ENUM, "", "PLATFORM|TOOL_TIP", 0, 0, "PLATFORM", "what "
+      "a program's X Y Z A B C command: the platform's pose, or the tool tip and orientation "
+      "(tool centre point control, as under G43.4)" },
     { "KINS", "FWD_TOLERANCE", NUM, "mm", "1e-15..1", 0, 0, "1e-9", "forward solve stops "
       "below this Newton step" },
     { "KINS", "FWD_MAX_ITERATIONS", INT, "", "1..1000", 0, 0, "20", "forward solve iteration "

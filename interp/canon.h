@@ -82,6 +82,10 @@ struct canon_cmd {
     double value;          /* DWELL s, PATH_MODE tol, SPINDLE_* rpm/dir, FEED_MODE */
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
+    int tcp;               /* under tool centre point control (G43.4): end (and an arc's
+                            * geometry) is the tool tip and orientation (kins_tcp_to_pose
+                            * gives the platform's pose), tool_len_mm the tool's length */
+    double tool_len_mm;
     int immediate;         /* DIGITAL_OUT, ANALOG_OUT: M64/M65/M68 (else M62/M63/M67) */
     int analog;            /* WAIT_INPUT: an analog input (E), else digital (P) */
     int wait_mode;         /* WAIT_INPUT: L, 0..4 */
@@ -106,6 +110,8 @@ struct canon_prog {
     size_t count;
     size_t cap;
     double start[6];       /* pose the program starts from */
+    int start_tcp;         /* start is the tool tip under G43.4 with this tool length (a */
+    double start_tool_len_mm; /* streamed window's start); 0: the platform's pose */
 };
 void canon_prog_init(struct canon_prog *p);
 void canon_prog_free(struct canon_prog *p);

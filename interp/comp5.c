@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "interp/comp5_join.h"
+#include "kins/kins.h"
 
 #define COMP5_DEG_TO_RAD (M_PI / 180.0)
 
@@ -87,10 +88,29 @@ void comp5_normal(double a_deg, double b_deg, double c_deg, double n[3])
     n[2] = cos(b) * cos(a);
 }
 
+/* N: the paper's R [0 0 1], or under G43.4 the tool axis in the program's frame. */
+void comp5_axis(const struct kins_tool_frame *tf, const double abc[3], double n[3])
+{
+    if (tf)
+        kins_tcp_tool_dir(tf, abc, n);
+    else
+        comp5_normal(abc[0], abc[1], abc[2], n);
+}
+
+static int offset_point_n(const double from[6], const double to[6], int side,
+                          double radius_mm, const double p[6], const double *nt, double out[6]);
+
 /* The paper's steps 1..4 for one point: p + s W unit(T x N), T from `from` to `to`, N from
  * p's orientation; s = +1 right (G141), -1 left (G142). */
 int comp5_offset_point(const double from[6], const double to[6], int side, double radius_mm,
                        const double p[6], double out[6])
+{
+    return offset_point_n(from, to, side, radius_mm, p, NULL, out);
+}
+
+/* The same with the tool axis N given (G43.4), or from p's orientation when nt is NULL. */
+static int offset_point_n(const double from[6], const double to[6], int side,
+                          double radius_mm, const double p[6], const double *nt, double out[6])
 {
     double t[3], n[3], v[3];
     if (side != 141 && side != 142)
@@ -103,7 +123,10 @@ int comp5_offset_point(const double from[6], const double to[6], int side, doubl
         return COMP5_ERR_ZERO_LENGTH;
     for (int i = 0; i < 3; i++)
         t[i] /= len_mm;
-    comp5_normal(p[3], p[4], p[5], n);
+    if (nt)
+        memcpy(n, nt, sizeof n);
+    else
+        comp5_normal(p[3], p[4], p[5], n);
     comp5_cross(t, n, v);
     double sin_mag = comp5_len(v); /* |T x N| = sin of the angle between motion and axis */
     if (!(sin_mag >= COMP5_MIN_SIN_AXIS))
@@ -121,11 +144,14 @@ int comp5_offset_point(const double from[6], const double to[6], int side, doubl
 static int comp5_make_seg(struct comp5 *c, const struct comp5_block *from,
                           const struct comp5_block *to, struct comp5_seg *seg)
 {
-    int rc = comp5_offset_point(from->point, to->point, to->side, from->radius_mm,
-                                from->point, seg->a0);
+    double n0[3], n1[3];
+    comp5_axis(c->tf, from->point + 3, n0);
+    comp5_axis(c->tf, to->point + 3, n1);
+    int rc = offset_point_n(from->point, to->point, to->side, from->radius_mm, from->point, n0,
+                            seg->a0);
     if (rc == COMP5_OK)
-        rc = comp5_offset_point(from->point, to->point, to->side, to->radius_mm, to->point,
-                                seg->a1);
+        rc = offset_point_n(from->point, to->point, to->side, to->radius_mm, to->point, n1,
+                            seg->a1);
     if (rc == COMP5_ERR_ALONG_AXIS)
         return comp5_fail(c, rc, to->line,
                           "%s: the move from line %d to line %d runs along the tool axis "
@@ -187,6 +213,7 @@ static int comp5_emit(struct comp5 *c, enum canon_type type, const double end[6]
     }
     m.radius_mm = b->radius_mm;
     m.line = b->line;
+    m.tf = c->tf;
     memcpy(c->tool_pos, end, sizeof c->tool_pos);
     if (comp5_gouge_add_move(&c->gouge, &m))
         return comp5_fail(c, COMP5_ERR_NO_MEMORY, b->line, "%s", comp5_strerror(COMP5_ERR_NO_MEMORY));
@@ -223,7 +250,7 @@ static int comp5_corner(struct comp5 *c, struct comp5_seg *b, canon_sink_fn sink
     struct comp5_join j;
     struct canon_arc arc;
     int rc;
-    comp5_join_corner(&c->seg, b, c->prev.point, &j);
+    comp5_join_corner(&c->seg, b, c->prev.point, c->tf, &j);
     switch (j.kind) {
     case COMP5_JOIN_INSIDE:
         rc = comp5_check_gouge(c, b, &j);

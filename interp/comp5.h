@@ -93,6 +93,8 @@ struct comp5 {
     struct comp5_seg seg;     /* the segment prev2 -> prev, not yet cut (nblocks >= 2) */
     char err_msg[240];        /* the last error in a machinist's words (no file:line prefix) */
     struct comp5_gouge gouge; /* the run's contour and moves, checked when it ends (heap) */
+    const struct kins_tool_frame *tf; /* G43.4: the tool (N from it, comp5_axis); NULL: the
+                               * paper's N. Set by the interpreter before each block */
 };
 
 void comp5_init(struct comp5 *c);
@@ -111,6 +113,10 @@ const double *comp5_tool_pos(const struct comp5 *c);
 /* The last error, in words, e.g. "G141 inside corner at line 12: ..." (never NULL). */
 const char *comp5_errmsg(const struct comp5 *c);
 
+/* The tool axis N at orientation abc (deg): the paper's R [0 0 1] when tf is NULL, else the
+ * tool's direction in the program's frame under G43.4 (kins_tcp_tool_dir). */
+struct kins_tool_frame;
+void comp5_axis(const struct kins_tool_frame *tf, const double abc[3], double n[3]);
 /* The table normal N = R [0 0 1] for orientation A, B, C in degrees (paper's step 2). */
 void comp5_normal(double a_deg, double b_deg, double c_deg, double n[3]);
 /* The compensated point of one segment (paper's steps 1..4): p + s W unit(T x N), with

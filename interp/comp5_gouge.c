@@ -225,7 +225,7 @@ static double gouge_dist_at(const struct comp5_gmove *m, double angle, double t,
 {
     double pose[6], n[3];
     gouge_pose(m, angle, t, pose);
-    comp5_normal(pose[3], pose[4], pose[5], n);
+    comp5_axis(m->tf, pose + 3, n);
     return gouge_point_seg(pose, n, a, b, u);
 }
 
@@ -305,7 +305,8 @@ static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double min_cos = 1.0, nn[3], max_turn = 0.0;
     sw->flat = 1;
-    comp5_normal(ref[3], ref[4], ref[5], sw->n);
+    const struct kins_tool_frame *tf = g->nmoves ? g->moves[0].tf : NULL;
+    comp5_axis(tf, ref + 3, sw->n);
     gouge_plane(sw->n, sw->e1, sw->e2);
     for (size_t k = 0; k < g->npts + 2 * g->nmoves; k++) {
         const struct comp5_gmove *m = k < g->npts ? NULL : &g->moves[(k - g->npts) / 2];
@@ -316,7 +317,7 @@ static void gouge_frame(const struct comp5_gouge *g, struct gouge_sweep *sw)
         if (gouge_same_abc(p, ref))
             continue;
         sw->flat = 0;
-        comp5_normal(p[3], p[4], p[5], nn);
+        comp5_axis(tf, p + 3, nn);
         min_cos = fmin(min_cos, comp5_dot(nn, sw->n));
     }
     double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
@@ -350,7 +351,7 @@ static void gouge_move_ctx(const struct comp5_gmove *m, struct gouge_movectx *x)
     double mid[6];
     for (int i = 0; i < 6; i++)
         mid[i] = 0.5 * (m->p0[i] + m->p1[i]);
-    comp5_normal(mid[3], mid[4], mid[5], x->nm);
+    comp5_axis(m->tf, mid + 3, x->nm);
     gouge_plane(x->nm, x->f1, x->f2);
     x->beta_rad = 0.5 * gouge_turn_rad(m);
     x->arc_r_mm = m->arc ? comp5_dist(m->p0, m->center) : 0.0;
@@ -495,7 +496,7 @@ static int gouge_counts(const struct comp5_gmove *m)
     if (!m->positioning)
         return 1;
     double n[3], d[3];
-    comp5_normal(m->p1[3], m->p1[4], m->p1[5], n);
+    comp5_axis(m->tf, m->p1 + 3, n);
     comp5_sub(m->p0, m->p1, d);
     return fabs(comp5_dot(d, n)) <= gouge_tol(m->radius_mm);
 }

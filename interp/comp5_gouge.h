@@ -32,6 +32,8 @@ struct comp5_gpt {
 };
 
 /* One emitted tool move (tool tip positions, machine frame). */
+struct kins_tool_frame;
+
 struct comp5_gmove {
     int arc;              /* 0: straight from p0 to p1; 1: arc about center, see canon.h */
     int positioning;      /* the move into the run */
@@ -40,6 +42,7 @@ struct comp5_gmove {
     double normal[3];     /* arc only: unit, counter-clockwise turn (rotation +1) */
     double radius_mm;     /* W of the block the move belongs to */
     int line;             /* that block's line */
+    const struct kins_tool_frame *tf; /* how N follows A B C (comp5_axis) */
 };
 
 /* What the check found: the deepest cut of the first move (in path order) that gouges. */

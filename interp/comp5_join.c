@@ -19,13 +19,14 @@ static void comp5_join_flat(const double v[3], const double n[3], double out[3])
  * depth difference |pa - pb| is shared. Closest points of two lines in the metric that
  * ignores N: minimise |flat(w0 + t Da - u Db)|^2. Parallel in that view: a straight join. */
 static void comp5_join_inside(const struct comp5_seg *a, const struct comp5_seg *b,
-                              const double corner[6], struct comp5_join *j)
+                              const double corner[6], const struct kins_tool_frame *tf,
+                              struct comp5_join *j)
 {
     double da[3], db[3], w0[3], pa[3], pb[3], n[3], fa[3], fb[3], fw[3];
     comp5_sub(a->a1, a->a0, da);
     comp5_sub(b->a1, b->a0, db);
     comp5_sub(a->a0, b->a0, w0);
-    comp5_normal(corner[3], corner[4], corner[5], n);
+    comp5_axis(tf, corner + 3, n);
     comp5_join_flat(da, n, fa);
     comp5_join_flat(db, n, fb);
     comp5_join_flat(w0, n, fw);
@@ -78,7 +79,8 @@ static void comp5_join_outside(const struct comp5_seg *a, const double ua[3],
 /* Classifies the corner: inside when the next segment turns towards the compensation side
  * (T_b . ua - T_a . ub > 0, ua and ub the unit offset directions at the corner). */
 void comp5_join_corner(const struct comp5_seg *a, const struct comp5_seg *b,
-                       const double corner[6], struct comp5_join *j)
+                       const double corner[6], const struct kins_tool_frame *tf,
+                       struct comp5_join *j)
 {
     double ua[3], ub[3];
     memset(j, 0, sizeof *j);
@@ -97,7 +99,7 @@ void comp5_join_corner(const struct comp5_seg *a, const struct comp5_seg *b,
         ua[i] /= ra, ub[i] /= rb;
     double turn = comp5_dot(b->dir, ua) - comp5_dot(a->dir, ub);
     if (turn > 0.0)
-        comp5_join_inside(a, b, corner, j);
+        comp5_join_inside(a, b, corner, tf, j);
     else
         comp5_join_outside(a, ua, ub, j);
 }

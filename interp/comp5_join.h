@@ -27,8 +27,10 @@ struct comp5_join {
 
 /* Classifies the corner and computes the join point or arc (pure geometry, no checks
  * against the segments' lengths: the caller does those). */
+struct kins_tool_frame;
 void comp5_join_corner(const struct comp5_seg *a, const struct comp5_seg *b,
-                       const double corner[6], struct comp5_join *j);
+                       const double corner[6], const struct kins_tool_frame *tf,
+                       struct comp5_join *j);
 
 /* Vector helpers on the X Y Z part of poses. */
 static inline double comp5_dot(const double a[3], const double b[3])

@@ -24,9 +24,21 @@ void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
 /* Hands a command to the sink; a refusal stops the run. */
 int interp_emit(struct interp *in, struct canon_cmd *c)
 {
+    c->tcp = in->tcp_on;
+    c->tool_len_mm = in->tcp_on ? in->tcp_len_mm : 0;
     if (in->sink(in->sink_ctx, c))
         return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the program");
     return 0;
+}
+
+/* The sink G141/G142 emit through: their moves carry the tool centre point state too. */
+int interp_comp_sink(void *ctx, const struct canon_cmd *cmd)
+{
+    struct interp *in = ctx;
+    struct canon_cmd c = *cmd;
+    c.tcp = in->tcp_on;
+    c.tool_len_mm = in->tcp_on ? in->tcp_len_mm : 0;
+    return in->sink(in->sink_ctx, &c);
 }
 
 /* Emits a command that carries only a value / ivalue. */
@@ -401,9 +413,10 @@ static int exec_comp5(struct interp *in, int g)
     cb.unit_mm = interp_len_mm(in, 1.0);
     for (int i = 0; i < 3; i++)
         cb.prog_off_mm[i] = in->g5x[i] + in->g92[i] + in->tool[i];
+    in->comp.tf = in->tcp_on ? &in->tf : NULL;  /* G43.4: the tool axis in the program's frame */
     if (in->contour_fn)
         in->contour_fn(in->contour_ctx, in->line, !in->comp.active, in->pos, cb.point);
-    int rc = comp5_block(&in->comp, &cb, in->pos, in->sink, in->sink_ctx);
+    int rc = comp5_block(&in->comp, &cb, in->pos, interp_comp_sink, in);
     if (rc) {
         int col = rc == COMP5_ERR_RADIUS ? (W('w') ? W('w') : W('d')) : 0;
         interp_fail(in, INTERP_ERR_COMP5, col, "%s", comp5_errmsg(&in->comp));
@@ -419,7 +432,7 @@ static int flush_comp5(struct interp *in)
 {
     if (!in->comp.active)
         return 0;
-    int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
+    int rc = comp5_flush(&in->comp, interp_comp_sink, in);
     in->comp_radius_mm = 0;
     if (rc) {
         interp_fail(in, INTERP_ERR_COMP5, 0, "%s", comp5_errmsg(&in->comp));

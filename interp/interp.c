@@ -108,7 +108,28 @@ void interp_destroy(struct interp *in)
 void interp_set_start(struct interp *in, const double pose[6])
 {
     memcpy(in->start, pose, sizeof in->start);
-    memcpy(in->pos, pose, sizeof in->pos);
+    if (in->tcp_on)
+        kins_tcp_from_pose(&in->tf, in->tcp_len_mm, pose, in->pos);
+    else
+        memcpy(in->pos, pose, sizeof in->pos);
+}
+
+void interp_use_kins(struct interp *in, struct kins *k)
+{
+    struct kins_tool_frame f;
+    if (k && kins_get_tool_frame(k, &f) == KINS_OK)
+        interp_set_tool_frame(in, &f);
+}
+
+void interp_set_tool_frame(struct interp *in, const struct kins_tool_frame *f)
+{
+    double plat[6];
+    interp_pos_platform(in, plat);
+    in->tf = *f;
+    in->have_tf = 1;
+    in->tcp_on = f->program_tip;
+    in->tcp_len_mm = f->length_mm;
+    interp_pos_from_platform(in, plat);
 }
 
 /* Names the parameter file and loads it, restoring the saved coordinate system and G92. */
@@ -208,6 +229,8 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     memcpy(v->g5x_mm, in->g5x, sizeof v->g5x_mm);
     memcpy(v->g92_mm, in->g92, sizeof v->g92_mm);
     memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
+    v->tcp = in->tcp_on;
+    v->tcp_len_mm = in->tcp_len_mm;
     v->feed_factor = in->feed_factor;
     v->current_tool = in->current_tool;
     v->path_mode = in->path_mode;
@@ -257,7 +280,7 @@ static int percent_line(struct interp *in, int first)
         return interp_fail(in, INTERP_ERR_SYNTAX, 1, "a '%%' line may only open the program (on "
                            "its first line) and then close it");
     in->ended = 1;
-    int rc = comp5_flush(&in->comp, in->sink, in->sink_ctx);
+    int rc = comp5_flush(&in->comp, interp_comp_sink, in);
     if (rc)
         return interp_comp5_fail(in);
     return 0;

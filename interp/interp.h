@@ -116,6 +116,14 @@ void interp_set_contour_fn(struct interp *in, interp_contour_fn fn, void *ctx);
 void interp_set_param(struct interp *in, int n, double v);
 /* MDI: lines come one at a time (a run need not end with M2 or M30). */
 void interp_set_mdi(struct interp *in, int on);
+/* Where the machine's tool is, from its kinematics (kins_tool_frame): G43.4 needs it. When
+ * f->program_tip ([KINS] PROGRAM_POINT = TOOL_TIP), tool centre point control is on from the
+ * start with f->length_mm. The start pose stays the platform's pose (the machine's). */
+struct kins_tool_frame;
+void interp_set_tool_frame(struct interp *in, const struct kins_tool_frame *f);
+/* The same from a kinematics instance, when its model has a tool (else nothing changes). */
+struct kins;
+void interp_use_kins(struct interp *in, struct kins *k);
 /* The tool in the spindle (as M61 Q sets it, without a tool change). */
 void interp_set_current_tool(struct interp *in, int tool);
 
@@ -126,7 +134,9 @@ struct interp_view {
     int coord_system;         /* 1..9 for G54..G59.3 */
     double g5x_mm[6];         /* offset of the active coordinate system (mm, deg) */
     double g92_mm[6];         /* G92 offset (mm, deg) */
-    double tool_mm[6];        /* tool length offset (Z only for G43 H) */
+    double tool_mm[6];        /* tool length offset (Z only for G43 H; 0 under G43.4) */
+    int tcp;                  /* tool centre point control (G43.4) is on */
+    double tcp_len_mm;        /* its tool length, mm */
     double feed_factor;       /* see interp_set_feed_factor */
     int current_tool;         /* tool in the spindle */
     int path_mode;            /* 610 (G61), 611 (G61.1) or 640 (G64) */

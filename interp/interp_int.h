@@ -6,6 +6,7 @@
 
 #include "interp/comp5.h"
 #include "interp/interp.h"
+#include "kins/kins.h"
 
 #define INTERP_NPARAMS 5603      /* #1 .. #5602, as LinuxCNC */
 #define INTERP_LINE_MAX 4096     /* characters in one program line */
@@ -186,7 +187,12 @@ struct interp {
                                   * and reported, not used by the planner (docs/gcode.md) */
     double g5x[6];               /* active work offset, mm/deg */
     double g92[6];               /* active G92 offset */
-    double tool[6];              /* active tool length offset */
+    double tool[6];              /* active tool length offset (0 under G43.4) */
+    struct kins_tool_frame tf;   /* where the machine's tool is (interp_set_tool_frame) */
+    int have_tf;                 /* tf is set: G43.4 can run */
+    int tcp_on;                  /* G43.4 (or PROGRAM_POINT = TOOL_TIP): pos is the tool tip
+                                  * and orientation (kins_tcp_*), not the platform's pose */
+    double tcp_len_mm;           /* the tool length tool centre point control uses */
     double feed_mm_min;          /* F in force, converted */
     double f_word;               /* F as programmed (for printers) */
     double cycle_r, cycle_q, cycle_p; /* sticky canned cycle words, program units */
@@ -212,6 +218,9 @@ struct interp {
 /* exec.c: M70..M73 state: fills a save; restores one (emitting what changed). */
 void interp_modal_save(const struct interp *in, struct modal_save *m);
 int interp_modal_restore(struct interp *in, const struct modal_save *m);
+
+/* The canon sink G141/G142 emit through (exec.c): stamps the tool centre point state. */
+int interp_comp_sink(void *ctx, const struct canon_cmd *cmd);
 
 /* Records the first error (printf-style message) and returns status. */
 int interp_fail(struct interp *in, int status, int column, const char *fmt, ...)
@@ -288,6 +297,10 @@ int interp_g10(struct interp *in);
 int interp_home(struct interp *in, int g);
 int interp_g92(struct interp *in, int g);
 int interp_tool_length(struct interp *in, int g);
+/* The machine's platform pose of in->pos, and back: in->pos set from a platform pose in the
+ * representation in force (the tip under G43.4). */
+void interp_pos_platform(const struct interp *in, double plat[6]);
+void interp_pos_from_platform(struct interp *in, const double plat[6]);
 
 #define CHP(call) do { int rc_ = (call); if (rc_) return rc_; } while (0)
 

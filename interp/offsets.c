@@ -134,9 +134,69 @@ int interp_g92(struct interp *in, int g)
     return interp_emit_offsets(in);
 }
 
-/* G43 H (tool table Z), G43.1 (offsets given in the block), G49 (none). */
+void interp_pos_platform(const struct interp *in, double plat[6])
+{
+    if (in->tcp_on)
+        kins_tcp_to_pose(&in->tf, in->tcp_len_mm, in->pos, plat);
+    else
+        memcpy(plat, in->pos, 6 * sizeof *plat);
+}
+
+void interp_pos_from_platform(struct interp *in, const double plat[6])
+{
+    if (in->tcp_on)
+        kins_tcp_from_pose(&in->tf, in->tcp_len_mm, plat, in->pos);
+    else
+        memcpy(in->pos, plat, sizeof in->pos);
+}
+
+/* G43.4 H: tool centre point control with tool h's length (the machine stays where it is;
+ * its position is now the tip's): [KINS] TOOL_LENGTH, the reference tool's, plus the tool
+ * table's Z of tool h, as G43 H shifts by it. H0, or no H with no tool in the spindle:
+ * TOOL_LENGTH alone. */
+static int tcp_on(struct interp *in)
+{
+    if (!in->have_tf)
+        return interp_fail(in, INTERP_ERR_CONFIG, in->blk.gcol[8], "G43.4 (tool centre "
+                           "point control) needs the machine's kinematics with its tool "
+                           "([KINS] TOOL_POINT, TOOL_AXIS): give the machine's INI file");
+    if (in->comp.active)
+        return interp_fail(in, INTERP_ERR_MODAL, in->blk.gcol[8], "G43.4 inside a G141/G142 "
+                           "run: switch tool centre point control before the run");
+    int h = in->current_tool;
+    if (W('h'))
+        CHP(interp_to_int(in, V('h'), W('h'), "H (tool number)", &h));
+    if (h < 0)
+        return interp_fail(in, INTERP_ERR_WORD, W('h'), "negative H word H%d", h);
+    double len = in->tf.length_mm;
+    if (h > 0) {
+        struct tool_entry *e = in->tt ? tooltable_find(in->tt, h) : NULL;
+        if (!e)
+            return interp_fail(in, INTERP_ERR_TOOL, W('h') ? W('h') : in->blk.gcol[8],
+                               "G43.4 H%d: tool %d is not in the tool table", h, h);
+        len += e->z_offset_mm;
+    }
+    double plat[6];
+    interp_pos_platform(in, plat);
+    memset(in->tool, 0, sizeof in->tool);
+    in->tcp_on = 1;
+    in->tcp_len_mm = len;
+    interp_pos_from_platform(in, plat);
+    return interp_emit_offsets(in);
+}
+
+/* G43 H (tool table Z), G43.1 (offsets given in the block), G43.4 (tool centre point
+ * control), G49 (none). Leaving G43.4 keeps the machine where it is. */
 int interp_tool_length(struct interp *in, int g)
 {
+    if (g == 434)
+        return tcp_on(in);
+    if (in->tcp_on) {
+        double plat[6];
+        interp_pos_platform(in, plat);
+        in->tcp_on = 0;
+        interp_pos_from_platform(in, plat);
+    }
     if (g == 490) {
         memset(in->tool, 0, sizeof in->tool);
     } else if (g == 431) {

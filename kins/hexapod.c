@@ -234,6 +234,18 @@ static int hexapod_tool_point(struct kins *k, const double pose[KINS_POSE_DIM],
     return KINS_OK;
 }
 
+/* What tool centre point control needs: the tool's data as configured. */
+static int hexapod_tool_frame(struct kins *k, struct kins_tool_frame *out)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    out->on_platform = h->carries == HEXAPOD_CARRIES_SPINDLE;
+    memcpy(out->gauge_mm, h->tool_gauge_mm, sizeof out->gauge_mm);
+    memcpy(out->axis, h->tool_axis, sizeof out->axis);
+    out->length_mm = h->tool_len_mm;
+    out->program_tip = h->program_tip;
+    return KINS_OK;
+}
+
 /* Frees an instance made by hexapod_create. */
 static void hexapod_destroy(struct kins *k)
 {
@@ -293,4 +305,5 @@ const struct kins_ops kins_hexapod_ops = {
     .tool_point = hexapod_tool_point,
     .inverse_rates = hexapod_inverse_rates,
     .describe = hexapod_describe,
+    .tool_frame = hexapod_tool_frame,
 };

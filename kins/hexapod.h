@@ -33,6 +33,9 @@ struct hexapod {
     double tool_tip_mm[3];             /* tool tip (gauge point + length along the tool axis):
                                         * base frame if the tool is fixed, else platform frame */
     double tool_axis[3];               /* [KINS] TOOL_AXIS, unit length, in the same frame */
+    double tool_gauge_mm[3];           /* [KINS] TOOL_POINT, in the same frame */
+    double tool_len_mm;                /* [KINS] TOOL_LENGTH */
+    int program_tip;                   /* [KINS] PROGRAM_POINT = TOOL_TIP */
     /* The workspace beyond leg lengths (hexapod_workspace.c, docs/kinematics.md). */
     double base_max_deg, plat_max_deg; /* [KINS] BASE_/PLATFORM_JOINT_MAX_ANGLE; 0: none */
     double base_cos_max, plat_cos_max; /* their cosines (-2 when there is no limit) */

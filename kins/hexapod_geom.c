@@ -203,7 +203,14 @@ static int hexapod_read_tool(struct hexapod *h, const struct kins_config *cfg, c
     double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
     if (n < 1e-9)
         return kins_cfg_error(err, errlen, "KINS", "TOOL_AXIS", "the direction is zero");
+    const char *pp = cfg->get(cfg->ctx, "KINS", "PROGRAM_POINT");
+    h->program_tip = pp && !strcasecmp(pp, "TOOL_TIP");
+    if (pp && !h->program_tip && strcasecmp(pp, "PLATFORM"))
+        return kins_cfg_error(err, errlen, "KINS", "PROGRAM_POINT", "'%s': expected PLATFORM "
+                              "or TOOL_TIP", pp);
+    h->tool_len_mm = len_mm;
     for (int j = 0; j < 3; j++) {
+        h->tool_gauge_mm[j] = gauge[j];
         h->tool_axis[j] = axis[j] / n;
         h->tool_tip_mm[j] = gauge[j] + len_mm * h->tool_axis[j];
     }

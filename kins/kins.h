@@ -53,6 +53,18 @@ struct kins_check {
     int near_singular;       /* 1 if condition exceeds the configured threshold */
 };
 
+/* Where the tool is on the machine: what tool centre point control needs (kins_tcp.c). */
+struct kins_tool_frame {
+    int on_platform;         /* 1: the spindle is on the platform (PLATFORM_CARRIES = SPINDLE),
+                              * its data in the platform frame; 0: the tool is fixed on the
+                              * machine frame (WORKPIECE), its data in the base frame */
+    double gauge_mm[3];      /* [KINS] TOOL_POINT: the spindle's gauge point */
+    double axis[3];          /* [KINS] TOOL_AXIS, unit: from the gauge point to the tip */
+    double length_mm;        /* [KINS] TOOL_LENGTH: the tool length when no G43.4 H gave one */
+    int program_tip;         /* [KINS] PROGRAM_POINT = TOOL_TIP: tool centre point control is
+                              * the machine's default (else PLATFORM: the platform's pose) */
+};
+
 struct kins;
 
 /* The ops table a plugin exports as `const struct kins_ops kins_<name>_ops` ('-' -> '_'). */
@@ -87,6 +99,9 @@ struct kins_ops {
      * by how much, which joint or legs), or "" and KINS_OK when it is inside. NULL: the
      * model has no limits beyond the joints'. */
     int (*describe)(struct kins *k, const double pose[KINS_POSE_DIM], char *msg, size_t len);
+    /* Optional: where the tool is (for tool centre point control). NULL: the model has no
+     * tool, and G43.4 is refused on it. */
+    int (*tool_frame)(struct kins *k, struct kins_tool_frame *out);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -148,6 +163,31 @@ static inline int kins_tool_point(struct kins *k, const double *pose, double *ti
                                   double *tip_platform_mm)
 { return k->ops->tool_point ? k->ops->tool_point(k, pose, tip_base_mm, tip_platform_mm)
                             : KINS_ERR_ARG; }
+
+/* The model's tool frame; KINS_ERR_ARG when it has none. */
+static inline int kins_get_tool_frame(struct kins *k, struct kins_tool_frame *out)
+{ return k->ops->tool_frame ? k->ops->tool_frame(k, out) : KINS_ERR_ARG; }
+
+/*
+ * Tool centre point control (G43.4, docs/kinematics.md): a "program pose" X Y Z A B C is the
+ * tool tip and the orientation, in the frame that holds the workpiece: the base (machine)
+ * frame when the platform carries the spindle, the platform (workpiece) frame when it carries
+ * the workpiece. A B C stay the platform's orientation R = Rz(C) Ry(B) Rx(A). len_mm is the
+ * tool's length beyond the gauge point along the tool axis. These are exact, rigid-body maps.
+ */
+/* The platform pose that puts the tip of a tool len_mm long at the program pose. */
+void kins_tcp_to_pose(const struct kins_tool_frame *f, double len_mm,
+                      const double prog[KINS_POSE_DIM], double pose[KINS_POSE_DIM]);
+/* The same with velocities: prog_vel (mm/s, deg/s) -> pose_vel. */
+void kins_tcp_to_pose_vel(const struct kins_tool_frame *f, double len_mm,
+                          const double prog[KINS_POSE_DIM], const double prog_vel[KINS_POSE_DIM],
+                          double pose[KINS_POSE_DIM], double pose_vel[KINS_POSE_DIM]);
+/* The program pose (tip and orientation) of a platform pose: the inverse of the above. */
+void kins_tcp_from_pose(const struct kins_tool_frame *f, double len_mm,
+                        const double pose[KINS_POSE_DIM], double prog[KINS_POSE_DIM]);
+/* The tool's direction from the tip back to the spindle, unit, in the program's frame at
+ * orientation abc (deg): what G141/G142 take as the tool axis N under G43.4. */
+void kins_tcp_tool_dir(const struct kins_tool_frame *f, const double abc[3], double n[3]);
 
 /* The models this library links in, for kins_create(). */
 extern const struct kins_ops kins_hexapod_ops;

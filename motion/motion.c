@@ -52,6 +52,7 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     }
     m->cfg = *cfg;
     m->kins = k;
+    m->have_tf = kins_get_tool_frame(k, &m->tf) == KINS_OK;
     m->nj = k->njoints;
     m->cfg.njoints = m->nj;
     m->override_cmd = 1;

@@ -180,6 +180,14 @@ struct motion_tool {
 struct motion_out {
     double pose[KINS_POSE_DIM];        /* commanded pose: mm, deg */
     double pose_vel[KINS_POSE_DIM];    /* its rate: mm/s, deg/s */
+    double prog_pose[KINS_POSE_DIM];   /* the path's pose: under G43.4 (tcp) the tool tip and
+                                        * orientation (kins_tcp_*), else pose */
+    int tcp;                           /* the path being followed is under G43.4 ... */
+    double tool_len_mm;                /* ... with this tool length, mm */
+    int seg_kind;                      /* the move being followed: 1 a straight feed, 2 an arc,
+                                        * 3 a rapid, 0 none (a stop, or no program) ... */
+    double seg_from[KINS_POSE_DIM];    /* ... from and to these path poses (the tool tip's */
+    double seg_to[KINS_POSE_DIM];      /* under tcp): for checks of the path between them */
     double joint_pos[KINS_MAX_JOINTS]; /* leg position commands, mm */
     double joint_vel[KINS_MAX_JOINTS]; /* leg rate commands, mm/s */
     double motor_pos[KINS_MAX_JOINTS]; /* what the drives get: joint_pos + home offset, mm */

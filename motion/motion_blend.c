@@ -81,14 +81,22 @@ static int transparent(enum canon_type t)
 static void scan(const struct motion_config *cfg, const struct canon_prog *in,
                  struct blend_rec *rec)
 {
-    double at[6], tol = 0;
+    double at[6], tol = 0, at_len = in->start_tcp ? in->start_tool_len_mm : 0;
+    int at_tcp = in->start_tcp;
     memcpy(at, in->start, sizeof at);
     for (size_t i = 0; i < in->count; i++) {
         const struct canon_cmd *c = &in->cmds[i];
         struct blend_rec *b = &rec[i];
         memcpy(b->from, at, sizeof at);
         b->tol_mm = tol;
-        if (c->type == CANON_FEED) {
+        /* a move after G43.4 or G49 starts from a pose in other coordinates: never blended
+         * (the planner stops there) */
+        int moves = c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC;
+        double len_c = c->tcp ? c->tool_len_mm : 0;
+        int switched = moves && (c->tcp != at_tcp || len_c != at_len);
+        if (moves)
+            at_tcp = c->tcp, at_len = len_c;
+        if (c->type == CANON_FEED && !switched) {
             double d[3] = {c->end[0] - at[0], c->end[1] - at[1], c->end[2] - at[2]};
             double len = sqrt(dot3(d, d));
             if (len > LINE_EPS_MM) {
@@ -165,6 +173,8 @@ static void blend_arc(const struct canon_prog *in, const struct blend_rec *rec, 
     a->n_number = cj->n_number;
     a->feed_mm_min = cj->feed_mm_min;
     a->compensated = cj->compensated;
+    a->tcp = cj->tcp;
+    a->tool_len_mm = cj->tool_len_mm;
     line_pose(bj->from, cj, bj->len_mm, bi->g.trim_mm, a->end);
     if (cj->inverse_time_min > 0)  /* G93: keep the entered move's speed on the arc */
         a->inverse_time_min = cj->inverse_time_min * bi->g.radius_mm * bi->g.turn_rad /
@@ -190,6 +200,8 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
                 struct motion_blend_abc *abc, size_t *ends)
 {
     memcpy(out->start, in->start, sizeof out->start);
+    out->start_tcp = in->start_tcp;
+    out->start_tool_len_mm = in->start_tool_len_mm;
     for (size_t i = 0; i < in->count; i++) {
         struct canon_cmd c = in->cmds[i];
         const struct blend_rec *b = &rec[i];

@@ -17,12 +17,14 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     double Lm[KINS_MAX_JOINTS], Lp[KINS_MAX_JOINTS];
     if (sg->kind == SEG_ARC)
         h = fmin(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
+    o->tcp = sg->tcp;
+    o->tool_len_mm = sg->tool_len_mm;
     motion_seg_pose(&m->plan, sg, s, o->pose);
     motion_seg_pose(&m->plan, sg, s - h, pm);
     motion_seg_pose(&m->plan, sg, s + h, pp);
-    int st = kins_inverse(m->kins, o->pose, o->L);
-    kins_inverse(m->kins, pm, Lm);     /* legs are written even when out of range */
-    kins_inverse(m->kins, pp, Lp);
+    int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
+    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pm, Lm); /* written even out of range */
+    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pp, Lp);
     for (int i = 0; i < KINS_POSE_DIM; i++) {
         o->dp[i] = (pp[i] - pm[i]) / (2 * h);
         o->d2p[i] = (pp[i] - 2 * o->pose[i] + pm[i]) / (h * h);
@@ -71,7 +73,7 @@ int motion_invert6(double a[6][6], double inv[6][6])
  * was taken (it changes by well under 1 % there). -1 when the Jacobian is singular. */
 static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S)
 {
-    int near = m->jc_valid;
+    int near = m->jc_valid && m->jc_tcp == S->tcp && m->jc_len_mm == S->tool_len_mm;
     for (int i = 0; i < 6 && near; i++)
         near = fabs(S->pose[i] - m->jc_pose[i]) <= (i < 3 ? 2.0 : 1.0);
     if (near)
@@ -80,7 +82,7 @@ static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S
     for (int j = 0; j < 6; j++) {
         memcpy(p1, S->pose, sizeof p1);
         p1[j] += d;
-        kins_inverse(m->kins, p1, L1);
+        motion_path_inverse(m, S->tcp, S->tool_len_mm, p1, L1);
         for (int i = 0; i < 6; i++)
             J[i][j] = (L1[i] - S->L[i]) / d;
     }
@@ -88,6 +90,8 @@ static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S
         return -1;
     memcpy(m->jc_pose, S->pose, sizeof m->jc_pose);
     m->jc_valid = 1;
+    m->jc_tcp = S->tcp;
+    m->jc_len_mm = S->tool_len_mm;
     return 0;
 }
 
@@ -205,7 +209,9 @@ static int unreachable(struct motion *m, const struct motion_seg *sg,
         }
     }
     char why[300];
-    if (st == KINS_ERR_WORKSPACE && kins_describe(m->kins, P, why, sizeof why) ==
+    double Q[KINS_POSE_DIM];
+    motion_platform(m, S->tcp, S->tool_len_mm, P, Q);
+    if (st == KINS_ERR_WORKSPACE && kins_describe(m->kins, Q, why, sizeof why) ==
         KINS_ERR_WORKSPACE) {
         snprintf(err, errlen, "%s:%d: the move leaves the machine's workspace: %s, at X%.3f "
                  "Y%.3f Z%.3f A%.3f B%.3f C%.3f", f, sg->line, why, P[0], P[1], P[2], P[3],

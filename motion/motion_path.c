@@ -363,6 +363,39 @@ static int add_io(struct motion_plan *p, enum motion_io_kind kind, double value,
     return 0;
 }
 
+/* Under tool centre point control the path is the tool tip's: a move carries its mode and
+ * tool length, and the pose it starts from is re-expressed when they change (the machine
+ * stands still there: an exact stop, as the two paths' tangents are in different spaces). */
+static int tcp_switch(struct motion *m, const struct canon_cmd *c, double at[KINS_POSE_DIM],
+                      int *at_tcp, double *at_len, char *err, size_t errlen)
+{
+    double len = c->tcp ? c->tool_len_mm : 0;
+    if (c->tcp == *at_tcp && len == *at_len)
+        return 0;
+    if (c->tcp && !m->have_tf) {
+        snprintf(err, errlen, "%s:%d: tool centre point control (G43.4) needs kinematics that "
+                 "know where the tool is; this machine's do not", c->file ? c->file
+                 : "program", c->line);
+        return -2;
+    }
+    double plat[KINS_POSE_DIM];
+    motion_platform(m, *at_tcp, *at_len, at, plat);
+    if (c->tcp)
+        kins_tcp_from_pose(&m->tf, len, plat, at);
+    else
+        memcpy(at, plat, sizeof plat);
+    *at_tcp = c->tcp, *at_len = len;
+    struct motion_plan *p = &m->plan;
+    if (p->nseg == 0 || (p->segs[p->nseg - 1].kind != SEG_LINE &&
+                         p->segs[p->nseg - 1].kind != SEG_ARC))
+        return 0;
+    if (add_stop(p, c, at, SEG_DWELL, 0) < 0)
+        return -1;
+    p->segs[p->nseg - 1].tcp = *at_tcp;
+    p->segs[p->nseg - 1].tool_len_mm = *at_len;
+    return 0;
+}
+
 /* Builds the segment list from the program (geometry only; speeds come later). */
 int motion_path_build(struct motion *m, const struct canon_prog *prog,
                       const struct motion_blend_abc *abc, char *err, size_t errlen)
@@ -373,6 +406,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     int sp_dir = m->io.dir;    /* the spindle as the program leaves it so far */
     double sp_rpm = m->io.rpm;
     memcpy(at, prog->start, sizeof at);
+    int at_tcp = prog->start_tcp;
+    double at_len = prog->start_tcp ? prog->start_tool_len_mm : 0;
     for (int k = 0; k < 2; k++)
         m->pb_seg[k] = p->nseg;
     size_t i = 0;
@@ -385,6 +420,16 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         if (motion_cancelled(m, c->file, c->line, err, errlen))
             return MOTION_ERR_CANCELLED;
         int rc = 0;
+        if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC) {
+            rc = tcp_switch(m, c, at, &at_tcp, &at_len, err, errlen);
+            if (rc == -2)
+                return MOTION_ERR_PROGRAM;
+            if (rc < 0) {
+                snprintf(err, errlen, "out of memory planning the program");
+                return MOTION_ERR_NOMEM;
+            }
+            nseg0 = p->nseg;
+        }
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
         case CANON_ARC:
@@ -460,8 +505,12 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             snprintf(err, errlen, "out of memory planning the program");
             return MOTION_ERR_NOMEM;
         }
-        if (p->nseg > nseg0)
-            set_speed(m, &p->segs[p->nseg - 1], c, blend);
+        if (p->nseg > nseg0) {
+            struct motion_seg *sg = &p->segs[p->nseg - 1];
+            set_speed(m, sg, c, blend);
+            sg->tcp = at_tcp;
+            sg->tool_len_mm = at_len;
+        }
         if (c->type == CANON_PATH_MODE)  /* G64 (ivalue 640) without P: BLEND_TOLERANCE */
             blend = motion_blend_tolerance(&m->cfg, c);
         if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)

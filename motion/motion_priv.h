@@ -69,6 +69,10 @@ struct motion_seg {
      * the path lie within reach of a chord touching an arc whose path curvature is at most
      * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
     double chord_mm[2], chord_k[2], chord_kabc[2];
+    int tcp;                 /* tool centre point control: the path (start, end, arcs) is the
+                              * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
+                              * gives the platform's pose */
+    double tool_len_mm;
 };
 
 /* The planned program: segments and the velocity profile at knots along them. Interval i
@@ -152,6 +156,8 @@ enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOM
 struct motion {
     struct motion_config cfg;
     struct kins *kins;       /* borrowed */
+    struct kins_tool_frame tf; /* the machine's tool, for tool centre point control */
+    int have_tf;             /* the kinematics has a tool frame */
     int nj;                  /* joints */
     struct motion_plan plan;
     struct motion_plan *run; /* the plan being followed: &plan, or a streamed chunk's */
@@ -182,6 +188,8 @@ struct motion {
     double jc_pose[KINS_POSE_DIM];
     double jc_Jinv[6][6];
     int jc_valid;
+    int jc_tcp;              /* ... for this tool centre point control and tool length */
+    double jc_len_mm;
     /* run state */
     double tau_s;            /* position on the plan's time axis, s */
     double rate;             /* current time-scaling rate (feed override in effect) */
@@ -215,8 +223,13 @@ struct motion {
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     int have_cmd;            /* joint_cmd holds a command */
-    double pose[KINS_POSE_DIM];
+    double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];
+    double prog_pose[KINS_POSE_DIM]; /* the path's pose: the tool tip under G43.4, else pose */
+    int tcp;                 /* the segment being followed is under G43.4 ... */
+    double tool_len_mm;      /* ... with this tool length */
+    int seg_kind;            /* it is a line (1), an arc (2), a stop (0) ... */
+    double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM]; /* ... from and to these poses */
     double joint_cmd[KINS_MAX_JOINTS];
     double joint_vel[KINS_MAX_JOINTS];
     double ferror[KINS_MAX_JOINTS];
@@ -300,6 +313,8 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
 /* One path sample through the kinematics: pose, its s-derivative, legs and their
  * first and second s-derivatives. */
 struct motion_sample {
+    int tcp;                 /* the segment's tool centre point control and tool length */
+    double tool_len_mm;
     double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
     double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
 };
@@ -339,5 +354,26 @@ double motion_junction_share(const struct motion *m, const struct motion_sample 
                              const struct motion_sample *B, double v);
 /* 6x6 inverse with partial pivoting (a is destroyed); 0 on success, -1 when singular. */
 int motion_invert6(double a[6][6], double inv[6][6]);
+
+/* A path pose of a segment as the platform's pose (the same unless under G43.4). */
+static inline void motion_platform(const struct motion *m, int tcp, double tool_len_mm,
+                                   const double P[KINS_POSE_DIM], double out[KINS_POSE_DIM])
+{
+    if (tcp)
+        kins_tcp_to_pose(&m->tf, tool_len_mm, P, out);
+    else if (out != P)
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            out[i] = P[i];
+}
+/* Leg lengths of a path pose (kins_inverse's status; legs written even when out of range). */
+static inline int motion_path_inverse(struct motion *m, int tcp, double tool_len_mm,
+                                      const double P[KINS_POSE_DIM], double *L)
+{
+    double q[KINS_POSE_DIM];
+    if (!tcp)
+        return kins_inverse(m->kins, P, L);
+    kins_tcp_to_pose(&m->tf, tool_len_mm, P, q);
+    return kins_inverse(m->kins, q, L);
+}
 
 #endif

@@ -332,10 +332,23 @@ static int evaluate(struct motion *m)
     double v = vp * m->rate;
     if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
         v = 0;
-    motion_seg_pose(p, sg, s, m->pose);
+    motion_seg_pose(p, sg, s, m->prog_pose);
     motion_seg_tangent(p, sg, s, dp);
-    for (int i = 0; i < KINS_POSE_DIM; i++)
-        m->pose_vel[i] = dp[i] * v;
+    m->tcp = sg->tcp;
+    m->tool_len_mm = sg->tool_len_mm;
+    m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
+    memcpy(m->seg_from, sg->start, sizeof m->seg_from);
+    memcpy(m->seg_to, sg->end, sizeof m->seg_to);
+    if (sg->tcp) {             /* G43.4: the path is the tip's; the platform's pose follows */
+        double pv[KINS_POSE_DIM];
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            pv[i] = dp[i] * v;
+        kins_tcp_to_pose_vel(&m->tf, sg->tool_len_mm, m->prog_pose, pv, m->pose, m->pose_vel);
+    } else {
+        memcpy(m->pose, m->prog_pose, sizeof m->pose);
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            m->pose_vel[i] = dp[i] * v;
+    }
     m->path_vel = v;
     m->line = sg->line;
     m->file = sg->file;
@@ -545,6 +558,12 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     stream_watch(m);
     memcpy(out->pose, m->pose, sizeof out->pose);
     memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
+    out->tcp = m->loaded && m->tcp;
+    out->tool_len_mm = out->tcp ? m->tool_len_mm : 0;
+    memcpy(out->prog_pose, out->tcp ? m->prog_pose : m->pose, sizeof out->prog_pose);
+    out->seg_kind = m->loaded ? m->seg_kind : 0;
+    memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
+    memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
     memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
     for (int i = 0; i < m->nj; i++) {

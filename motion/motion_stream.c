@@ -37,6 +37,8 @@ struct motion_stream {
     size_t nctx;                    /* context commands at its start */
     size_t fresh;                   /* commands added since the window was last cut */
     double start[KINS_POSE_DIM];    /* pose where win[0] starts */
+    int start_tcp;                  /* ... the tool tip under G43.4 with this tool length */
+    double start_len_mm;
     double start0[KINS_POSE_DIM];   /* the program's start */
     double tol_mm;                  /* G64 tolerance in force at win[0] */
     double tail_mm, tail_deg;       /* path a window keeps after its cut */
@@ -215,9 +217,11 @@ static void carry_state(struct motion_stream *s, size_t end)
 {
     for (size_t i = 0; i < end; i++) {
         const struct canon_cmd *c = &s->win[i];
-        if (is_move(c->type))
+        if (is_move(c->type)) {
             memcpy(s->start, c->end, sizeof s->start);
-        else if (c->type == CANON_PATH_MODE)
+            s->start_tcp = c->tcp;
+            s->start_len_mm = c->tool_len_mm;
+        } else if (c->type == CANON_PATH_MODE)
             s->tol_mm = motion_blend_tolerance(&s->pm->cfg, c);
         else if (i < s->nctx)
             continue;
@@ -276,6 +280,8 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
         return MOTION_OK;
     struct canon_prog raw = { .cmds = s->win, .count = s->n, .cap = s->cap };
     memcpy(raw.start, s->start, sizeof raw.start);
+    raw.start_tcp = s->start_tcp;
+    raw.start_tool_len_mm = s->start_len_mm;
     size_t *ends = malloc((s->n ? s->n : 1) * sizeof *ends);
     struct canon_prog blended;
     struct motion_blend_abc *abc = NULL;
@@ -309,7 +315,8 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     if ((st = motion_plan_profile(pm, pm->msg, sizeof pm->msg)))
         return fail(s, st, pm->msg);
     double L[KINS_MAX_JOINTS];
-    if (p->nseg == 0 && kins_inverse(pm->kins, s->start, L) != KINS_OK)
+    if (p->nseg == 0 && motion_path_inverse(pm, s->start_tcp, s->start_len_mm, s->start, L)
+        != KINS_OK)
         return fail(s, MOTION_ERR_UNREACHABLE, "the program's start position is outside the "
                     "machine's reach");
     s->deficit = fmax(s->deficit, p->enter_deficit);

@@ -183,8 +183,10 @@ int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *t
     char msg[1024];
     int st = interp_setup(in, tt, hal_ini_lookup, r->hal, hal_ini_dir(r->hal), 0, msg,
                           sizeof msg);
-    if (st == INTERP_OK)
+    if (st == INTERP_OK) {
+        interp_use_kins(in, r->kins);   /* G43.4 and [KINS] PROGRAM_POINT */
         return RUNNER_OK;
+    }
     char where[1536];
     return errbuf_set(err, errlen, RUNNER_ERR_CONFIG, "%s", st == INTERP_ERR_CONFIG
                        ? inifile_locate_msg(hal_ini_file(r->hal), msg, where, sizeof where)

@@ -61,6 +61,8 @@ static json_t *gcodes(const struct session *s)
     json_array_insert_new(a, 0, json_string(buf));
     json_array_append_new(a, json_string(v.incremental ? "G91" : "G90"));
     json_array_append_new(a, json_string(v.inverse_time ? "G93" : "G94"));
+    if (v.tcp)
+        json_array_append_new(a, json_string("G43.4"));
     return a;
 }
 
@@ -97,11 +99,24 @@ json_t *session_status(struct session *s)
     const double *cmd = motion_pose_known(s->m) ? o.pose : nanpose;
     struct interp_view v;
     interp_get_view(s->mdi, &v);
+    /* under G43.4 (the running program's, else MDI's) the program's position is the tip's */
+    int tcp = s->running ? o.tcp : v.tcp;
+    double tcp_len = s->running ? o.tool_len_mm : v.tcp_len_mm;
+    struct kins_tool_frame tf;
+    double tcmd[KINS_POSE_DIM], tact[KINS_POSE_DIM];
+    memcpy(tcmd, cmd, sizeof tcmd);
+    memcpy(tact, actual, sizeof tact);
+    if (tcp && kins_get_tool_frame(s->k, &tf) == KINS_OK) {
+        kins_tcp_from_pose(&tf, tcp_len, cmd, tcmd);
+        kins_tcp_from_pose(&tf, tcp_len, actual, tact);
+    } else {
+        tcp = 0;
+    }
     double off[KINS_POSE_DIM], pcmd[KINS_POSE_DIM], pact[KINS_POSE_DIM];
     for (int i = 0; i < KINS_POSE_DIM; i++) {
         off[i] = v.g5x_mm[i] + v.g92_mm[i] + v.tool_mm[i];
-        pcmd[i] = cmd[i] - off[i];
-        pact[i] = ok ? actual[i] - off[i] : (double)NAN;
+        pcmd[i] = tcmd[i] - off[i];
+        pact[i] = ok ? tact[i] - off[i] : (double)NAN;
     }
     json_t *legs = json_array();
     for (int i = 0; i < s->nj; i++)
@@ -114,7 +129,7 @@ json_t *session_status(struct session *s)
     double progress = s->running ? fmin(1.0, p.percent / 100.0) : 0.0;
     json_t *j = json_pack(
         "{s:f, s:s, s:s, s:o, s:b, s:s, s:s, s:s?, s:i, s:f,"
-        " s:{s:o, s:o}, s:{s:o, s:o}, s:o, s:o, s:o, s:{s:i, s:i, s:f}, s:f,"
+        " s:{s:o, s:o}, s:{s:o, s:o}, s:o, s:o, s:o, s:{s:i, s:i, s:f, s:b, s:f}, s:f,"
         " s:{s:f, s:i, s:f}, s:{s:b, s:b}, s:{s:f, s:f, s:f}, s:{s:b, s:b}, s:s?}",
         "time", (double)hal_now_ns(s->hal) * 1e-9,
         "state", session_state_name(s->state),
@@ -134,7 +149,7 @@ json_t *session_status(struct session *s)
         "gcodes", gcodes(s),
         "mcodes", mcodes(&v),
         "tool", "number", o.tool.number, "selected", v.selected_tool, "length",
-        v.tool_mm[2],
+        v.tool_mm[2], "tcp", tcp != 0, "tcp_length", tcp ? tcp_len : 0.0,
         "feed", v.feed_mm_min,
         "spindle", "speed", o.spindle.rpm, "direction", o.spindle.dir, "override",
         s->spindle_ovr,

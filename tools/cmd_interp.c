@@ -8,6 +8,7 @@
 #include "interp/interp_setup.h"
 #include "interp/printer.h"
 #include "interp/tooltable.h"
+#include "kins/kins.h"
 #include "tools/cmd.h"
 
 const char cmd_interp_usage[] =
@@ -37,6 +38,17 @@ static int apply_ini(struct interp *in, const char *path, struct tooltable *tt)
     if (st != INTERP_OK)   /* a bad value names its key: point it at the INI's line */
         fprintf(stderr, "error: %s\n", st == INTERP_ERR_CONFIG
                 ? inifile_locate_msg(&ini, err, msg, sizeof msg) : err);
+    const char *kname = inifile_get(&ini, "KINS", "KINEMATICS");
+    if (st == INTERP_OK && kname) {   /* the machine's tool, for G43.4 */
+        struct kins_config cfg = { inifile_config_get, &ini };
+        struct kins *k = NULL;
+        if (kins_load(kname, &cfg, &k, err, sizeof err) != KINS_OK) {
+            fprintf(stderr, "error: %s\n", err);
+            st = INTERP_ERR_CONFIG;
+        }
+        interp_use_kins(in, k);
+        kins_free(k);
+    }
     inifile_free(&ini);
     return st == INTERP_OK ? 0 : -1;
 }

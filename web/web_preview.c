@@ -12,6 +12,7 @@
 #include "interp/interp.h"
 #include "interp/interp_setup.h"
 #include "interp/tooltable.h"
+#include "kins/kins.h"
 #include "web/web.h"
 
 #define RPC_FAILED -32005
@@ -160,6 +161,15 @@ json_t *web_preview(const struct web_config *c, const char *path, const double s
                      INTERP_SETUP_PARAMS_READ_ONLY, msg, sizeof msg) != INTERP_OK) {
         errbuf_set(err, errlen, -1, "%s", msg);
         goto out;
+    }
+    const char *kname = inifile_get(c->ini, "KINS", "KINEMATICS");
+    if (kname && !strcmp(kname, "hexapod")) {   /* the tool, for G43.4 (the path drawn is
+                                                 * then the tool tip's) */
+        struct kins_config kc = { inifile_config_get, (void *)c->ini };
+        struct kins *k = NULL;
+        if (kins_create(&kins_hexapod_ops, &kc, &k, msg, sizeof msg) == KINS_OK)
+            interp_use_kins(in, k);
+        kins_free(k);
     }
     for (int i = 0; i < 3; i++) {
         p.lo[i] = HUGE_VAL;

@@ -196,6 +196,30 @@ def plain_session(tmp):
           (st["gcodes"], st["mcodes"], st["spindle"], st["coolant"]))
     c.ok("mdi.execute", line="M5 M9")
     c.ok("mdi.execute", line="G90")
+    # tool centre point control from MDI (TMU: the tool is fixed at Z720, the platform at
+    # X6 Y5 Z650): the program's position becomes the tip in the workpiece's frame, and B5
+    # turns the table about it
+    c.ok("mdi.execute", line="G43.4 H1")
+    st = c.status()
+    tip = st["pose"]["commanded"]
+    check("G43.4: status shows it and the tip (X-6 Y-5 Z70 on the table) as the position",
+          st["tool"]["tcp"] and "G43.4" in st["gcodes"] and st["tool"]["tcp_length"] == 60 and
+          max(abs(a - b) for a, b in zip(tip, [-6, -5, 70, 0, 0, 0])) < 1e-6, (st["tool"], tip))
+    c.ok("mdi.execute", line="G1 B5 F600")
+    st = c.wait()
+    b5 = math.radians(5)
+    check("G43.4 G1 B5: the tip stays, the platform moves under it (X = 6 cos 5 - 70 sin 5)",
+          max(abs(a - b) for a, b in zip(st["pose"]["commanded"], [-6, -5, 70, 0, 5, 0]))
+          < 1e-6 and abs(st["machine_pose"]["commanded"][0] -
+                         (6 * math.cos(b5) - 70 * math.sin(b5))) < 1e-6,
+          (st["pose"]["commanded"], st["machine_pose"]["commanded"]))
+    c.ok("mdi.execute", line="G1 B0")
+    c.wait()
+    c.ok("mdi.execute", line="G49")
+    st = c.status()
+    check("G49: back to the platform's pose", not st["tool"]["tcp"] and max(
+        abs(a - b) for a, b in zip(st["pose"]["commanded"], [6, 5, 650, 0, 0, 0])) < 1e-6,
+        st["pose"]["commanded"])
     st = c.status()
     check("... and its changes: G90, M5, M9", "G90" in st["gcodes"] and "M5" in st["mcodes"]
           and "M9" in st["mcodes"] and st["spindle"]["direction"] == 0, (st["gcodes"],
