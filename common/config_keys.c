@@ -109,8 +109,16 @@ const struct config_key config_keys[] = {
       "number above which a pose counts as near-singular" },
     { "KINS", "BASE_JOINT_MAX_ANGLE", NUM, "deg", "(0..89.9]", 0, 0, "", "largest angle "
       "between a leg and its base joint's axis (the base normal); absent: not limited" },
+    { "KINS", "BASE_JOINT_AXIS", NUMS, "", "", 3, 0, "0 0 1", "mounting axis of every "
+      "base joint, base frame, pointing up along the legs (needs BASE_JOINT_MAX_ANGLE)" },
+    { "KINS", "BASE_JOINT_AXIS_#", NUMS, "", "", 3, 0, "BASE_JOINT_AXIS", "mounting axis of "
+      "base joint # (0..5), in place of BASE_JOINT_AXIS" },
+    { "KINS", "PLATFORM_JOINT_AXIS", NUMS, "", "", 3, 0, "0 0 1", "mounting axis of every "
+      "platform joint, platform frame, pointing up (needs PLATFORM_JOINT_MAX_ANGLE)" },
+    { "KINS", "PLATFORM_JOINT_AXIS_#", NUMS, "", "", 3, 0, "PLATFORM_JOINT_AXIS", "mounting "
+      "axis of platform joint # (0..5), in place of PLATFORM_JOINT_AXIS" },
     { "KINS", "PLATFORM_JOINT_MAX_ANGLE", NUM, "deg", "(0..89.9]", 0, 0, "", "largest angle "
-      "between a leg and its platform joint's axis (the platform normal); absent: not "
+      "between a leg and its platform joint's axis (PLATFORM_JOINT_AXIS); absent: not "
       "limited" },
     { "KINS", "LEG_DIAMETER", NUM, "mm", "(0..1000]", 0, 0, "", "legs' outer diameter: two "
       "legs' axes stay LEG_DIAMETER + LEG_CLEARANCE apart; absent: not checked" },

@@ -39,6 +39,9 @@ struct hexapod {
     /* The workspace beyond leg lengths (hexapod_workspace.c, docs/kinematics.md). */
     double base_max_deg, plat_max_deg; /* [KINS] BASE_/PLATFORM_JOINT_MAX_ANGLE; 0: none */
     double base_cos_max, plat_cos_max; /* their cosines (-2 when there is no limit) */
+    double base_jaxis[HEXAPOD_LEGS][3]; /* [KINS] BASE_JOINT_AXIS(_n): each base joint's
+                                         * mounting axis, unit, base frame (default +Z) */
+    double plat_jaxis[HEXAPOD_LEGS][3]; /* PLATFORM_JOINT_AXIS(_n): platform frame (+Z) */
     double leg_diameter_mm;            /* [KINS] LEG_DIAMETER; 0: collisions not checked */
     double leg_clearance_mm;           /* [KINS] LEG_CLEARANCE, kept between two legs */
     double axis_min[KINS_POSE_DIM];    /* [AXIS_X..C] MIN_LIMIT, MAX_LIMIT: the pose's soft */

@@ -9,6 +9,11 @@
 #include "kins/hexapod_math.h"
 #include "kins/kins_cfg.h"
 
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, char *err,
                            size_t errlen)
 {
@@ -26,6 +31,40 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
         if (found && !(*out[i] > 0 && *out[i] <= hi[i]) && !(i == 3 && *out[i] == 0))
             return kins_cfg_error(err, errlen, "KINS", keys[i], "%g is outside %s..%g", *out[i],
                                   i == 3 ? "0" : "(0", hi[i]);
+    }
+    /* the joints' mounting axes: one for all (BASE_JOINT_AXIS), or per joint (_n) */
+    static const char *const akeys[2] = { "BASE_JOINT_AXIS", "PLATFORM_JOINT_AXIS" };
+    for (int b = 0; b < 2; b++) {
+        double (*ax)[3] = b ? h->plat_jaxis : h->base_jaxis, all[3] = { 0, 0, 1 };
+        int found_all, found;
+        int st = kins_cfg_numbers(cfg, "KINS", akeys[b], all, 3, &found_all, err, errlen);
+        if (st != KINS_OK)
+            return st;
+        int any = found_all;
+        for (int i = 0; i < HEXAPOD_LEGS; i++) {
+            char key[40];
+            snprintf(key, sizeof key, "%s_%d", akeys[b], i);
+            double *a = ax[i];
+            a[0] = all[0], a[1] = all[1], a[2] = all[2];
+            if ((st = kins_cfg_numbers(cfg, "KINS", key, a, 3, &found, err, errlen)) != KINS_OK)
+                return st;
+            any |= found;
+            double n = sqrt(dot3(a, a));
+            if (!(n > 1e-9))
+                return kins_cfg_error(err, errlen, "KINS", found ? key : akeys[b],
+                                      "the direction is zero");
+            if (a[2] <= 0)
+                return kins_cfg_error(err, errlen, "KINS", found ? key : akeys[b], "%g %g %g "
+                                      "points down: give a joint's axis pointing up, the way "
+                                      "a leg runs from its base joint to its platform joint "
+                                      "(%s frame)", a[0], a[1], a[2], b ? "platform" : "base");
+            for (int j = 0; j < 3; j++)
+                a[j] /= n;
+        }
+        if (any && !(b ? h->plat_max_deg : h->base_max_deg))
+            return kins_cfg_error(err, errlen, "KINS", akeys[b], "needs %s_JOINT_MAX_ANGLE "
+                                  "(the angle the joint turns from this axis)", b ? "PLATFORM"
+                                  : "BASE");
     }
     if (h->leg_clearance_mm > 0 && h->leg_diameter_mm == 0)
         return kins_cfg_error(err, errlen, "KINS", "LEG_CLEARANCE", "needs LEG_DIAMETER (the "
@@ -54,10 +93,6 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
     return KINS_OK;
 }
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 static double clamp01(double x)
 {
@@ -114,11 +149,14 @@ int hexapod_workspace(const struct hexapod *h, const double pose[KINS_POSE_DIM],
             FAIL("leg %d's platform joint would be %.3f mm below its base joint: that is the "
                  "mirror assembly, with the platform on the wrong side of the base, which the "
                  "machine cannot reach", i + 1, -lg->u[i][2] * lg->len_mm[i]);
-    /* the base joints' axes are the base normal (+Z); the platform joints' the platform
-     * normal, turned with the platform: cos(angle) = u·n */
-    double pz[3] = { o->r[0][2], o->r[1][2], o->r[2][2] };
+    /* the joints' mounting axes (by default the base normal +Z, and the platform normal
+     * turned with the platform): cos(angle) = u·a */
     for (int i = 0; i < HEXAPOD_LEGS && (h->base_max_deg > 0 || h->plat_max_deg > 0); i++) {
-        double cb = lg->u[i][2], cp = dot3(lg->u[i], pz);
+        const double *pa = h->plat_jaxis[i];
+        double pz[3];
+        for (int j = 0; j < 3; j++)
+            pz[j] = o->r[j][0] * pa[0] + o->r[j][1] * pa[1] + o->r[j][2] * pa[2];
+        double cb = dot3(lg->u[i], h->base_jaxis[i]), cp = dot3(lg->u[i], pz);
         if (cb < h->base_cos_max) {
             double a = acos(fmax(-1, fmin(1, cb))) * HEXAPOD_DEG_PER_RAD;
             FAIL("leg %d's base joint would turn %.2f deg from its axis, %.2f deg beyond [KINS] "

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "kins/hexapod.h"
 #include "kins/kins.h"
 #include "tests/test_kins_util.h"
 
@@ -454,6 +455,53 @@ START_TEST(test_workspace)
     double rates[6], vel[6] = { 0 };
     ck_assert_int_eq(kins_inverse_rates(k, tilt20, vel, legs, rates), KINS_ERR_WORKSPACE);
     kins_free(k);
+
+    /* mounting axes: base joints mounted along their legs at HOME turn 0 deg there, so a
+     * 5 deg limit that the base normal breaks by 22 deg holds; a move of 100 mm in X turns
+     * leg 1's by 7.58 deg (legs 3 and 4 by 7.81, by hand): the message names the first
+     * joint beyond the limit */
+    struct hexapod_legs_dir { double u[6][3]; } hd;
+    {
+        struct kins *k0 = make_kins(c);   /* the legs' directions at HOME, by hand */
+        const struct hexapod *h0 = (const struct hexapod *)k0;
+        for (int i = 0; i < 6; i++) {
+            double v[3], n = 0;
+            for (int j = 0; j < 3; j++)
+                v[j] = h0->p_mm[i][j] + home[j] - h0->b_mm[i][j], n += v[j] * v[j];
+            for (int j = 0; j < 3; j++)
+                hd.u[i][j] = v[j] / sqrt(n);
+        }
+        kins_free(k0);
+    }
+    tk_set(c, "KINS", "PLATFORM_JOINT_MAX_ANGLE", NULL);
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", "5");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "base joint would turn 27.23"));
+    for (int i = 0; i < 6; i++) {
+        char key[40], val[120];
+        snprintf(key, sizeof key, "BASE_JOINT_AXIS_%d", i);
+        snprintf(val, sizeof val, "%.12f %.12f %.12f", hd.u[i][0], hd.u[i][1], hd.u[i][2]);
+        tk_set(c, "KINS", key, val);
+    }
+    k = make_kins(c);
+    ck_assert_int_eq(kins_inverse(k, home, legs), KINS_OK);
+    const double x60[6] = { 100, 0, 645, 0, 0, 0 }, x10[6] = { 10, 0, 645, 0, 0, 0 };
+    ck_assert_int_eq(kins_inverse(k, x10, legs), KINS_OK);
+    ck_assert_int_eq(kins_inverse(k, x60, legs), KINS_ERR_WORKSPACE);
+    ck_assert_int_eq(kins_describe(k, x60, why, sizeof why), KINS_ERR_WORKSPACE);
+    ck_assert_msg(strstr(why, "leg 1's base joint would turn 7.58 deg from its axis, 2.58 deg "
+                         "beyond [KINS] BASE_JOINT_MAX_ANGLE = 5 deg"), "%s", why);
+    kins_free(k);
+    tk_set(c, "KINS", "BASE_JOINT_AXIS_2", "0 0 -1");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "[KINS] BASE_JOINT_AXIS_2: 0 0 "
+                                 "-1 points down"));
+    tk_set(c, "KINS", "BASE_JOINT_MAX_ANGLE", NULL);
+    tk_set(c, "KINS", "BASE_JOINT_AXIS_2", "0 0 1");
+    ck_assert_ptr_nonnull(strstr(create_err(c, err, sizeof err), "needs BASE_JOINT_MAX_ANGLE"));
+    for (int i = 0; i < 6; i++) {
+        char key[40];
+        snprintf(key, sizeof key, "BASE_JOINT_AXIS_%d", i);
+        tk_set(c, "KINS", key, NULL);
+    }
 
     /* leg clearance: at the level HOME, legs 1 and 2 come closest where they meet their
      * platform pair, 2 * 300 * sin(10 deg) = 104.189 mm apart */

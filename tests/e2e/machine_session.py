@@ -509,6 +509,11 @@ def homing_ini(tmp):
                         "HALFILE = " + os.path.join(SIM, "tmu-hexapod.hal") +
                         "\nHALFILE = homing.hal")
     text = text.replace("HALFILE = lcm-status.hal", "")
+    # the workspace beyond the legs: joint angles, leg clearance, a soft limit
+    text = text.replace("SINGULAR_CONDITION = 50\n", "SINGULAR_CONDITION = 50\n"
+                        "PLATFORM_JOINT_MAX_ANGLE = 45\nBASE_JOINT_MAX_ANGLE = 40\n"
+                        "LEG_DIAMETER = 40\nLEG_CLEARANCE = 5\n", 1)
+    text += "\n[AXIS_Z]\nMIN_LIMIT = 560\nMAX_LIMIT = 700\n"
     for i in range(6):
         text = text.replace("[JOINT_%d]\n" % i, "[JOINT_%d]\nHOME_SEARCH_VEL = 20\n"
                             "HOME_LATCH_VEL = -2\nHOME_OFFSET = 760\nHOME_SEQUENCE = %d\n"
@@ -665,6 +670,38 @@ def homing_session(tmp):
     c.ok("program.run")
     st = c.wait()
     check("a program runs after homing", st["motion"] == "done", (st["motion"], st["error"]))
+    # the workspace's limits by MDI, program and jog (homing.ini sets them): each refusal
+    # names the limit, the amount and the joint
+    c.ok("mdi.execute", line="G0 X0 Y0 Z645 A0 B0 C0")
+    c.wait()
+    r = c.call("mdi.execute", line="G0 B20")
+    check("MDI tilting B20: refused before motion where the move first passes a platform "
+          "joint's limit (B16.5, sampled every 0.5 deg; the edge is B16.22)",
+          err_code(r) == -32003 and "leg 1's platform joint would turn 45.33 deg from its "
+          "axis, 0.33 deg beyond [KINS] PLATFORM_JOINT_MAX_ANGLE = 45 deg, at X0.000 Y0.000 "
+          "Z645.000 A0.000 B16.500" in r["error"]["message"], r)
+    r = c.call("mdi.execute", line="G0 Z710")
+    check("MDI above [AXIS_Z] MAX_LIMIT: refused where the move first passes it, naming the "
+          "key and the amount", err_code(r) == -32003 and "Z701.000 is 1.000 mm above "
+          "[AXIS_Z] MAX_LIMIT = 700" in r["error"]["message"], r)
+    prog = os.path.join(tmp, "over.ngc")
+    open(prog, "w").write("G21 G90\nG0 X0 Y0 Z645\nG1 X300 F3000\nM2\n")
+    c.ok("program.open", path=prog)
+    r = c.call("program.run")
+    check("a program past a base joint's angle does not start: line 3 and the key named",
+          err_code(r) == -32003 and "over.ngc:3" in r["error"]["message"] and
+          "BASE_JOINT_MAX_ANGLE = 40 deg" in r["error"]["message"], r)
+    st = c.status()
+    check("... and nothing moved", max(abs(a - b) for a, b in zip(
+        st["machine_pose"]["commanded"], [0, 0, 645, 0, 0, 0])) < 1e-9, st["machine_pose"])
+    c.notes.clear()
+    c.ok("jog.move", frame="world", axis="B", velocity=5)
+    st = c.wait()
+    b = st["machine_pose"]["commanded"][4]
+    check("a continuous B jog stops short of the platform joints' edge (45 deg at B16.22)",
+          15.5 < b <= 16.22, b)
+    check("... and says which limit stopped it", any(
+        "PLATFORM_JOINT_MAX_ANGLE" in m for m in c.messages()), c.messages())
     stop(p, c)
 
 
