@@ -13,11 +13,11 @@ static const struct { int code, group; } g_table[] = {
     {580, 12}, {590, 12}, {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13},
     {730, 1},  {800, 1},  {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},
     {901, 4},  {910, 3},  {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},
-    {940, 5},  {980, 10}, {990, 10}, {1410, 0}, {1420, 0},
+    {940, 5},  {980, 10}, {990, 10}, {1410, 0}, {1420, 0}, {51, 1},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {50, 51, 52, 55, 61, 70, 80, 330, 331, 382, 383, 384, 385,
+static const int g_unsupported[] = {50, 52, 55, 61, 70, 80, 330, 331, 382, 383, 384, 385,
                                     411, 421, 520, 760, 840, 860, 870, 880, 950, 960, 970};
 
 /* Formats a code stored x10 as "92.1" or "1". */
@@ -168,7 +168,8 @@ static int word_used(const struct interp *in, char w)
     int arc = !comp && g0 < 0 && (m == 20 || m == 30);
     int cycle = !comp && g0 < 0 && is_cycle(m);
     switch (w) {
-    case 'i': case 'j': case 'k': return arc || g0 == 100;
+    case 'i': case 'j': return arc || g0 == 100 || (!comp && g0 < 0 && m == 51);
+    case 'k': return arc || g0 == 100;
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 ||
                      (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66);

@@ -522,6 +522,12 @@ static int exec_motion(struct interp *in)
         CHP(interp_need_feed(in, m == 20 ? "G2" : "G3"));
         return interp_arc(in, m);
     }
+    if (m == 51) {
+        if (!axis && !W('i') && !W('j'))
+            return 0;
+        CHP(interp_need_feed(in, "G5.1"));
+        return interp_spline(in);
+    }
     if (m >= 0 && axis)
         return interp_cycle(in, m);
     return 0;

@@ -219,6 +219,9 @@ struct interp {
 void interp_modal_save(const struct interp *in, struct modal_save *m);
 int interp_modal_restore(struct interp *in, const struct modal_save *m);
 
+/* spline.c: G5.1 (quadratic B-spline) as straight feeds. */
+int interp_spline(struct interp *in);
+
 /* The canon sink G141/G142 emit through (exec.c): stamps the tool centre point state. */
 int interp_comp_sink(void *ctx, const struct canon_cmd *cmd);
 

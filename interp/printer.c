@@ -261,6 +261,13 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
         put_offsets(p, &v, 0);
         return p->failed ? -1 : 0;
     }
+    if (c->type == CANON_FEED && c->spline) {   /* rs274 prints a spline as one line */
+        if (c->spline == 1) {
+            line_start(p, c);
+            puts_(p, "NURBS_FEED(3, ...)\n");
+        }
+        return p->failed ? -1 : 0;
+    }
     line_start(p, c);
     if (c->type == CANON_TRAVERSE || c->type == CANON_FEED) {
         double e[6];

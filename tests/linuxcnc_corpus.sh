@@ -9,14 +9,28 @@
 # where rs274 or the programs are not installed.
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
-MIN_ACCEPTED=156     # of the programs rs274 accepts (measured: 156 of 169)
-MIN_IDENTICAL=155    # of those, motion identical to rs274's (measured: 155)
-if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ]; then
+MIN_ACCEPTED=162     # of the programs rs274 accepts (measured: 162 of 169)
+MIN_IDENTICAL=161    # of those, motion identical to rs274's (measured: 161)
+if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ] ||
+   [ ! -f /usr/share/doc/linuxcnc/examples/sample-configs/sim/sim.tbl ]; then
     echo "SKIP linuxcnc_corpus: rs274 or LinuxCNC's programs are not installed (linuxcnc-uspace)"
     exit 0
 fi
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
+# Both run with LinuxCNC's sim tool table, as a machinist runs programs with the machine's
+# table: rs274 alone reads a table in inches (its machine units), hexcnc in mm, so hexcnc
+# gets the same tools with every length (X Y Z U V W D) times 25.4
+tbl=/usr/share/doc/linuxcnc/examples/sample-configs/sim/sim.tbl
+awk '{ out = ""
+       for (i = 1; i <= NF; i++) {
+           t = $i
+           if (t ~ /^;/) { for (j = i; j <= NF; j++) out = out " " $j; break }
+           c = substr(t, 1, 1)
+           if (c ~ /[XYZUVWDxyzuvwd]/) t = sprintf("%s%.6f", c, substr(t, 2) * 25.4)
+           out = out " " t
+       }
+       print substr(out, 2) }' "$tbl" > "$tmp/tools_mm.tbl"
 # A zero rs274 prints with a minus sign (-0.0000: a value of about -1e-16 after a rounding
 # that differs in the last bit) is the zero it is.
 motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL' | cut -c7- |
@@ -28,9 +42,9 @@ total=0; reference=0; accepted=0; identical=0
 while IFS= read -r f; do
     total=$((total + 1))
     d=$(dirname "$f"); b=$(basename "$f")
-    (cd "$d" && timeout 20 rs274 -g "$b" < /dev/null > "$tmp/rs.out" 2> /dev/null) || continue
+    (cd "$d" && timeout 20 rs274 -t "$tbl" -g "$b" < /dev/null > "$tmp/rs.out" 2> /dev/null) || continue
     reference=$((reference + 1))
-    if ! (cd "$d" && timeout 20 "$bin" interp "$b" < /dev/null > "$tmp/hx.out" 2> "$tmp/hx.err")
+    if ! (cd "$d" && timeout 20 "$bin" interp -t "$tmp/tools_mm.tbl" "$b" < /dev/null > "$tmp/hx.out" 2> "$tmp/hx.err")
     then
         msg=$(head -1 "$tmp/hx.err" | sed -E 's/^[^:]*:[0-9]+(:[0-9]+)?: (error: )?//' | cut -c1-90)
         printf '%s\t%s\n' "$msg" "$f" >> "$tmp/refused"

@@ -257,6 +257,59 @@ START_TEST(g141_hand_off)
 }
 END_TEST
 
+/* G5.1 from (0, 0) through the pull of (5, 5) to (10, 0): the parabola y = x (10 - x) / 10,
+ * top (5, 2.5). Every chord end lies on it, the chords stay within 0.1 um of it, the last
+ * ends exactly on the end point; under G93 the chords share the block's time; the errors
+ * are LinuxCNC's. */
+START_TEST(g5_1_quadratic_spline)
+{
+    struct canon_prog p;
+    struct interp_error err;
+    ck_assert_int_eq(run_text("G21 G17 G90\nG0 X0 Y0 Z1\nG5.1 X10 Y0 I5 J5 F100\nM2\n", &p,
+                              &err), INTERP_OK);
+    int n = count_type(&p, CANON_FEED);
+    /* |P0 - 2 P1 + P2| = 10: chords over dt leave it by 10 dt^2 / 4 <= 1e-4: 159 of them */
+    ck_assert_int_eq(n, 159);
+    double prev[2] = { 0, 0 }, worst = 0, top = 0;
+    for (int k = 0; k < n; k++) {
+        const struct canon_cmd *c = nth(&p, CANON_FEED, k);
+        ck_assert_int_eq(c->spline, k == 0 ? 1 : 2);
+        ck_assert_int_eq(c->line, 3);
+        double x = c->end[0], y = c->end[1];
+        ck_assert_double_eq_tol(y, x * (10 - x) / 10, 1e-12);
+        ck_assert(c->end[2] == 1);
+        /* the parabola's farthest point from the chord: where its slope is the chord's */
+        double xm = 0.5 * (prev[0] + x), ym = xm * (10 - xm) / 10;
+        double cy = prev[1] + (y - prev[1]) * (xm - prev[0]) / (x - prev[0]);
+        worst = fmax(worst, fabs(ym - cy));
+        top = fmax(top, y);
+        prev[0] = x, prev[1] = y;
+    }
+    ck_assert(worst <= 1e-4 && worst > 0.5e-4);
+    ck_assert_double_eq_tol(top, 2.5, 1e-3);
+    ck_assert(last_move(&p)->end[0] == 10 && last_move(&p)->end[1] == 0);
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_text("G21 G17\nG0 X0 Y0\nG93 G5.1 X10 Y0 I5 J5 F2\nM2\n", &p, &err),
+                     INTERP_OK);
+    double total = 0;
+    for (int k = 0; k < count_type(&p, CANON_FEED); k++)
+        total += nth(&p, CANON_FEED, k)->inverse_time_min;
+    ck_assert_double_eq_tol(total, 0.5, 1e-12);   /* F2 under G93: the block in 1/2 min */
+    canon_prog_free(&p);
+    static const struct { const char *prog, *msg; } bad[] = {
+        { "G21 G17\nG0 X0 Y0\nG5.1 X10 Y0 I5 F100\nM2\n", "G5.1 needs both I and J" },
+        { "G21 G18\nG0 X0 Y0\nG5.1 X10 Y0 I5 J5 F100\nM2\n", "XY plane (G17)" },
+        { "G21 G17\nG0 X0 Y0\nG5.1 X10 Y0 Z3 I5 J5 F100\nM2\n", "may not move Z, A, B or C" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ck_assert_int_ne(run_text(bad[i].prog, &p, &err), INTERP_OK);
+        ck_assert_int_eq(err.line, 3);
+        ck_assert_msg(strstr(err.message, bad[i].msg), "%s", err.message);
+        canon_prog_free(&p);
+    }
+}
+END_TEST
+
 static Suite *motion_suite(void)
 {
     Suite *s = suite_create("interp_motion");
@@ -271,6 +324,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, tool_length);
     tcase_add_test(tc, machine_words);
     tcase_add_test(tc, g141_hand_off);
+    tcase_add_test(tc, g5_1_quadratic_spline);
     suite_add_tcase(s, tc);
     return s;
 }

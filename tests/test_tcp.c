@@ -403,19 +403,26 @@ START_TEST(test_tip_bound_binds)
 END_TEST
 
 /* The same tip positions at the ends of every move, but the moves interpolated as platform
- * poses (G49): check reports the tip's swing by line. For the pivot about the tip by A15
- * (line 6), with the tip 300 mm below the platform, the tip swings |d| (1 - cos 7.5 deg) =
- * 2.5667 mm off its point at mid-move. Under G43.4 the same program has no problem. */
+ * poses (G49): check warns of the tip's swing by line. Turning by th about the tip, a tip
+ * at distance r from the axis of the turn swings r (1 - cos th/2) off its point at
+ * mid-move: on the spindle machine A15 (line 6) with the tip 300 mm below the platform,
+ * 2.5665 mm; on the TMU B8 (line 6) about the tip at X10 Z80 on the table, r = sqrt(10^2 +
+ * 80^2), 0.1964 mm. Under G43.4 the same programs have no warning. */
+static const struct { const char *ini, *prog; double r_mm, turn_deg; } swings[] = {
+    { SPINDLE_INI, "examples/tcp/pivot.ngc", 300, 15 },
+    { TMU_INI, "examples/tcp/tmu-pivot.ngc", 80.62257748, 8 },
+};
+
 START_TEST(test_check_reports_swing)
 {
-    struct check_machine *mc = open_machine(SPINDLE_INI);
+    struct check_machine *mc = open_machine(swings[_i].ini);
     struct kins_tool_frame f = frame_of(mc);
     char pp[1024], text[4096], *w = text;
     struct canon_prog p;
     struct check_problem pb;
     canon_prog_init(&p);
-    ck_assert(check_machine_interpret(mc, tc_path("examples/tcp/pivot.ngc", pp, sizeof pp),
-                                      &p, &pb) == CHECK_OK);
+    ck_assert(check_machine_interpret(mc, tc_path(swings[_i].prog, pp, sizeof pp), &p, &pb) ==
+              CHECK_OK);
     /* line by line, the platform poses of the programmed tips: lines 1..4 as in the file */
     w += sprintf(w, "(platform poses)\n(of the tips)\nG21 G90 G94 G61\nG49\n");
     for (size_t i = 0; i < p.count; i++) {
@@ -424,7 +431,7 @@ START_TEST(test_check_reports_swing)
             continue;
         double q[6];
         kins_tcp_to_pose(&f, c->tool_len_mm, c->end, q);
-        w += sprintf(w, "G%d X%.9f Y%.9f Z%.9f A%.9f B%.9f C%.9f F1200\n",
+        w += sprintf(w, "G%d X%.9f Y%.9f Z%.9f A%.9f B%.9f C%.9f F600\n",
                      c->type == CANON_TRAVERSE ? 0 : 1, q[0], q[1], q[2], q[3], q[4], q[5]);
     }
     w += sprintf(w, "M2\n");
@@ -440,26 +447,28 @@ START_TEST(test_check_reports_swing)
     ck_assert_int_eq(check_program(mc, path, NULL, &r), CHECK_OK);   /* warnings only */
     unlink(path);
     int found = 0;
+    double seen = 0;
     ck_assert_uint_eq(r.nproblems, 0);
     ck_assert_uint_gt(r.nwarnings, 0);
     for (size_t i = 0; i < r.nwarnings; i++) {
         const struct check_problem *q = &r.warnings[i];
         ck_assert_int_eq(q->kind, CHECK_TIP_DEVIATION);
         if (q->line == 6) {
-            double want = 300 * (1 - cos(7.5 * M_PI / 180));
-            printf("without G43.4, line 6 (A15 about the tip): the tip swings %.4f mm "
-                   "(by hand %.4f mm)\n", q->value, want);
+            double want = swings[_i].r_mm * (1 - cos(swings[_i].turn_deg / 2 * M_PI / 180));
+            printf("%s without G43.4, line 6 (%g deg about the tip): the tip swings %.4f mm "
+                   "(by hand %.4f mm)\n", swings[_i].prog, swings[_i].turn_deg, q->value, want);
             ck_assert_msg(fabs(q->value - want) < 0.01 * want, "%.6f vs %.6f", q->value, want);
             ck_assert(strstr(q->message, "G43.4"));
             found = 1;
+            seen = q->value;
         }
     }
     ck_assert(found);
-    ck_assert(r.max_tip_deviation_mm >= 2.5);
+    ck_assert(r.max_tip_deviation_mm >= seen);   /* the figure covers the warned line */
     check_result_free(&r);
     check_result_init(&r);
-    ck_assert_int_eq(check_program(mc, tc_path("examples/tcp/pivot.ngc", pp, sizeof pp), NULL,
-                                   &r), CHECK_OK);
+    ck_assert_int_eq(check_program(mc, tc_path(swings[_i].prog, pp, sizeof pp), NULL, &r),
+                     CHECK_OK);
     ck_assert(r.tip_measured && r.max_tip_deviation_mm <= r.kin_tol_mm);
     ck_assert_uint_eq(r.nwarnings, 0);
     check_result_free(&r);
@@ -479,7 +488,7 @@ static Suite *tcp_suite(void)
     tcase_add_test(tc, test_interp_errors);
     tcase_add_loop_test(tc, test_tip_on_path, 0, 4);
     tcase_add_test(tc, test_tip_bound_binds);
-    tcase_add_test(tc, test_check_reports_swing);
+    tcase_add_loop_test(tc, test_check_reports_swing, 0, 2);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -52,5 +52,17 @@ check "... naming line 3, the amount and the key" has "$tmp/out" \
 printf 'MAX_LIMITS = 660\n' >> "$tmp/soft.ini"
 "$bin" check "$tmp/soft.ini" "$tmp/high.ngc" > "$tmp/out" 2>&1
 check "a misspelt soft limit is an error naming it" has "$tmp/out" 'AXIS_Z\] MAX_LIMITS: unknown key'
+# leg clearance: legs 95 mm thick kept 5 mm apart; turning A passes legs 3 and 4 closer
+cp "$root/configs/sim/tmu-hexapod.ini" "$tmp/legs.ini"
+sed -i 's/^SINGULAR_CONDITION = 50$/SINGULAR_CONDITION = 50\nLEG_DIAMETER = 95\nLEG_CLEARANCE = 5/' "$tmp/legs.ini"
+printf 'G21 G90\nG0 X0 Y0 Z645\nG1 A30 F600\nG1 A45\nM2\n' > "$tmp/roll.ngc"
+"$bin" check "$tmp/legs.ini" "$tmp/roll.ngc" > "$tmp/out" 2>&1
+check "check refuses a roll that brings two legs closer than LEG_DIAMETER + LEG_CLEARANCE" \
+    [ $? -eq 1 ]
+check "... naming line 4, the legs, the distance and the keys" has "$tmp/out" \
+    "roll.ngc:4: .*legs 3 and 4 would pass .* mm apart (axis to axis), .* mm closer than \[KINS\] LEG_DIAMETER 95 mm + LEG_CLEARANCE 5 mm"
+"$bin" kins "$tmp/legs.ini" workspace > "$tmp/ws" 2>&1
+check "workspace: +A limited by legs 3 and 4's clearance at 43.19 deg" has "$tmp/ws" \
+    "^+A       43.19 deg  legs 3 and 4 would pass 100.00 mm apart"
 echo "workspace_cli: $fails failed"
 [ "$fails" -eq 0 ]
