@@ -13,12 +13,21 @@ static const struct { int code, group; } g_table[] = {
     {580, 12}, {590, 12}, {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13},
     {730, 1},  {800, 1},  {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},
     {901, 4},  {910, 3},  {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},
-    {940, 5},  {980, 10}, {990, 10}, {1410, 0}, {1420, 0}, {51, 1},
+    {940, 5},  {980, 10}, {990, 10}, {1410, 0}, {1420, 0}, {51, 1},  {520, 0},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {50, 52, 55, 61, 70, 80, 330, 331, 382, 383, 384, 385,
-                                    411, 421, 520, 760, 840, 860, 870, 880, 950, 960, 970};
+static const int g_unsupported[] = {50, 52, 55, 61, 331, 382, 383, 384, 385, 411, 421, 840,
+                                    860, 870, 880, 950};
+
+/* LinuxCNC's lathe codes: refused as such, not as unknown or "not yet". */
+static const struct { int code; const char *what; } g_lathe[] = {
+    {70, "lathe diameter mode"}, {80, "lathe radius mode"}, {330, "spindle-synchronised "
+    "threading"}, {700, "a lathe finishing cycle"}, {710, "a lathe roughing cycle"},
+    {711, "a lathe roughing cycle"}, {720, "a lathe roughing cycle"}, {721, "a lathe roughing "
+    "cycle"}, {760, "lathe threading"}, {960, "constant surface speed"}, {970, "the end of "
+    "constant surface speed (G96)"},
+};
 
 /* Formats a code stored x10 as "92.1" or "1". */
 static const char *code_str(int c10, char *buf)
@@ -58,6 +67,11 @@ int interp_add_g(struct interp *in, double v, int column)
         b->gcol[grp] = column;
         return 0;
     }
+    for (size_t i = 0; i < sizeof g_lathe / sizeof g_lathe[0]; i++)
+        if (g_lathe[i].code == c)
+            return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "G%s is %s, a lathe code: a "
+                               "hexapod has no turning spindle axis to run it", code_str(c, s),
+                               g_lathe[i].what);
     for (size_t i = 0; i < sizeof g_unsupported / sizeof g_unsupported[0]; i++)
         if (g_unsupported[i] == c)
             return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "G%s is not supported yet",
@@ -130,8 +144,8 @@ static int check_axis_users(struct interp *in)
 {
     struct interp_block *b = &in->blk;
     int g0 = b->g[0], g1 = b->g[1];
-    int g0_axes = g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 1410 || g0 == 1420 ||
-                  b->g[8] == 431;
+    int g0_axes = g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 ||
+                  g0 == 1410 || g0 == 1420 || b->g[8] == 431;
     char s[32], s2[32];
     if (g0 == 1410 || g0 == 1420) {
         if (g1 >= 0 && g1 != 10)

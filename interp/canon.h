@@ -114,6 +114,10 @@ struct canon_prog {
     double start[6];       /* pose the program starts from */
     int start_tcp;         /* start is the tool tip under G43.4 with this tool length (a */
     double start_tool_len_mm; /* streamed window's start); 0: the platform's pose */
+    int start_path_mode;   /* the path mode before the first command: 0 LinuxCNC's default
+                            * (G64 with [TRAJ] BLEND_TOLERANCE), 610 exact stop, 640 G64 with
+                            * start_path_tol_mm (an MDI line under its interpreter's mode) */
+    double start_path_tol_mm;
 };
 void canon_prog_init(struct canon_prog *p);
 void canon_prog_free(struct canon_prog *p);

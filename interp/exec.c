@@ -503,7 +503,7 @@ static int exec_motion(struct interp *in)
         if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
             in->cycle_mode = in->cycle_il_on = 0;
     }
-    if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || b->g[8] == 431)
+    if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 || b->g[8] == 431)
         return 0; /* those blocks' axis words are not motion */
     int m = in->motion;
     int axis = W('x') || W('y') || W('z') || W('a') || W('b') || W('c');
@@ -613,7 +613,7 @@ int interp_execute(struct interp *in)
         CHP(interp_g10(in));
     else if (g0 == 280 || g0 == 281 || g0 == 300 || g0 == 301)
         CHP(interp_home(in, g0));
-    else if (g0 >= 920 && g0 <= 923)
+    else if ((g0 >= 920 && g0 <= 923) || g0 == 520)
         CHP(interp_g92(in, g0));
     if (comp && b->g[1] >= 0)
         in->motion = b->g[1]; /* G1 beside G141/G142 is modal as usual */

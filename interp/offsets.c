@@ -39,6 +39,36 @@ static int g10_l1(struct interp *in, int p)
     return interp_emit_tool_setting(in, p >= TOOLTABLE_WEAR_BASE ? p - TOOLTABLE_WEAR_BASE : p);
 }
 
+/* G10 L10 / L11 P R Z: tool P's length such that, with it in force, the current point reads
+ * Z in the current coordinate system (L10: its work offset and G92) or in G59.3's (L11:
+ * that fixture's offset alone), as LinuxCNC sets it; R its radius. The table keeps a mill
+ * tool's length and diameter only, so other axis words are refused. */
+static int g10_l10(struct interp *in, int l, int p)
+{
+    if (!in->tt)
+        return interp_fail(in, INTERP_ERR_TOOL, in->blk.gcol[0], "G10 L%d needs a tool table "
+                           "(give one with -t or [EMCIO] TOOL_TABLE)", l);
+    static const char others[] = "xyabc";
+    for (int k = 0; k < 5; k++)
+        if (W(others[k]))
+            return interp_fail(in, INTERP_ERR_WORD, W(others[k]), "G10 L%d: a tool here has a "
+                               "length (Z) and a radius (R) only, no %c offset", l,
+                               others[k] - 'a' + 'A');
+    if (in->tcp_on)
+        return interp_fail(in, INTERP_ERR_MODAL, in->blk.gcol[0], "G10 L%d under G43.4: the "
+                           "position is the tool tip there; measure the tool with G49", l);
+    double z = 0;
+    if (W('z'))
+        z = l == 10 ? in->pos[AX_Z] - in->g5x[AX_Z] - in->g92[AX_Z] - axis_mm(in, AX_Z)
+                    : in->pos[AX_Z] - in->params[PARAM_G54 + 20 * 8 + AX_Z] - axis_mm(in, AX_Z);
+    int rc = tooltable_g10_l1(in->tt, p, W('r') != 0, interp_len_mm(in, V('r')), W('z') != 0,
+                              z);
+    if (rc)
+        return interp_fail(in, INTERP_ERR_TOOL, W('p'), "G10 L%d P%d: %s", l, p,
+                           tooltable_strerror(rc));
+    return interp_emit_tool_setting(in, p >= TOOLTABLE_WEAR_BASE ? p - TOOLTABLE_WEAR_BASE : p);
+}
+
 /* G10 L2 / L20 P: a work offset set directly, or so that the current point reads as given. */
 static int g10_coord(struct interp *in, int l, int p)
 {
@@ -78,8 +108,10 @@ int interp_g10(struct interp *in)
         return g10_l1(in, p);
     if (l == 2 || l == 20)
         return g10_coord(in, l, p);
-    return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('l'), "G10 L%d is not supported (L1, L2 "
-                       "and L20 are)", l);
+    if (l == 10 || l == 11)
+        return g10_l10(in, l, p);
+    return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('l'), "G10 L%d is not supported (L1, L2, "
+                       "L10, L11 and L20 are)", l);
 }
 
 /* G28/G30: rapid through the point given (if any) to the stored home; .1 stores the home. */
@@ -117,6 +149,13 @@ int interp_g92(struct interp *in, int g)
                 continue;
             in->g92[i] = in->pos[i] - in->g5x[i] - in->tool[i] - axis_mm(in, i);
         }
+        for (int i = 0; i < 6; i++)
+            in->params[PARAM_G92 + i] = in->g92[i];
+        in->params[PARAM_G92_ON] = 1;
+    } else if (g == 520) {   /* G52: a local offset, kept in G92's registers (LinuxCNC) */
+        for (int i = 0; i < 6; i++)
+            if (W(axis_letter[i]))
+                in->g92[i] = axis_mm(in, i);
         for (int i = 0; i < 6; i++)
             in->params[PARAM_G92 + i] = in->g92[i];
         in->params[PARAM_G92_ON] = 1;

@@ -68,6 +68,14 @@ double motion_blend_tolerance(const struct motion_config *c, const struct canon_
     return pm->ivalue == 640 ? c->blend_tol_mm : 0;
 }
 
+double motion_blend_start(const struct motion_config *c, const struct canon_prog *p)
+{
+    if (p->start_path_mode == 610 || p->start_path_mode == 611)
+        return 0;
+    return p->start_path_mode == 640 && p->start_path_tol_mm > 0 ? p->start_path_tol_mm
+                                                                  : c->blend_tol_mm;
+}
+
 /* Commands that may sit between two moves without stopping the blend between them (they
  * change nothing on the path: the next move carries its own feed). */
 static int transparent(enum canon_type t)
@@ -81,7 +89,8 @@ static int transparent(enum canon_type t)
 static void scan(const struct motion_config *cfg, const struct canon_prog *in,
                  struct blend_rec *rec)
 {
-    double at[6], tol = 0, at_len = in->start_tcp ? in->start_tool_len_mm : 0;
+    double at[6], tol = motion_blend_start(cfg, in);
+    double at_len = in->start_tcp ? in->start_tool_len_mm : 0;
     int at_tcp = in->start_tcp;
     memcpy(at, in->start, sizeof at);
     for (size_t i = 0; i < in->count; i++) {
@@ -201,6 +210,8 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
 {
     memcpy(out->start, in->start, sizeof out->start);
     out->start_tcp = in->start_tcp;
+    out->start_path_mode = in->start_path_mode;
+    out->start_path_tol_mm = in->start_path_tol_mm;
     out->start_tool_len_mm = in->start_tool_len_mm;
     for (size_t i = 0; i < in->count; i++) {
         struct canon_cmd c = in->cmds[i];

@@ -47,6 +47,9 @@ int motion_blend_corner(const double d1[3], const double d2[3], double len1_mm, 
 /* The G64 tolerance a PATH_MODE command sets: its P (value), BLEND_TOLERANCE for G64 without
  * P (ivalue 640), 0 (no blending) for G61 and G61.1. */
 double motion_blend_tolerance(const struct motion_config *c, const struct canon_cmd *pm);
+/* The G64 tolerance in force before a program's first command (canon_prog's start_path_mode:
+ * by default G64 with [TRAJ] BLEND_TOLERANCE, as LinuxCNC starts in G64). */
+double motion_blend_start(const struct motion_config *c, const struct canon_prog *p);
 
 /* How A B C turn along a blend arc: the rates of the two lines at its ends, so that the
  * orientation follows a cubic in the arc's angle whose rate joins both lines' without a step

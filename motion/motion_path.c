@@ -402,7 +402,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
 {
     struct motion_plan *p = &m->plan;
     double at[KINS_POSE_DIM];
-    double blend = 0;          /* G61 exact stop until the program says G64 */
+    double blend = motion_blend_start(&m->cfg, prog); /* LinuxCNC's G64 unless told */
     int sp_dir = m->io.dir;    /* the spindle as the program leaves it so far */
     double sp_rpm = m->io.rpm;
     memcpy(at, prog->start, sizeof at);

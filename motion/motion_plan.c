@@ -135,6 +135,12 @@ static int all_caps(struct motion *m, double *gain, double *zcap, char *err, siz
         apply_chord_caps(p, sg, zcap);
         double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, &prev_end, &first) : 0;
         size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
+        /* a joint passed no faster than full acceleration reaches in STOP_EQUIV_PERIODS
+         * servo periods (a sharp corner) is a stop in all but name, while the jump would
+         * take a share of the moves' acceleration on both sides: stop there instead */
+        if (vin > 0 && j > 0 && vin < STOP_EQUIV_PERIODS * m->cfg.servo_period_s *
+                                      fmin(p->iacc[sg->k0], p->iacc[pk]))
+            vin = 0;
         p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
         if (j > 0)
             p->kv[pk] = fmin(p->kv[pk], vin);

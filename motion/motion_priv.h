@@ -309,6 +309,10 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
 
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */
 #define JUMP_SHARE 0.5
+/* A joint that could be passed only as fast as full acceleration reaches in this many servo
+ * periods is planned as a stop (motion_plan.c): the moves beside it keep their whole
+ * acceleration instead of sharing it with a jump that saves next to no time. */
+#define STOP_EQUIV_PERIODS 2.0
 
 /* One path sample through the kinematics: pose, its s-derivative, legs and their
  * first and second s-derivatives. */

@@ -81,6 +81,7 @@ int motion_stream_create(struct motion *m, const double start[KINS_POSE_DIM],
     memcpy(s->start, start, sizeof s->start);
     memcpy(s->start0, start, sizeof s->start0);
     const struct motion_config *c = &m->cfg;
+    s->tol_mm = c->blend_tol_mm;    /* a program starts in G64 (LinuxCNC's default) */
     double acc = c->max_lin_acc_mm_s2;
     for (int j = 0; j < m->nj; j++)
         acc = fmin(acc, c->joint[j].max_acc_mm_s2);

@@ -40,6 +40,10 @@ int session_mdi(struct session *s, const char *line, char *err, size_t len)
     motion_hal_pose(s->hal, pose);
     interp_set_start(s->mdi, pose);
     memcpy(prog.start, pose, sizeof pose);
+    struct interp_view v0;           /* the line starts in the path mode MDI left */
+    interp_get_view(s->mdi, &v0);
+    prog.start_path_mode = v0.path_mode == 640 ? 640 : 610;
+    prog.start_path_tol_mm = v0.path_tol_mm;
     if (interp_run_text(s->mdi, "MDI", line, strlen(line), canon_prog_sink, &prog) !=
         INTERP_OK) {
         char msg[600];

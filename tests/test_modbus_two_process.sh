@@ -41,7 +41,7 @@ done
 if ! cmp -s "$tmp/ext.cmp" "$tmp/inproc.cmp"; then
     echo "two processes vs in-process:"; diff "$tmp/ext.cmp" "$tmp/inproc.cmp"; fail=1
 fi
-grep -q "0.0031 mm from the commanded end" "$tmp/ext.out" ||
+grep -q "0.0066 mm from the commanded end" "$tmp/ext.out" ||
     { echo "end point:"; cat "$tmp/ext.out"; fail=1; }
 
 # One connection per drive for the whole program, one exchange every 4 ms of its 4.97 s.

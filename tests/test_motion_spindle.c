@@ -35,6 +35,7 @@ static void add_simple(struct canon_prog *p, enum canon_type t, int line, double
 static void spindle_program(struct canon_prog *p)
 {
     canon_prog_init(p);
+    p->start_path_mode = 610;        /* exact stops: the commands lie at rest points */
     memcpy(p->start, P0, sizeof P0);
     add_simple(p, CANON_SPINDLE_SPEED, 1, 1000, 0);
     add_simple(p, CANON_SPINDLE_ON, 1, 1, 0);
@@ -60,6 +61,7 @@ START_TEST(test_commands_where_the_path_reaches_them)
     struct canon_prog p, bare;
     spindle_program(&p);
     canon_prog_init(&bare);
+    bare.start_path_mode = 610;
     memcpy(bare.start, P0, sizeof P0);
     tm_add(&bare, CANON_FEED, 2, P1, 1200, 0);
     tm_add(&bare, CANON_FEED, 4, P2, 1200, 0);

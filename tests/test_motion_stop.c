@@ -29,11 +29,12 @@ static void open_machine(struct tm_machine *mc, double sp_s, double lin_acc_mm_s
 
 /* A program from the origin through pts[0..n-1]: G0 for the first move when rapid_first,
  * G1 at feed_mm_min otherwise; a dwell of dwell_s (> 0) or an M0 (dwell_s < 0) after the
- * first move. G61 (the default). */
+ * first move. G61 (stated: a program that says nothing runs in G64). */
 static void prog(struct canon_prog *p, const double (*pts)[6], int n, double feed_mm_min,
                  int rapid_first, double dwell_s)
 {
     canon_prog_init(p);
+    p->start_path_mode = 610;
     for (int i = 0; i < n; i++) {
         tm_add(p, i == 0 && rapid_first ? CANON_TRAVERSE : CANON_FEED, 10 + i, pts[i],
                feed_mm_min, 0);

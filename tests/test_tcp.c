@@ -330,6 +330,81 @@ START_TEST(test_tip_on_path)
 }
 END_TEST
 
+/* An arc under G43.4: the tip on the circle (centre c, radius r, in the plane z = c[2],
+ * normal Z) while the tool tilts along it. Forward kinematics of the legs interpolated
+ * between set points, as above, while the program is on the arc's line; returns the
+ * largest distance from the circle, mm. */
+static double tip_arc_deviation(const char *ini, const char *text, int arc_line,
+                                const double c[3], double r, double *tol_mm)
+{
+    struct check_machine *mc = open_machine(ini);
+    struct kins *k = check_machine_kins(mc);
+    struct motion *m = check_machine_motion(mc);
+    struct kins_tool_frame f = frame_of(mc);
+    *tol_mm = check_machine_motion_config(mc)->kin_tol_mm;
+    struct canon_prog p;
+    interpret(mc, text, &p);
+    double len = 0;
+    for (size_t i = 0; i < p.count; i++)
+        if (p.cmds[i].type == CANON_ARC) {
+            ck_assert_int_eq(p.cmds[i].tcp, 1);
+            len = p.cmds[i].tool_len_mm;
+        }
+    char err[512] = "";
+    ck_assert_msg(motion_load(m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(m), MOTION_OK);
+    double T = check_machine_motion_config(mc)->servo_period_s, worst = 0;
+    struct motion_out a, b;
+    long samples = 0;
+    motion_step(m, T, &a);
+    for (long step = 0; step < 10000000 && a.state != MOTION_DONE; step++) {
+        motion_step(m, T, &b);
+        ck_assert(b.state != MOTION_FAULT);
+        if (a.line == arc_line && b.line == arc_line) {
+            double guess[6];
+            memcpy(guess, a.pose, sizeof guess);
+            for (int j = 1; j < 10; j++) {
+                double L[KINS_MAX_JOINTS], P[6], tip[6];
+                for (int i = 0; i < 6; i++)
+                    L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+                memcpy(P, guess, sizeof P);
+                ck_assert_int_eq(kins_forward(k, L, P, NULL), KINS_OK);
+                memcpy(guess, P, sizeof guess);
+                kins_tcp_from_pose(&f, len, P, tip);
+                double rho = hypot(tip[0] - c[0], tip[1] - c[1]);
+                worst = fmax(worst, hypot(rho - r, tip[2] - c[2]));
+                samples++;
+            }
+        }
+        a = b;
+    }
+    ck_assert_int_eq(a.state, MOTION_DONE);
+    ck_assert(samples > 1000);
+    canon_prog_free(&p);
+    check_machine_close(mc);
+    return worst;
+}
+
+START_TEST(test_tip_on_arc)
+{
+    double tol;
+    /* spindle machine: a half circle of radius 30 about X0 Y0 at Z700, the tool tilting
+     * A0 -> A10 and C0 -> C20 along it */
+    static const double c1[3] = { 0, 0, 700 };
+    double d1 = tip_arc_deviation(SPINDLE_INI, "G21 G90 G17\nG43.4 H1\nG0 X30 Y0 Z700\n"
+                                  "G3 X-30 Y0 I-30 J0 A10 C20 F1200\nM2\n", 4, c1, 30, &tol);
+    /* the TMU: a full circle of radius 20 about X5 Y5 on the table at Z80, the table
+     * tilting B0 -> B6 */
+    static const double c2[3] = { 5, 5, 80 };
+    double d2 = tip_arc_deviation(TMU_INI, "G21 G90 G17\nG43.4 H1\nG1 X25 Y5 Z80 F600\n"
+                                  "G2 X25 Y5 I-20 J0 B6 F600\nM2\n", 4, c2, 20, &tol);
+    printf("arcs under G43.4: the tip stays within %.3g um (spindle machine) and %.3g um "
+           "(TMU) of the programmed circle (tolerance %.3g um)\n", d1 * 1e3, d2 * 1e3,
+           tol * 1e3);
+    ck_assert_msg(d1 <= tol && d2 <= tol, "%.6f %.6f mm", d1, d2);
+}
+END_TEST
+
 /* The bound binds: drives that take a set point every 10 ms, a machine five times faster
  * and the chamfer at 500 mm/s. The tip stays within KINEMATIC_TOLERANCE; with the bound
  * off (KINEMATIC_TOLERANCE = 0) the same moves leave it by more, so the measure can fail. */
@@ -487,6 +562,7 @@ static Suite *tcp_suite(void)
     tcase_add_test(tc, test_interp_program_point_and_length);
     tcase_add_test(tc, test_interp_errors);
     tcase_add_loop_test(tc, test_tip_on_path, 0, 4);
+    tcase_add_test(tc, test_tip_on_arc);
     tcase_add_test(tc, test_tip_bound_binds);
     tcase_add_loop_test(tc, test_check_reports_swing, 0, 2);
     suite_add_tcase(s, tc);
