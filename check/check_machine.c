@@ -193,6 +193,7 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
     }
     interp_set_start(in, mc->kins->home);
     interp_use_kins(in, mc->kins);       /* G43.4 and [KINS] PROGRAM_POINT */
+    interp_set_ini(in, hal_ini_lookup, mc->hal);   /* #<_ini[..]..> */
     memcpy(prog->start, mc->kins->home, sizeof prog->start);
     mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
     /* the runner's settings, but the machine's parameter file is never written */

@@ -114,6 +114,18 @@ void interp_set_start(struct interp *in, const double pose[6])
         memcpy(in->pos, pose, sizeof in->pos);
 }
 
+void interp_set_ini(struct interp *in, interp_ini_fn get, void *ctx)
+{
+    in->ini_get = get;
+    in->ini_ctx = ctx;
+}
+
+void interp_set_hal_fn(struct interp *in, interp_hal_fn fn, void *ctx)
+{
+    in->hal_fn = fn;
+    in->hal_ctx = ctx;
+}
+
 void interp_use_kins(struct interp *in, struct kins *k)
 {
     struct kins_tool_frame f;

@@ -112,6 +112,14 @@ void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx);
 typedef void (*interp_contour_fn)(void *ctx, int line, int first, const double from[6],
                                   const double point[6]);
 void interp_set_contour_fn(struct interp *in, interp_contour_fn fn, void *ctx);
+/* #<_ini[SECTION]KEY>: get(ctx, SECTION, KEY) gives the INI's value text or NULL (the same
+ * lookup as struct kins_config); ctx must outlive the interpreter's runs. NULL: no INI. */
+typedef const char *(*interp_ini_fn)(void *ctx, const char *section, const char *key);
+void interp_set_ini(struct interp *in, interp_ini_fn get, void *ctx);
+/* #<_hal[name]>: fn(ctx, name, &value) reads a HAL pin or signal of the running machine, 0
+ * or -1 when there is none. NULL (the default, `hexcnc interp` and `check`): reads 0. */
+typedef int (*interp_hal_fn)(void *ctx, const char *name, double *value);
+void interp_set_hal_fn(struct interp *in, interp_hal_fn fn, void *ctx);
 /* Sets numbered parameter #n (1..5602) (the session: #5399 after an MDI line's M66). */
 void interp_set_param(struct interp *in, int n, double v);
 /* MDI: lines come one at a time (a run need not end with M2 or M30). */

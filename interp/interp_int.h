@@ -149,6 +149,10 @@ struct interp {
     interp_input_fn input_fn;    /* M66's answer (NULL: 0) */
     void *input_ctx;
     interp_contour_fn contour_fn; /* G141/G142's programmed points, for displays (NULL: none) */
+    interp_ini_fn ini_get;       /* #<_ini[SECTION]KEY> (NULL: no INI) */
+    void *ini_ctx;
+    interp_hal_fn hal_fn;        /* #<_hal[name]> (NULL: no machine; reads 0) */
+    void *hal_ctx;
     void *contour_ctx;
     double feed_factor;          /* mm/min per F unit in G21 */
     int block_delete;            /* 1: skip lines starting with '/' */

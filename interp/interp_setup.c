@@ -108,5 +108,7 @@ int interp_setup(struct interp *in, struct tooltable *tt, interp_setup_get_fn ge
 {
     struct interp_settings s;
     int st = interp_settings_read(&s, get, ctx, dir, err, errlen);
+    if (st == INTERP_OK)
+        interp_set_ini(in, get, ctx);   /* #<_ini[..]..>: ctx lives as long as the INI */
     return st != INTERP_OK ? st : interp_settings_apply(in, &s, tt, flags, err, errlen);
 }

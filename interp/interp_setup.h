@@ -41,8 +41,9 @@ int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, voi
 int interp_settings_apply(struct interp *in, const struct interp_settings *s,
                           struct tooltable *tt, unsigned flags, char *err, size_t errlen);
 
-/* Both: reads the INI's settings and applies them. Returns INTERP_OK or an interp status
- * with the message in err. */
+/* Both: reads the INI's settings and applies them, and gives the interpreter the INI for
+ * #<_ini[SECTION]KEY> (get and ctx must outlive its runs). Returns INTERP_OK or an interp
+ * status with the message in err. */
 int interp_setup(struct interp *in, struct tooltable *tt, interp_setup_get_fn get, void *ctx,
                  const char *dir, unsigned flags, char *err, size_t errlen);
 

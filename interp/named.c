@@ -1,5 +1,9 @@
 /* named.c: named parameters #<name> (local) and #<_name> (global), kept as LinuxCNC keeps them. */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -115,10 +119,74 @@ int interp_read_name(struct interp *in, int *pos, int col, const char **name, in
 }
 
 /* The value of #<name>: a predefined one, or one set before; reading any other is an error. */
+/* #<_ini[SECTION]KEY> and #<_hal[name]>: 1 with *out set, 0 when name is neither, -1 when
+ * it is one whose value cannot be had (why in why). The section and key are looked up in
+ * upper case (the interpreter reads names in lower case), as LinuxCNC does; only a number
+ * is a value. A HAL pin or signal is read from the running machine; without one it is 0. */
+static int outside_value(const struct interp *in, const char *name, int len, double *out,
+                         char *why, size_t wlen)
+{
+    int ini = len > 5 && !strncmp(name, "_ini[", 5), hal = len > 5 && !strncmp(name, "_hal[", 5);
+    if (!ini && !hal)
+        return 0;
+    const char *close = memchr(name + 5, ']', (size_t)(len - 5));
+    if (!close || (hal && close != name + len - 1) || (ini && close == name + len - 1)) {
+        snprintf(why, wlen, "write #<_ini[SECTION]KEY> or #<_hal[pin]>");
+        return -1;
+    }
+    char a[128], b[128];
+    int na = (int)(close - (name + 5)), nb = len - (int)(close - name) - 1;
+    if (na <= 0 || na >= (int)sizeof a || nb >= (int)sizeof b) {
+        snprintf(why, wlen, "the name is empty or too long");
+        return -1;
+    }
+    for (int i = 0; i < na; i++)
+        a[i] = ini ? (char)toupper((unsigned char)name[5 + i]) : name[5 + i];
+    a[na] = 0;
+    for (int i = 0; i < nb; i++)
+        b[i] = (char)toupper((unsigned char)close[1 + i]);
+    b[nb] = 0;
+    if (hal) {
+        if (!in->hal_fn) {
+            *out = 0;     /* no machine to read: `hexcnc interp` and `check` take 0 */
+            return 1;
+        }
+        if (in->hal_fn(in->hal_ctx, a, out) == 0)
+            return 1;
+        snprintf(why, wlen, "the machine has no HAL pin or parameter '%.100s'", a);
+        return -1;
+    }
+    const char *v = in->ini_get ? in->ini_get(in->ini_ctx, a, b) : NULL;
+    if (!v) {
+        snprintf(why, wlen, in->ini_get ? "the INI file has no [%.40s] %.60s" : "no INI file is "
+                 "given (hexcnc interp -i CONFIG.ini)", a, b);
+        return -1;
+    }
+    char *end = NULL;
+    errno = 0;
+    double d = strtod(v, &end);
+    const char *rest = end ? end : v;
+    while (isspace((unsigned char)*rest))
+        rest++;
+    if (rest == v || *rest || errno || !isfinite(d)) {
+        snprintf(why, wlen, "[%.40s] %.60s = %.60s is not a number", a, b, v);
+        return -1;
+    }
+    *out = d;
+    return 1;
+}
+
 int interp_named_get(struct interp *in, const char *name, int len, int col, double *out)
 {
     if (name[0] == '_' && interp_predefined(in, name, len, out))
         return 0;
+    char why[200];
+    int o = name[0] == '_' ? outside_value(in, name, len, out, why, sizeof why) : 0;
+    if (o > 0)
+        return 0;
+    if (o < 0)
+        return interp_fail(in, INTERP_ERR_PARAM, col, "named parameter #<%.*s> is not "
+                           "defined: %s", len > 60 ? 60 : len, name, why);
     int e = lookup(&in->named, name, len);
     if (e < 0)
         return interp_fail(in, INTERP_ERR_PARAM, col, "named parameter #<%.*s> is not defined "
@@ -132,7 +200,9 @@ int interp_named_get(struct interp *in, const char *name, int len, int col, doub
 int interp_named_exists(struct interp *in, const char *name, int len)
 {
     double v;
-    if (name[0] == '_' && interp_predefined(in, name, len, &v))
+    char why[200];
+    if (name[0] == '_' && (interp_predefined(in, name, len, &v) ||
+                           outside_value(in, name, len, &v, why, sizeof why) > 0))
         return 1;
     return lookup(&in->named, name, len) >= 0;
 }
@@ -145,6 +215,9 @@ int interp_named_target(struct interp *in, const char *name, int len, int col, i
     if (name[0] == '_' && interp_predefined(in, name, len, &v))
         return interp_fail(in, INTERP_ERR_PARAM, col, "#<%.*s> is read-only (it tells the "
                            "interpreter's state and cannot be set)", len, name);
+    if (len > 5 && (!strncmp(name, "_ini[", 5) || !strncmp(name, "_hal[", 5)))
+        return interp_fail(in, INTERP_ERR_PARAM, col, "#<%.*s> is read-only (it reads the "
+                           "machine's %s)", len, name, name[1] == 'i' ? "INI file" : "HAL");
     *entry = lookup(&in->named, name, len);
     if (*entry >= 0)
         return 0;

@@ -175,6 +175,22 @@ const char *runner_default_program(const struct runner *r)
     return r->default_program[0] ? r->default_program : NULL;
 }
 
+/* #<_hal[name]>: a pin or parameter of the running machine, read as it is now. */
+static int runner_hal_value(void *ctx, const char *name, double *v)
+{
+    enum hal_type t;
+    const void *p = hal_data_ptr(ctx, name, &t);
+    if (!p)
+        return -1;
+    switch (t) {
+    case HAL_BIT: *v = *(const volatile bool *)p ? 1 : 0; return 0;
+    case HAL_FLOAT: *v = *(const volatile double *)p; return 0;
+    case HAL_S32: *v = *(const volatile int32_t *)p; return 0;
+    case HAL_U32: *v = *(const volatile uint32_t *)p; return 0;
+    }
+    return -1;
+}
+
 /* Applies [RS274NGC] FEED_UNITS, TOOL_TABLE and PARAMETER_FILE (interp_setup: the same code
  * hexcnc check and hexcnc interp use); a bad value is pointed at its INI line. */
 int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *tt, char *err,
@@ -185,6 +201,7 @@ int runner_setup_interp(struct runner *r, struct interp *in, struct tooltable *t
                           sizeof msg);
     if (st == INTERP_OK) {
         interp_use_kins(in, r->kins);   /* G43.4 and [KINS] PROGRAM_POINT */
+        interp_set_hal_fn(in, runner_hal_value, r->hal);   /* #<_hal[..]> */
         return RUNNER_OK;
     }
     char where[1536];

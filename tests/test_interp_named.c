@@ -157,6 +157,69 @@ START_TEST(errors)
 }
 END_TEST
 
+/* #<_ini[SECTION]KEY> through the INI lookup (upper-cased, numbers only, errors naming the
+ * key) and #<_hal[name]> through the machine's (0 without one; an unknown pin an error). */
+static const char *fake_ini(void *ctx, const char *sec, const char *key)
+{
+    (void)ctx;
+    if (!strcmp(sec, "TRAJ") && !strcmp(key, "MAX_LINEAR_VELOCITY"))
+        return "33.5";
+    if (!strcmp(sec, "TRAJ") && !strcmp(key, "COORDINATES"))
+        return "X Y Z";
+    return NULL;
+}
+
+static int fake_hal(void *ctx, const char *name, double *v)
+{
+    (void)ctx;
+    if (strcmp(name, "motion.in-position"))
+        return -1;
+    *v = 1;
+    return 0;
+}
+
+START_TEST(ini_and_hal)
+{
+    struct canon_prog p;
+    struct interp *in = interp_create();
+    const char *prog = "G21\nG0 X#<_ini[traj]max_linear_velocity> Y#<_hal[motion.in-position]>\n"
+                       "G0 Z[EXISTS[#<_ini[TRAJ]MAX_LINEAR_VELOCITY>] + "
+                       "EXISTS[#<_ini[traj]nope>]]\nM2\n";
+    const char *pin = "G21\nG0 Y5\nG0 Y#<_hal[motion.in-position]>\nM2\n";
+    ck_assert_int_eq(run_on(in, pin, &p), INTERP_OK);   /* no machine: a pin reads 0 */
+    ck_assert(last_move(&p)->end[1] == 0);
+    canon_prog_free(&p);
+    interp_destroy(in);
+    in = interp_create();
+    const char *noini = "G21\nG0 X#<_ini[traj]max_linear_velocity>\nM2\n";
+    ck_assert_int_ne(run_on(in, noini, &p), INTERP_OK);
+    ck_assert_msg(strstr(interp_last_error(in)->message, "no INI file is given"), "%s",
+                  interp_last_error(in)->message);
+    canon_prog_free(&p);
+    interp_set_ini(in, fake_ini, NULL);
+    interp_set_hal_fn(in, fake_hal, NULL);
+    ck_assert_int_eq(run_on(in, prog, &p), INTERP_OK);
+    const struct canon_cmd *a = nth(&p, CANON_TRAVERSE, 0), *b = nth(&p, CANON_TRAVERSE, 1);
+    ck_assert(a->end[0] == 33.5 && a->end[1] == 1);
+    ck_assert(b->end[2] == 1);                       /* one exists, the other does not */
+    canon_prog_free(&p);
+    static const struct { const char *prog, *msg; } bad[] = {
+        { "G0 X#<_ini[traj]nope>\n", "the INI file has no [TRAJ] NOPE" },
+        { "G0 X#<_ini[traj]coordinates>\n", "[TRAJ] COORDINATES = X Y Z is not a number" },
+        { "G0 X#<_hal[no.such-pin]>\n", "no HAL pin or parameter 'no.such-pin'" },
+        { "#<_ini[traj]max_linear_velocity>=3\n", "is read-only" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ck_assert_int_ne(run_on(in, bad[i].prog, &p), INTERP_OK);
+        ck_assert_msg(strstr(interp_last_error(in)->message, bad[i].msg), "%s",
+                      interp_last_error(in)->message);
+        ck_assert_int_eq(interp_last_error(in)->line, 1);
+        canon_prog_free(&p);
+    }
+    interp_destroy(in);
+}
+END_TEST
+
 static Suite *named_suite(void)
 {
     Suite *s = suite_create("interp_named");
@@ -167,6 +230,7 @@ static Suite *named_suite(void)
     tcase_add_test(tc, predefined);
     tcase_add_test(tc, exists);
     tcase_add_test(tc, errors);
+    tcase_add_test(tc, ini_and_hal);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -22,25 +22,26 @@ static int write_stdout(void *ctx, const char *buf, size_t len)
 }
 
 /* Applies the INI's interpreter settings (interp_setup); its tool table goes into tt unless
- * tt is NULL (-t given). Returns 0 or prints why not. */
-static int apply_ini(struct interp *in, const char *path, struct tooltable *tt)
+ * tt is NULL (-t given). ini stays loaded for #<_ini[..]..> (the caller frees it). Returns 0
+ * or prints why not. */
+static int apply_ini(struct interp *in, const char *path, struct inifile *ini,
+                     struct tooltable *tt)
 {
-    struct inifile ini = { 0 };
     char err[1024], msg[1536];
-    if (config_load(&ini, path, err, sizeof err) != CONFIG_OK) {
+    if (config_load(ini, path, err, sizeof err) != CONFIG_OK) {
         fprintf(stderr, "error: %s\n", err);
         return -1;
     }
     if (tt)
         tooltable_init(tt);
-    int st = interp_setup(in, tt, inifile_config_get, &ini, inifile_dir(&ini), 0, err,
+    int st = interp_setup(in, tt, inifile_config_get, ini, inifile_dir(ini), 0, err,
                           sizeof err);
     if (st != INTERP_OK)   /* a bad value names its key: point it at the INI's line */
         fprintf(stderr, "error: %s\n", st == INTERP_ERR_CONFIG
-                ? inifile_locate_msg(&ini, err, msg, sizeof msg) : err);
-    const char *kname = inifile_get(&ini, "KINS", "KINEMATICS");
+                ? inifile_locate_msg(ini, err, msg, sizeof msg) : err);
+    const char *kname = inifile_get(ini, "KINS", "KINEMATICS");
     if (st == INTERP_OK && kname) {   /* the machine's tool, for G43.4 */
-        struct kins_config cfg = { inifile_config_get, &ini };
+        struct kins_config cfg = { inifile_config_get, ini };
         struct kins *k = NULL;
         if (kins_load(kname, &cfg, &k, err, sizeof err) != KINS_OK) {
             fprintf(stderr, "error: %s\n", err);
@@ -49,7 +50,6 @@ static int apply_ini(struct interp *in, const char *path, struct tooltable *tt)
         interp_use_kins(in, k);
         kins_free(k);
     }
-    inifile_free(&ini);
     return st == INTERP_OK ? 0 : -1;
 }
 
@@ -80,13 +80,14 @@ int cmd_interp(int argc, char **argv)
     }
     struct interp *in = interp_create();
     struct tooltable *tt = calloc(1, sizeof *tt);
+    struct inifile inidata = { 0 };   /* kept for #<_ini[..]..> while the program runs */
     int rc = 1;
     if (!in || !tt) {
         fprintf(stderr, "hexcnc interp: out of memory\n");
         goto out;
     }
     interp_set_block_delete(in, block_delete);
-    if (ini && apply_ini(in, ini, ttpath ? NULL : tt))
+    if (ini && apply_ini(in, ini, &inidata, ttpath ? NULL : tt))
         goto out;
     if (ttpath) {
         char err[512];
@@ -119,5 +120,6 @@ int cmd_interp(int argc, char **argv)
 out:
     free(tt);
     interp_destroy(in);
+    inifile_free(&inidata);
     return rc;
 }

@@ -253,6 +253,16 @@ def plain_session(tmp):
     num = c.ok("hal.get", name="iocontrol.0.tool-number")["value"]
     check("after tool.changed: tool 3 in the spindle (status, iocontrol.0.tool-number)",
           st["tool"]["number"] == 3 and num == "3", (st["tool"], num))
+    # #<_hal[..]> reads the running machine: the tool number pin says 3 now
+    c.ok("mdi.execute", line="G0 X[5 + #<_hal[iocontrol.0.tool-number]>]")
+    st = c.wait()
+    check("MDI reads a HAL pin: G0 X[5 + #<_hal[iocontrol.0.tool-number]>] goes to X8",
+          abs(st["machine_pose"]["commanded"][0] - 8) < 1e-9, st["machine_pose"]["commanded"])
+    r = c.call("mdi.execute", line="G0 X[#<_ini[traj]max_linear_velocity> / 20]")
+    st = c.wait()
+    check("... and an INI value: X[#<_ini[TRAJ]MAX_LINEAR_VELOCITY> / 20] goes to X5",
+          "error" not in r and abs(st["machine_pose"]["commanded"][0] - 5) < 1e-9,
+          (r, st["machine_pose"]["commanded"]))
     r = c.call("mdi.execute", line="G1 X10 Q")
     check("a bad MDI line: -32003 naming MDI:1", err_code(r) == -32003 and
           r["error"]["message"].startswith("MDI:1"), r)
