@@ -20,13 +20,17 @@ static const struct { int code, group; } g_table[] = {
 static const int g_unsupported[] = {50, 52, 55, 61, 331, 382, 383, 384, 385, 411, 421, 840,
                                     860, 870, 880, 950};
 
-/* LinuxCNC's lathe codes: refused as such, not as unknown or "not yet". */
+/* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
+ * or "not yet". */
+#define LATHE ", a lathe code: a hexapod has no turning spindle axis to run it"
 static const struct { int code; const char *what; } g_lathe[] = {
-    {70, "lathe diameter mode"}, {80, "lathe radius mode"}, {330, "spindle-synchronised "
-    "threading"}, {700, "a lathe finishing cycle"}, {710, "a lathe roughing cycle"},
-    {711, "a lathe roughing cycle"}, {720, "a lathe roughing cycle"}, {721, "a lathe roughing "
-    "cycle"}, {760, "lathe threading"}, {960, "constant surface speed"}, {970, "the end of "
-    "constant surface speed (G96)"},
+    {70, "lathe diameter mode" LATHE}, {80, "lathe radius mode" LATHE},
+    {330, "spindle-synchronised motion (threading): this machine has no spindle position "
+     "feedback to follow"},
+    {700, "a lathe finishing cycle" LATHE}, {710, "a lathe roughing cycle" LATHE},
+    {711, "a lathe roughing cycle" LATHE}, {720, "a lathe roughing cycle" LATHE},
+    {721, "a lathe roughing cycle" LATHE}, {760, "lathe threading" LATHE},
+    {960, "constant surface speed" LATHE}, {970, "the end of constant surface speed (G96)" LATHE},
 };
 
 /* Formats a code stored x10 as "92.1" or "1". */
@@ -69,9 +73,8 @@ int interp_add_g(struct interp *in, double v, int column)
     }
     for (size_t i = 0; i < sizeof g_lathe / sizeof g_lathe[0]; i++)
         if (g_lathe[i].code == c)
-            return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "G%s is %s, a lathe code: a "
-                               "hexapod has no turning spindle axis to run it", code_str(c, s),
-                               g_lathe[i].what);
+            return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "G%s is %s",
+                               code_str(c, s), g_lathe[i].what);
     for (size_t i = 0; i < sizeof g_unsupported / sizeof g_unsupported[0]; i++)
         if (g_unsupported[i] == c)
             return interp_fail(in, INTERP_ERR_UNSUPPORTED, column, "G%s is not supported yet",

@@ -255,6 +255,33 @@ START_TEST(test_preview)
     json_decref(r);
     json_decref(p);
 
+    /* under G43.4 the program gives the tool tip; the points drawn are the platform's poses
+     * like any others: on the TMU hexapod the tip X10 Y0 Z75 on the table is the platform at
+     * X-10 Z645 (the tool stands at Z720) */
+    inifile_free(&ini);
+    ck_assert_int_eq(config(&ini, &c, "\n[KINS]\nKINEMATICS = hexapod\nBASE_RADIUS = 500\n"
+                            "PLATFORM_RADIUS = 300\nBASE_HALF_ANGLE = 10\nPLATFORM_HALF_ANGLE = "
+                            "10\nHOME = 0 0 645 0 0 0\nTOOL_POINT = 0 0 780\nTOOL_LENGTH = 60\n"
+                            "[JOINT_0]\nMIN_LIMIT = 520\nMAX_LIMIT = 980\n[JOINT_1]\nMIN_LIMIT = "
+                            "520\nMAX_LIMIT = 980\n[JOINT_2]\nMIN_LIMIT = 520\nMAX_LIMIT = 980\n"
+                            "[JOINT_3]\nMIN_LIMIT = 520\nMAX_LIMIT = 980\n[JOINT_4]\nMIN_LIMIT = "
+                            "520\nMAX_LIMIT = 980\n[JOINT_5]\nMIN_LIMIT = 520\nMAX_LIMIT = 980\n",
+                            err, sizeof err), 0);
+    write_file("progs/tcp.ngc", "G21 G90\nG43.4 H0\nG1 X10 F600\nG49\nG1 Z650\nM2\n", 0644);
+    p = json_pack("{s:s, s:[ffffff]}", "path", "tcp.ngc", "start", 0.0, 0.0, 645.0, 0.0, 0.0,
+                  0.0);
+    r = web_local_call(&c, "program.preview", p, false, &code, err, sizeof err);
+    ck_assert_msg(r != NULL, "%s", err);
+    ck_assert_msg(json_is_null(json_object_get(r, "error")), "%s",
+                  json_string_value(json_object_get(r, "error")));
+    ck_assert_int_eq(json_integer_value(json_object_get(r, "points")), 3);
+    ck_assert_double_eq_tol(pt(r, 1, 0), -10.0, 1e-9);
+    ck_assert_double_eq_tol(pt(r, 1, 2), 645.0, 1e-9);
+    ck_assert_double_eq_tol(pt(r, 2, 0), -10.0, 1e-9);   /* after G49: the platform moves */
+    ck_assert_double_eq_tol(pt(r, 2, 2), 650.0, 1e-9);
+    json_decref(r);
+    json_decref(p);
+
     /* G141: the tool path (kind 2) offset by the radius to the right of travel, and the
      * programmed contour beside it */
     write_file("progs/c.ngc", "G21 G90\nG0 X70 Y-100 Z630\nG141 X50 Y-80 Z630 W10 F100\n"

@@ -23,13 +23,48 @@ struct preview {
     json_t *pts, *kind, *line;
     json_t *contour, *contour_line, *contour_first;  /* G141/G142's programmed contour */
     size_t n, max;
-    double at[6];
+    double at[6];              /* where the path is, in the commands' coordinates */
     double lo[3], hi[3];
     bool truncated;
+    struct kins_tool_frame tf; /* under G43.4 the commands give the tool tip: the points */
+    bool have_tf;              /* drawn are the platform's poses, as for any move */
+    int at_tcp;                /* at is the tip, with this tool length */
+    double at_len;
+    int tcp;                   /* the command being drawn is under G43.4 ... */
+    double len;                /* ... with this tool length */
 };
 
-static void put(struct preview *p, const double x[6], int kind, int line)
+/* The platform's pose of a command's pose (the same unless under G43.4). */
+static void platform(const struct preview *p, int tcp, double len, const double x[6],
+                     double out[6])
 {
+    if (tcp && p->have_tf)
+        kins_tcp_to_pose(&p->tf, len, x, out);
+    else
+        memcpy(out, x, 6 * sizeof *out);
+}
+
+/* A command under another G43.4 state than the path so far: where the path is, re-expressed
+ * in its coordinates (the machine does not move at the switch). */
+static void follow_tcp(struct preview *p, const struct canon_cmd *cmd)
+{
+    p->tcp = cmd->tcp && p->have_tf;
+    p->len = p->tcp ? cmd->tool_len_mm : 0;
+    if (p->tcp == p->at_tcp && p->len == p->at_len)
+        return;
+    double plat[6];
+    platform(p, p->at_tcp, p->at_len, p->at, plat);
+    if (p->tcp)
+        kins_tcp_from_pose(&p->tf, p->len, plat, p->at);
+    else
+        memcpy(p->at, plat, sizeof p->at);
+    p->at_tcp = p->tcp, p->at_len = p->len;
+}
+
+static void put(struct preview *p, const double xc[6], int kind, int line)
+{
+    double x[6];
+    platform(p, p->tcp, p->len, xc, x);
     for (int i = 0; i < 6; i++)
         json_array_append_new(p->pts, json_integer((json_int_t)llround(x[i] * 1000.0)));
     for (int i = 0; i < 3; i++) {
@@ -40,7 +75,7 @@ static void put(struct preview *p, const double x[6], int kind, int line)
     }
     json_array_append_new(p->kind, json_integer(kind));
     json_array_append_new(p->line, json_integer(line));
-    memcpy(p->at, x, sizeof p->at);
+    memcpy(p->at, xc, sizeof p->at);
     p->n++;
 }
 
@@ -103,8 +138,10 @@ static void put_arc(struct preview *p, const struct canon_cmd *cmd, int kind)
     put(p, cmd->end, kind, cmd->line);
 }
 
-static void contour_point(struct preview *p, const double x[6], int line, int first)
+static void contour_point(struct preview *p, const double xc[6], int line, int first)
 {
+    double x[6];
+    platform(p, p->tcp, p->len, xc, x);
     for (int i = 0; i < 6; i++)
         json_array_append_new(p->contour, json_integer((json_int_t)llround(x[i] * 1000.0)));
     json_array_append_new(p->contour_line, json_integer(line));
@@ -130,6 +167,8 @@ static int sink(void *ctx, const struct canon_cmd *cmd)
         return 1;
     }
     int kind = cmd->compensated ? KIND_COMP : KIND_FEED;
+    if (cmd->type == CANON_TRAVERSE || cmd->type == CANON_FEED || cmd->type == CANON_ARC)
+        follow_tcp(p, cmd);
     if (cmd->type == CANON_TRAVERSE)
         put(p, cmd->end, KIND_RAPID, cmd->line);
     else if (cmd->type == CANON_FEED)
@@ -167,8 +206,10 @@ json_t *web_preview(const struct web_config *c, const char *path, const double s
                                                  * then the tool tip's) */
         struct kins_config kc = { inifile_config_get, (void *)c->ini };
         struct kins *k = NULL;
-        if (kins_create(&kins_hexapod_ops, &kc, &k, msg, sizeof msg) == KINS_OK)
+        if (kins_create(&kins_hexapod_ops, &kc, &k, msg, sizeof msg) == KINS_OK) {
             interp_use_kins(in, k);
+            p.have_tf = kins_get_tool_frame(k, &p.tf) == KINS_OK;
+        }
         kins_free(k);
     }
     for (int i = 0; i < 3; i++) {
