@@ -6,6 +6,7 @@
 #include "interp/interp.h"
 #include "interp/printer.h"
 #include "interp/tooltable.h"
+#include "kins/kins.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -33,6 +34,28 @@ static void fill_tools(struct tooltable *tt)
     }
 }
 
+/* A fixed INI and HAL, so #<_ini[..]..> and #<_hal[..]> are reached with values and
+ * without. */
+static const char *fake_ini(void *ctx, const char *sec, const char *key)
+{
+    (void)ctx;
+    if (!strcmp(sec, "TRAJ") && !strcmp(key, "MAX_LINEAR_VELOCITY"))
+        return "100";
+    if (!strcmp(sec, "TRAJ") && !strcmp(key, "COORDINATES"))
+        return "X Y Z A B C";
+    return NULL;
+}
+
+static int fake_hal(void *ctx, const char *name, double *v)
+{
+    (void)ctx;
+    *v = (double)strlen(name);
+    return name[0] == 'x' ? -1 : 0;
+}
+
+/* The TMU machine's tool (fixed on the frame, 60 mm below its gauge point), for G43.4. */
+static const struct kins_tool_frame tmu_tool = { 0, { 0, 0, 780 }, { 0, 0, -1 }, 60, 0 };
+
 /* One input: a fresh interpreter runs it through the printer; errors are fine, crashes not. */
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -43,6 +66,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!in)
         return 0;
     interp_set_tooltable(in, &tt);
+    interp_set_ini(in, fake_ini, NULL);
+    interp_set_hal_fn(in, fake_hal, NULL);
+    if (size & 2)              /* half the inputs may use G43.4 */
+        interp_set_tool_frame(in, &tmu_tool);
     interp_set_block_delete(in, size & 1);
     interp_set_loop_limit(in, 10000);  /* a loop that never ends fails fast, not at 10^7 */
     interp_printer_init(&pr, in, 4, discard, NULL);

@@ -90,7 +90,7 @@ int interp_add_m(struct interp *in, double v, int column)
     int c, grp;
     CHP(interp_to_int(in, v, column, "an M code", &c));
     switch (c) {
-    case 0: case 1: case 2: case 30: grp = 4; break;
+    case 0: case 1: case 2: case 30: case 98: case 99: grp = 4; break;
     case 6: case 61: grp = 6; break;
     case 3: case 4: case 5: grp = 7; break;
     case 7: case 8: case 9: grp = 8; break;
@@ -188,12 +188,12 @@ static int word_used(const struct interp *in, char w)
     case 'i': case 'j': return arc || g0 == 100 || (!comp && g0 < 0 && m == 51);
     case 'k': return arc || g0 == 100;
     case 'r': return arc || cycle || g0 == 100;
-    case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 ||
+    case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 || b->m[4] == 98 ||
                      (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66);
     case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640 ||
                      b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68;
     case 'e': return b->m[5] >= 66 && b->m[5] <= 68;
-    case 'l': return cycle || g0 == 100 || b->m[5] == 66;
+    case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98;
     case 'h': return b->g[8] == 430 || b->g[8] == 434;
     case 'd': case 'w': return comp;
     default: return 1;

@@ -537,6 +537,15 @@ static int exec_motion(struct interp *in)
 static int exec_stop(struct interp *in)
 {
     int m = in->blk.m[4];
+    if (m == 98)
+        return oword_m98(in);
+    if (m == 99) {
+        int end;
+        CHP(oword_m99(in, &end));
+        if (!end)
+            return 0;
+        m = 2;               /* the main program's M99 ends it */
+    }
     if (m == 0 || m == 1)
         return emit_simple(in, CANON_PAUSE, 0, m);
     if (m != 2 && m != 30)

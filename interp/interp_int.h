@@ -122,6 +122,10 @@ struct ow_call {                 /* a call in progress */
     struct named_entry *locals;  /* the caller's local named parameters */
     size_t nlocals;
     struct modal_save m73;       /* M73 in this call: the state its return restores */
+    int m98;                     /* an M98 call (a Fanuc subprogram, no arguments) ... */
+    long m98_left;               /* ... to run this many more times (L) ... */
+    int sub_idx;                 /* ... from this O<n> line of text `sub_text` */
+    int sub_text;
 };
 struct oword {
     struct ow_text *texts;       /* [0] is the program */
@@ -254,6 +258,11 @@ void interp_named_free(struct interp *in);
 int oword_begin(struct interp *in, const char *text, size_t len);
 int oword_next_line(struct interp *in, const char **line, size_t *len);
 int oword_execute(struct interp *in);
+/* M98 P<n> L<k>: runs the subprogram that starts at the bare line O<n> k times. */
+int oword_m98(struct interp *in);
+/* M99: the end of an M98 subprogram (again while L lasts, then back after the M98); in the
+ * main program *end is set: the program ends there, as rs274 reads it. */
+int oword_m99(struct interp *in, int *end);
 int oword_end(struct interp *in);
 void oword_free(struct interp *in);
 int interp_named_push_locals(struct interp *in, struct named_entry **saved, size_t *nsaved);
