@@ -9,7 +9,7 @@
 static const struct { int code, group; } g_table[] = {
     {0, 1},    {10, 1},   {20, 1},   {30, 1},   {40, 0},   {100, 0},  {170, 2},  {180, 2},
     {190, 2},  {200, 6},  {210, 6},  {280, 0},  {281, 0},  {300, 0},  {301, 0},  {400, 7},
-    {430, 8},  {431, 8},  {434, 8},  {490, 8},  {530, 0},  {540, 12}, {550, 12}, {560, 12}, {570, 12},
+    {430, 8},  {431, 8},  {432, 8},  {434, 8},  {490, 8},  {530, 0},  {540, 12}, {550, 12}, {560, 12}, {570, 12},
     {580, 12}, {590, 12}, {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13},
     {730, 1},  {800, 1},  {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},
     {901, 4},  {910, 3},  {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},
@@ -148,7 +148,7 @@ static int check_axis_users(struct interp *in)
     struct interp_block *b = &in->blk;
     int g0 = b->g[0], g1 = b->g[1];
     int g0_axes = g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 ||
-                  g0 == 1410 || g0 == 1420 || b->g[8] == 431;
+                  g0 == 1410 || g0 == 1420 || b->g[8] == 431 || b->g[8] == 432;
     char s[32], s2[32];
     if (g0 == 1410 || g0 == 1420) {
         if (g1 >= 0 && g1 != 10)
@@ -160,7 +160,7 @@ static int check_axis_users(struct interp *in)
     if (g0_axes && g1 >= 0 && g1 != 800)
         return interp_fail(in, INTERP_ERR_MODAL, b->gcol[1], "G%s and G%s in one block both use "
                            "the axis words; put them in separate blocks",
-                           code_str(g0 >= 0 ? g0 : 431, s), code_str(g1, s2));
+                           code_str(g0 >= 0 ? g0 : b->g[8], s), code_str(g1, s2));
     if (!g0_axes && has_axis(b) && block_motion(in) < 0)
         return interp_fail(in, INTERP_ERR_MODAL, first_axis_col(b), "axis words with no motion "
                            "mode in force (after G80 give G0, G1, G2, G3 or a cycle)");
@@ -194,7 +194,7 @@ static int word_used(const struct interp *in, char w)
                      b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68;
     case 'e': return b->m[5] >= 66 && b->m[5] <= 68;
     case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98;
-    case 'h': return b->g[8] == 430 || b->g[8] == 434;
+    case 'h': return b->g[8] == 430 || b->g[8] == 432 || b->g[8] == 434;
     case 'd': case 'w': return comp;
     default: return 1;
     }
@@ -212,7 +212,7 @@ static int check_unused(struct interp *in)
         "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G82/G89 (dwell) and M62..M66",
         "Q is used by the peck cycles G73 and G83, G10, G64, M61, M66, M67 and M68",
         "L is used by G10, canned cycles (repeats) and M66",
-        "H is used by G43 (tool length offset) and G43.4 (tool centre point control)",
+        "H is used by G43, G43.2 (tool length offsets) and G43.4 (tool centre point control)",
         "D (tool for the radius) is only used with G141/G142",
         "W (tool radius) is only used with G141/G142",
         "E is the analog input of M66 and the analog output of M67 and M68",

@@ -503,7 +503,8 @@ static int exec_motion(struct interp *in)
         if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
             in->cycle_mode = in->cycle_il_on = 0;
     }
-    if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 || b->g[8] == 431)
+    if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 || b->g[8] == 431 ||
+        b->g[8] == 432)
         return 0; /* those blocks' axis words are not motion */
     int m = in->motion;
     int axis = W('x') || W('y') || W('z') || W('a') || W('b') || W('c');

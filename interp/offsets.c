@@ -230,6 +230,9 @@ int interp_tool_length(struct interp *in, int g)
 {
     if (g == 434)
         return tcp_on(in);
+    if (g == 432 && in->tcp_on)
+        return interp_fail(in, INTERP_ERR_MODAL, in->blk.gcol[8], "G43.2 under G43.4: the tool "
+                           "length is the tool centre point's; switch with G43.4 H instead");
     if (in->tcp_on) {
         double plat[6];
         interp_pos_platform(in, plat);
@@ -242,6 +245,23 @@ int interp_tool_length(struct interp *in, int g)
         for (int i = 0; i < 6; i++)
             if (W(axis_letter[i]))
                 in->tool[i] = axis_mm(in, i);
+    } else if (g == 432) {   /* G43.2: another tool's length, or the axis words, added */
+        if (!W('h') && !any_axis(in))
+            return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[8], "G43.2 needs H (the tool "
+                               "whose length is added) or axis words (the offsets added)");
+        if (W('h')) {
+            int h;
+            CHP(interp_to_int(in, V('h'), W('h'), "H (tool number)", &h));
+            struct tool_entry *e = h > 0 && in->tt ? tooltable_find(in->tt, h) : NULL;
+            if (h != 0 && !e)
+                return interp_fail(in, INTERP_ERR_TOOL, W('h'), "G43.2 H%d: tool %d is not in "
+                                   "the tool table", h, h);
+            if (e)
+                in->tool[AX_Z] += e->z_offset_mm;
+        }
+        for (int i = 0; i < 6; i++)
+            if (W(axis_letter[i]))
+                in->tool[i] += axis_mm(in, i);
     } else {
         int h = in->current_tool;
         if (W('h'))

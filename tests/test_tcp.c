@@ -222,6 +222,75 @@ static double seg_dist(const double *p, const double *a, const double *b)
     return sqrt(e2);
 }
 
+/* What a drive does between two set points a and b it takes: each leg moves linearly, through
+ * La + (Lb - La) j / 10 for j = 1..9. Runs the loaded program to its end, the drives taking
+ * every `every`-th set point ([TRAJ] SETPOINT_PERIOD), and hands each of those poses (the
+ * forward kinematics of the legs, warm-started) to measure with the two set points; returns
+ * how many poses were measured. */
+typedef void (*pose_fn)(void *ctx, const struct motion_out *a, const struct motion_out *b,
+                        const double P[6]);
+static long drive_walk(struct check_machine *mc, pose_fn measure, void *ctx)
+{
+    struct kins *k = check_machine_kins(mc);
+    struct motion *m = check_machine_motion(mc);
+    const struct motion_config *cfg = check_machine_motion_config(mc);
+    double T = cfg->servo_period_s;
+    int every = cfg->setpoint_period_s > 0 ? (int)lround(cfg->setpoint_period_s / T) : 1;
+    ck_assert_int_eq(motion_start(m), MOTION_OK);
+    struct motion_out a, b;
+    long n = 0;
+    motion_step(m, T, &a);
+    for (long step = 0; step < 10000000 && a.state != MOTION_DONE; step++) {
+        for (int e = 0; e < every; e++) {
+            ck_assert_int_ne(motion_step(m, T, &b), MOTION_ERR_UNREACHABLE);
+            if (b.state == MOTION_DONE)
+                break;
+        }
+        ck_assert(b.state != MOTION_FAULT);
+        double guess[6];
+        memcpy(guess, a.pose, sizeof guess);
+        for (int j = 1; j < 10; j++) {
+            double L[KINS_MAX_JOINTS], P[6];
+            for (int i = 0; i < 6; i++)
+                L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
+            memcpy(P, guess, sizeof P);
+            ck_assert_int_eq(kins_forward(k, L, P, NULL), KINS_OK);
+            memcpy(guess, P, sizeof guess);
+            measure(ctx, &a, &b, P);
+            n++;
+        }
+        a = b;
+    }
+    ck_assert_int_eq(a.state, MOTION_DONE);
+    return n;
+}
+
+/* The programmed tip path of a G43.4 program of straight moves, per line. */
+enum { MAXL = 64 };
+struct tip_path {
+    struct kins_tool_frame f;
+    double from[MAXL][3], to[MAXL][3], len_mm[MAXL];
+    int tcp[MAXL], have[MAXL];
+    double worst;
+    long samples;
+};
+
+/* A pose between set points of two G43.4 lines: its tip against their programmed lines. */
+static void tip_on_lines(void *ctx, const struct motion_out *a, const struct motion_out *b,
+                         const double P[6])
+{
+    struct tip_path *t = ctx;
+    int la = a->line, lb = b->line;
+    if (la <= 0 || la >= MAXL || !t->have[la] || !t->tcp[la] || lb <= 0 || lb >= MAXL ||
+        !t->have[lb] || !t->tcp[lb])
+        return;
+    double tip[6];
+    kins_tcp_from_pose(&t->f, t->len_mm[lb], P, tip);
+    double d = fmin(seg_dist(tip, t->from[la], t->to[la]), seg_dist(tip, t->from[lb], t->to[lb]));
+    t->worst = fmax(t->worst, d);
+    t->samples++;
+}
+
 /* Runs a G43.4 program of straight moves through motion at the servo period. Between
  * successive set points the legs pass La + (Lb - La) j / 10, j = 1..9, as a drive moves
  * them; the forward kinematics of those legs gives the pose, and the tip of that pose (with
@@ -230,9 +299,10 @@ static double seg_dist(const double *p, const double *a, const double *b)
 static double tip_path_deviation(const char *ini, const char *prog_rel, double *tol_mm)
 {
     struct check_machine *mc = open_machine(ini);
-    struct kins *k = check_machine_kins(mc);
     struct motion *m = check_machine_motion(mc);
-    struct kins_tool_frame f = frame_of(mc);
+    static struct tip_path t;
+    memset(&t, 0, sizeof t);
+    t.f = frame_of(mc);
     *tol_mm = check_machine_motion_config(mc)->kin_tol_mm;
     char pp[1024];
     struct canon_prog p;
@@ -240,10 +310,6 @@ static double tip_path_deviation(const char *ini, const char *prog_rel, double *
     canon_prog_init(&p);
     ck_assert_msg(check_machine_interpret(mc, tree_path(prog_rel, pp, sizeof pp), &p, &pb) ==
                   CHECK_OK, "%s", pb.message);
-    /* the programmed tip path per line: from (the tip before it) to its end */
-    enum { MAXL = 64 };
-    double from[MAXL][3], to[MAXL][3], len_mm[MAXL];
-    int tcp[MAXL] = { 0 }, have[MAXL] = { 0 };
     double at[6];
     int at_tcp = 0;
     double at_len = 0;
@@ -256,62 +322,27 @@ static double tip_path_deviation(const char *ini, const char *prog_rel, double *
         if (c->tcp != at_tcp || c->tool_len_mm != at_len) {   /* re-express the start */
             double plat[6];
             if (at_tcp)
-                kins_tcp_to_pose(&f, at_len, at, plat);
+                kins_tcp_to_pose(&t.f, at_len, at, plat);
             else
                 memcpy(plat, at, sizeof plat);
             if (c->tcp)
-                kins_tcp_from_pose(&f, c->tool_len_mm, plat, at);
+                kins_tcp_from_pose(&t.f, c->tool_len_mm, plat, at);
             else
                 memcpy(at, plat, sizeof at);
             at_tcp = c->tcp, at_len = c->tool_len_mm;
         }
-        memcpy(from[c->line], at, sizeof from[0]);
-        memcpy(to[c->line], c->end, sizeof to[0]);
-        tcp[c->line] = c->tcp, len_mm[c->line] = c->tool_len_mm, have[c->line] = 1;
+        memcpy(t.from[c->line], at, sizeof t.from[0]);
+        memcpy(t.to[c->line], c->end, sizeof t.to[0]);
+        t.tcp[c->line] = c->tcp, t.len_mm[c->line] = c->tool_len_mm, t.have[c->line] = 1;
         memcpy(at, c->end, sizeof at);
     }
     char err[512] = "";
     ck_assert_msg(motion_load(m, &p, err, sizeof err) == MOTION_OK, "%s", err);
-    ck_assert_int_eq(motion_start(m), MOTION_OK);
-    /* the drives take every `every`-th set point ([TRAJ] SETPOINT_PERIOD) */
-    const struct motion_config *cfg = check_machine_motion_config(mc);
-    double T = cfg->servo_period_s, worst = 0;
-    int every = cfg->setpoint_period_s > 0 ? (int)lround(cfg->setpoint_period_s / T) : 1;
-    struct motion_out a, b;
-    motion_step(m, T, &a);
-    long tip_samples = 0;
-    for (long step = 0; step < 10000000 && a.state != MOTION_DONE; step++) {
-        for (int e = 0; e < every; e++) {
-            ck_assert_int_ne(motion_step(m, T, &b), MOTION_ERR_UNREACHABLE);
-            if (b.state == MOTION_DONE)
-                break;
-        }
-        ck_assert(b.state != MOTION_FAULT);
-        int la = a.line, lb = b.line;
-        if (la > 0 && la < MAXL && have[la] && tcp[la] && lb > 0 && lb < MAXL && have[lb] &&
-            tcp[lb]) {
-            double guess[6];
-            memcpy(guess, a.pose, sizeof guess);
-            for (int j = 1; j < 10; j++) {
-                double L[KINS_MAX_JOINTS], P[6], tip[6];
-                for (int i = 0; i < 6; i++)
-                    L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
-                memcpy(P, guess, sizeof P);
-                ck_assert_int_eq(kins_forward(k, L, P, NULL), KINS_OK);
-                memcpy(guess, P, sizeof guess);
-                kins_tcp_from_pose(&f, len_mm[lb], P, tip);
-                double d = fmin(seg_dist(tip, from[la], to[la]), seg_dist(tip, from[lb], to[lb]));
-                worst = fmax(worst, d);
-                tip_samples++;
-            }
-        }
-        a = b;
-    }
-    ck_assert_int_eq(a.state, MOTION_DONE);
-    ck_assert(tip_samples > 1000);
+    drive_walk(mc, tip_on_lines, &t);
+    ck_assert(t.samples > 1000);
     canon_prog_free(&p);
     check_machine_close(mc);
-    return worst;
+    return t.worst;
 }
 
 START_TEST(test_tip_on_path)
@@ -330,6 +361,27 @@ START_TEST(test_tip_on_path)
 }
 END_TEST
 
+struct tip_arc {
+    struct kins_tool_frame f;
+    double len_mm, c[3], r, worst;
+    int line;
+    long samples;
+};
+
+/* A pose between set points on the arc's line: its tip's distance from the circle. */
+static void tip_on_circle(void *ctx, const struct motion_out *a, const struct motion_out *b,
+                          const double P[6])
+{
+    struct tip_arc *t = ctx;
+    if (a->line != t->line || b->line != t->line)
+        return;
+    double tip[6];
+    kins_tcp_from_pose(&t->f, t->len_mm, P, tip);
+    double rho = hypot(tip[0] - t->c[0], tip[1] - t->c[1]);
+    t->worst = fmax(t->worst, hypot(rho - t->r, tip[2] - t->c[2]));
+    t->samples++;
+}
+
 /* An arc under G43.4: the tip on the circle (centre c, radius r, in the plane z = c[2],
  * normal Z) while the tool tilts along it. Forward kinematics of the legs interpolated
  * between set points, as above, while the program is on the arc's line; returns the
@@ -338,51 +390,24 @@ static double tip_arc_deviation(const char *ini, const char *text, int arc_line,
                                 const double c[3], double r, double *tol_mm)
 {
     struct check_machine *mc = open_machine(ini);
-    struct kins *k = check_machine_kins(mc);
     struct motion *m = check_machine_motion(mc);
-    struct kins_tool_frame f = frame_of(mc);
+    struct tip_arc t = { .f = frame_of(mc), .r = r, .line = arc_line };
+    memcpy(t.c, c, sizeof t.c);
     *tol_mm = check_machine_motion_config(mc)->kin_tol_mm;
     struct canon_prog p;
     interpret(mc, text, &p);
-    double len = 0;
     for (size_t i = 0; i < p.count; i++)
         if (p.cmds[i].type == CANON_ARC) {
             ck_assert_int_eq(p.cmds[i].tcp, 1);
-            len = p.cmds[i].tool_len_mm;
+            t.len_mm = p.cmds[i].tool_len_mm;
         }
     char err[512] = "";
     ck_assert_msg(motion_load(m, &p, err, sizeof err) == MOTION_OK, "%s", err);
-    ck_assert_int_eq(motion_start(m), MOTION_OK);
-    double T = check_machine_motion_config(mc)->servo_period_s, worst = 0;
-    struct motion_out a, b;
-    long samples = 0;
-    motion_step(m, T, &a);
-    for (long step = 0; step < 10000000 && a.state != MOTION_DONE; step++) {
-        motion_step(m, T, &b);
-        ck_assert(b.state != MOTION_FAULT);
-        if (a.line == arc_line && b.line == arc_line) {
-            double guess[6];
-            memcpy(guess, a.pose, sizeof guess);
-            for (int j = 1; j < 10; j++) {
-                double L[KINS_MAX_JOINTS], P[6], tip[6];
-                for (int i = 0; i < 6; i++)
-                    L[i] = a.joint_pos[i] + (b.joint_pos[i] - a.joint_pos[i]) * j / 10.0;
-                memcpy(P, guess, sizeof P);
-                ck_assert_int_eq(kins_forward(k, L, P, NULL), KINS_OK);
-                memcpy(guess, P, sizeof guess);
-                kins_tcp_from_pose(&f, len, P, tip);
-                double rho = hypot(tip[0] - c[0], tip[1] - c[1]);
-                worst = fmax(worst, hypot(rho - r, tip[2] - c[2]));
-                samples++;
-            }
-        }
-        a = b;
-    }
-    ck_assert_int_eq(a.state, MOTION_DONE);
-    ck_assert(samples > 1000);
+    drive_walk(mc, tip_on_circle, &t);
+    ck_assert(t.samples > 1000);
     canon_prog_free(&p);
     check_machine_close(mc);
-    return worst;
+    return t.worst;
 }
 
 START_TEST(test_tip_on_arc)
