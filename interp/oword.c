@@ -1,6 +1,7 @@
 /* oword.c: O-words as LinuxCNC reads them: sub/endsub/call/return with #1..#30 arguments and
  * return values, if/elseif/else/endif, while/endwhile, do/while, repeat/endrepeat, break and
- * continue; subroutines in their own files (o<name> call finds name.ngc).
+ * continue; subroutines in their own files (o<name> call finds name.ngc). Fanuc's M98/M99
+ * subprograms are in oword_fanuc.c.
  *
  * The interpreter reads lines through oword_next_line() from a list of texts (the program,
  * then any subroutine file), each with a table of line starts, so a jump is a change of line
@@ -16,6 +17,7 @@
 #include <string.h>
 
 #include "interp/interp_int.h"
+#include "interp/oword_priv.h"
 
 enum { OW_IF = 1, OW_WHILE, OW_DO, OW_REPEAT };
 
@@ -116,7 +118,7 @@ int oword_begin(struct interp *in, const char *text, size_t len)
 
 /* Where line i of t starts and ends (b: past its newline, or the text's end), from the
  * cursor when reading on, else from the sparse index; the cursor moves to line i + 1. */
-static void line_span(struct ow_text *t, int i, size_t *a, size_t *b)
+void oword_line_span(struct ow_text *t, int i, size_t *a, size_t *b)
 {
     int k = i;
     size_t p;
@@ -170,7 +172,7 @@ int oword_next_line(struct interp *in, const char **line, size_t *len)
         return 0;
     }
     size_t a, b;
-    line_span(t, ow->idx, &a, &b);
+    oword_line_span(t, ow->idx, &a, &b);
     release_behind(t, a);
     if (b > a && t->text[b - 1] == '\n')
         b--;
@@ -182,7 +184,7 @@ int oword_next_line(struct interp *in, const char **line, size_t *len)
 
 /* Reads the label of an O-line from a raw line ("o100", "O<My Sub>") and its keyword:
  * label as normalised ("100", "<mysub>"), keyword lowercase. 0 when the line is no O-line. */
-static int peek(const char *s, size_t len, char *label, char *kw)
+int oword_peek(const char *s, size_t len, char *label, char *kw)
 {
     size_t i = 0, n = 0;
     while (i < len && (s[i] == ' ' || s[i] == '\t'))
@@ -245,8 +247,8 @@ static int find_line(struct oword *ow, int text, int idx, const char *label,
     size_t cur_off = t->cur_off, a, b;
     int found = -1;
     for (int i = idx + 1; i < t->nlines && found < 0; i++) {
-        line_span(t, i, &a, &b);
-        if (peek(t->text + a, b - a, l, kw) && !strcmp(l, label) && kw_in(kw, set))
+        oword_line_span(t, i, &a, &b);
+        if (oword_peek(t->text + a, b - a, l, kw) && !strcmp(l, label) && kw_in(kw, set))
             found = i;
     }
     t->cur_idx = cur_idx;
@@ -297,15 +299,9 @@ static int nothing_after(struct interp *in, int pos, const char *label, const ch
     return 0;
 }
 
-/* Goes on at line idx of the current text (0-based). */
-static void jump(struct oword *ow, int idx)
-{
-    ow->idx = idx;
-}
-
 /* One more loop iteration (counted where a loop's body starts); too many is a runaway
  * program. */
-static int loop_count(struct interp *in, const char *label)
+int oword_loop_count(struct interp *in, const char *label)
 {
     if (++in->ow.loops > in->ow.loop_limit)
         return interp_fail(in, INTERP_ERR_SYNTAX, 1, "o%s: more than %ld loop iterations in "
@@ -421,158 +417,6 @@ static int find_sub(struct interp *in, const char *label, int *text, int *idx)
                        label, label, name);
 }
 
-/* The raw line as a block's words: lower case, without blanks and comments. */
-static size_t squeeze(const char *s, size_t len, char *out, size_t cap)
-{
-    size_t n = 0;
-    int paren = 0;
-    for (size_t i = 0; i < len && n + 1 < cap; i++) {
-        char c = s[i];
-        if (paren) {
-            paren = c != ')';
-            continue;
-        }
-        if (c == '(') {
-            paren = 1;
-            continue;
-        }
-        if (c == ';')
-            break;
-        if (c != ' ' && c != '\t' && c != '\r')
-            out[n++] = (char)tolower((unsigned char)c);
-    }
-    out[n] = 0;
-    return n;
-}
-
-/* Whether a squeezed block holds M<code> (not M<code><digit>, nor M0<code> forms beyond it). */
-static int has_m(const char *b, int code)
-{
-    for (const char *p = strchr(b, 'm'); p; p = strchr(p + 1, 'm')) {
-        char *e;
-        long v = strtol(p + 1, &e, 10);
-        if (e != p + 1 && v == code && *e != '.')
-            return 1;
-    }
-    return 0;
-}
-
-/* A bare O<n> line at idx: 1 when it starts a Fanuc subprogram (the first of M99, M2, M30
- * or another bare O-line after it is an M99; *end gets that line), 0 when it only numbers
- * the program. */
-static int m99_after(struct oword *ow, int text, int idx, int *end)
-{
-    struct ow_text *t = &ow->texts[text];
-    int cur_idx = t->cur_idx, found = 0;
-    size_t cur_off = t->cur_off, a, b;
-    char buf[512], l[OWORD_LABEL_MAX], kw[16];
-    for (int i = idx + 1; i < t->nlines; i++) {
-        line_span(t, i, &a, &b);
-        if (peek(t->text + a, b - a, l, kw) && !kw[0])
-            break;
-        squeeze(t->text + a, b - a, buf, sizeof buf);
-        if (has_m(buf, 99)) {
-            found = 1;
-            *end = i;
-            break;
-        }
-        if (has_m(buf, 2) || has_m(buf, 30) || !strcmp(buf, "%"))
-            break;
-    }
-    t->cur_idx = cur_idx;
-    t->cur_off = cur_off;
-    return found;
-}
-
-/* The bare line O<label> of a text, or -1. */
-static int find_bare(struct oword *ow, int text, const char *label)
-{
-    struct ow_text *t = &ow->texts[text];
-    int cur_idx = t->cur_idx, found = -1;
-    size_t cur_off = t->cur_off, a, b;
-    char l[OWORD_LABEL_MAX], kw[16];
-    for (int i = 0; i < t->nlines && found < 0; i++) {
-        line_span(t, i, &a, &b);
-        if (peek(t->text + a, b - a, l, kw) && !kw[0] && !strcmp(l, label))
-            found = i;
-    }
-    t->cur_idx = cur_idx;
-    t->cur_off = cur_off;
-    return found;
-}
-
-int oword_m98(struct interp *in)
-{
-    struct oword *ow = &in->ow;
-    const struct interp_block *bl = &in->blk;
-    int p, l = 1;
-    if (!bl->col['p' - 'a'])
-        return interp_fail(in, INTERP_ERR_WORD, bl->mcol[4], "M98 needs P: the number of the "
-                           "subprogram (a line O<n> ... M99)");
-    CHP(interp_to_int(in, bl->val['p' - 'a'], bl->col['p' - 'a'], "M98 P", &p));
-    if (bl->col['l' - 'a'])
-        CHP(interp_to_int(in, bl->val['l' - 'a'], bl->col['l' - 'a'], "M98 L", &l));
-    if (p < 0 || l < 0)
-        return interp_fail(in, INTERP_ERR_WORD, bl->col[p < 0 ? 'p' - 'a' : 'l' - 'a'], "M98: "
-                           "P and L are not negative");
-    char label[OWORD_LABEL_MAX];
-    snprintf(label, sizeof label, "%d", p);
-    int text = ow->text, at = find_bare(ow, text, label);
-    if (at < 0 && text != 0)
-        at = find_bare(ow, text = 0, label);
-    if (at < 0)
-        return interp_fail(in, INTERP_ERR_SYNTAX, bl->col['p' - 'a'], "M98 P%d: no line O%d "
-                           "(the subprogram's start, ended by M99) in this program", p, p);
-    if (l == 0)
-        return 0;
-    if (ow->ncalls == OWORD_MAX_CALLS)
-        return interp_fail(in, INTERP_ERR_SYNTAX, 1, "M98 P%d: subprograms nested more than %d "
-                           "deep (a recursion that never ends?)", p, OWORD_MAX_CALLS);
-    if (!ow->calls && !(ow->calls = calloc(OWORD_MAX_CALLS, sizeof *ow->calls)))
-        return interp_fail(in, INTERP_ERR_NOMEM, 1, "out of memory");
-    struct ow_call *c = &ow->calls[ow->ncalls++];
-    memset(c, 0, sizeof *c);
-    snprintf(c->label, sizeof c->label, "%s", label);
-    c->text = ow->text;
-    c->idx = ow->idx;
-    c->nctl = ow->nctl;
-    c->m98 = 1;
-    c->m98_left = l;
-    c->sub_idx = at;
-    c->sub_text = text;
-    ow->text = text;
-    jump(ow, at + 1);
-    snprintf(in->file, sizeof in->file, "%s", ow->texts[text].file);
-    return 0;
-}
-
-int oword_m99(struct interp *in, int *end)
-{
-    struct oword *ow = &in->ow;
-    *end = 0;
-    if (ow->ncalls == 0) {
-        *end = 1;            /* the main program's M99: its end (rs274 stops there) */
-        return 0;
-    }
-    struct ow_call *c = &ow->calls[ow->ncalls - 1];
-    if (!c->m98)
-        return interp_fail(in, INTERP_ERR_SYNTAX, in->blk.mcol[4], "M99 inside o%s, which was "
-                           "called with 'call': end it with 'o%s endsub' (M99 ends an M98 "
-                           "subprogram)", c->label, c->label);
-    if (--c->m98_left > 0) {
-        CHP(loop_count(in, c->label));
-        ow->nctl = c->nctl;
-        jump(ow, c->sub_idx + 1);
-        return 0;
-    }
-    ow->ncalls--;
-    ow->nctl = c->nctl;
-    ow->text = c->text;
-    jump(ow, c->idx);
-    snprintf(in->file, sizeof in->file, "%s", ow->texts[c->text].file);
-    return 0;
-}
-
 /* Sets #<_value> and #<_value_returned>, the result of the last call. */
 static int set_result(struct interp *in, double v, int returned)
 {
@@ -617,7 +461,7 @@ static int do_call(struct interp *in, const char *label, int pos)
     memcpy(&in->params[1], args, sizeof args);
     CHP(set_result(in, 0.0, 0));
     ow->text = text;
-    jump(ow, idx + 1);
+    oword_jump(ow, idx + 1);
     snprintf(in->file, sizeof in->file, "%s", ow->texts[text].file);
     return 0;
 }
@@ -652,7 +496,7 @@ static int do_return(struct interp *in, const char *label, const char *kw, int p
         return interp_fail(in, INTERP_ERR_NOMEM, 1, "out of memory");
     ow->nctl = c->nctl;
     ow->text = c->text;
-    jump(ow, c->idx);
+    oword_jump(ow, c->idx);
     snprintf(in->file, sizeof in->file, "%s", ow->texts[c->text].file);
     return set_result(in, v, has);
 }
@@ -691,7 +535,7 @@ static int do_if(struct interp *in, const char *label, const char *kw, int pos)
     /* this branch is not taken: on to the next elseif or else (when none has run) or endif */
     CHP(find(in, ow->text, here, label, done || !strcmp(kw, "else") ? "endif"
              : "elseif|else|endif", &at, next, kw));
-    jump(ow, at);
+    oword_jump(ow, at);
     return 0;
 }
 
@@ -704,7 +548,7 @@ static int do_loop(struct interp *in, const char *label, const char *kw, int pos
     double v;
     if (!strcmp(kw, "do")) {
         CHP(nothing_after(in, pos, label, kw));
-        CHP(loop_count(in, label));
+        CHP(oword_loop_count(in, label));
         return push(in, label, OW_DO, 0, 0);
     }
     if (!strcmp(kw, "while")) {
@@ -716,16 +560,16 @@ static int do_loop(struct interp *in, const char *label, const char *kw, int pos
                 ow->nctl = c;
                 return 0;
             }
-            CHP(loop_count(in, label));
-            jump(ow, ow->ctl[c].idx + 1);
+            CHP(oword_loop_count(in, label));
+            oword_jump(ow, ow->ctl[c].idx + 1);
             return 0;
         }
         if (v == 0.0) {
             CHP(find(in, ow->text, here, label, "endwhile", &at, next, kw));
-            jump(ow, at + 1);
+            oword_jump(ow, at + 1);
             return 0;
         }
-        CHP(loop_count(in, label));
+        CHP(oword_loop_count(in, label));
         return push(in, label, OW_WHILE, 0, 0);
     }
     if (!strcmp(kw, "endwhile")) {
@@ -735,7 +579,7 @@ static int do_loop(struct interp *in, const char *label, const char *kw, int pos
             return interp_fail(in, INTERP_ERR_SYNTAX, 1, "o%s endwhile without o%s while",
                                label, label);
         ow->nctl = c;
-        jump(ow, ow->ctl[c].idx);  /* the while line tests again (and counts) */
+        oword_jump(ow, ow->ctl[c].idx);  /* the while line tests again (and counts) */
         return 0;
     }
     if (!strcmp(kw, "repeat")) {
@@ -744,10 +588,10 @@ static int do_loop(struct interp *in, const char *label, const char *kw, int pos
         long n = v >= 1e15 ? (long)1e15 : (long)v;
         if (n <= 0) {
             CHP(find(in, ow->text, here, label, "endrepeat", &at, next, kw));
-            jump(ow, at + 1);
+            oword_jump(ow, at + 1);
             return 0;
         }
-        CHP(loop_count(in, label));
+        CHP(oword_loop_count(in, label));
         return push(in, label, OW_REPEAT, n, 0);
     }
     /* endrepeat */
@@ -757,9 +601,9 @@ static int do_loop(struct interp *in, const char *label, const char *kw, int pos
         return interp_fail(in, INTERP_ERR_SYNTAX, 1, "o%s endrepeat without o%s repeat", label,
                            label);
     if (--ow->ctl[c].count > 0) {
-        CHP(loop_count(in, label));
+        CHP(oword_loop_count(in, label));
         ow->nctl = c + 1;
-        jump(ow, ow->ctl[c].idx + 1);
+        oword_jump(ow, ow->ctl[c].idx + 1);
     } else {
         ow->nctl = c;
     }
@@ -783,10 +627,10 @@ static int do_break(struct interp *in, const char *label, const char *kw, int po
     CHP(find(in, l->text, l->idx, label, end, &at, next, kw));
     if (!strcmp(kw, "break")) {
         ow->nctl = c;
-        jump(ow, at + 1);
+        oword_jump(ow, at + 1);
     } else {
         ow->nctl = c + 1;        /* the end line decides whether the loop goes on */
-        jump(ow, at);
+        oword_jump(ow, at);
     }
     return 0;
 }
@@ -836,15 +680,15 @@ int oword_execute(struct interp *in)
         int at;
         char next[16];
         CHP(find(in, ow->text, ow->idx - 1, label, "endsub", &at, next, kw));
-        jump(ow, at + 1);
+        oword_jump(ow, at + 1);
         return 0;
     }
     if (!kw[0] && !in->norm[pos] && label[0] != '<') {
         /* O<n> alone: a Fanuc subprogram's start met in the flow (skip to its M99), or the
          * program's number */
         int end;
-        if (m99_after(ow, ow->text, ow->idx - 1, &end))
-            jump(ow, end + 1);
+        if (oword_fanuc_sub_end(ow, ow->text, ow->idx - 1, &end))
+            oword_jump(ow, end + 1);
         return 0;
     }
     if (!strcmp(kw, "call"))
