@@ -21,11 +21,17 @@ void interp_cmd_init(struct interp *in, struct canon_cmd *c, enum canon_type t)
     c->n_digits = in->blk.n_digits;
 }
 
-/* Hands a command to the sink; a refusal stops the run. */
-int interp_emit(struct interp *in, struct canon_cmd *c)
+/* Every command carries the tool centre point state its pose is written in. */
+static void stamp_tcp(const struct interp *in, struct canon_cmd *c)
 {
     c->tcp = in->tcp_on;
     c->tool_len_mm = in->tcp_on ? in->tcp_len_mm : 0;
+}
+
+/* Hands a command to the sink; a refusal stops the run. */
+int interp_emit(struct interp *in, struct canon_cmd *c)
+{
+    stamp_tcp(in, c);
     if (in->sink(in->sink_ctx, c))
         return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the program");
     return 0;
@@ -36,8 +42,7 @@ int interp_comp_sink(void *ctx, const struct canon_cmd *cmd)
 {
     struct interp *in = ctx;
     struct canon_cmd c = *cmd;
-    c.tcp = in->tcp_on;
-    c.tool_len_mm = in->tcp_on ? in->tcp_len_mm : 0;
+    stamp_tcp(in, &c);
     return in->sink(in->sink_ctx, &c);
 }
 

@@ -14,6 +14,7 @@
 #include "motion/motion.h"
 #include "tests/test_check_util.h"
 #include "tests/test_kins_util.h"
+#include "tests/test_motion_util.h"
 
 #define TMU_INI "configs/sim/tmu-hexapod.ini"
 #define SPINDLE_INI "examples/tcp/spindle-hexapod.ini"
@@ -210,18 +211,6 @@ END_TEST
 
 /* ---- the tip on the path ---- */
 
-/* Distance of p from the segment a..b. */
-static double seg_dist(const double *p, const double *a, const double *b)
-{
-    double d[3], w[3], n2 = 0, u = 0, e2 = 0;
-    for (int i = 0; i < 3; i++)
-        d[i] = b[i] - a[i], w[i] = p[i] - a[i], n2 += d[i] * d[i], u += w[i] * d[i];
-    u = n2 > 1e-24 ? fmin(1, fmax(0, u / n2)) : 0;
-    for (int i = 0; i < 3; i++)
-        e2 += (w[i] - u * d[i]) * (w[i] - u * d[i]);
-    return sqrt(e2);
-}
-
 /* What a drive does between two set points a and b it takes: each leg moves linearly, through
  * La + (Lb - La) j / 10 for j = 1..9. Runs the loaded program to its end, the drives taking
  * every `every`-th set point ([TRAJ] SETPOINT_PERIOD), and hands each of those poses (the
@@ -286,7 +275,7 @@ static void tip_on_lines(void *ctx, const struct motion_out *a, const struct mot
         return;
     double tip[6];
     kins_tcp_from_pose(&t->f, t->len_mm[lb], P, tip);
-    double d = fmin(seg_dist(tip, t->from[la], t->to[la]), seg_dist(tip, t->from[lb], t->to[lb]));
+    double d = fmin(tm_dist_seg(tip, t->from[la], t->to[la]), tm_dist_seg(tip, t->from[lb], t->to[lb]));
     t->worst = fmax(t->worst, d);
     t->samples++;
 }
