@@ -97,7 +97,7 @@ static int message_line(const char *msg, const struct canon_prog *prog, char *fi
 }
 
 /* Fills the result's header fields from the machine. */
-static void result_header(struct check_machine *mc, const struct check_opts *o,
+void check_result_header(struct check_machine *mc, const struct check_opts *o,
                           struct check_result *r)
 {
     r->servo_period_s = mc->mcfg.servo_period_s;
@@ -118,7 +118,7 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
         check_opts_default(&def);
         opts = &def;
     }
-    result_header(mc, opts, r);
+    check_result_header(mc, opts, r);
     int reach = check_scan_reach(mc, prog, r);
     char msg[400];
     if (motion_load(mc->motion, prog, msg, sizeof msg) != MOTION_OK) {
@@ -133,7 +133,7 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
     }
     if (motion_start(mc->motion) != MOTION_OK)
         return CHECK_ERR_CONFIG;
-    int st = check_simulate(mc, prog->start, opts, r);
+    int st = check_simulate(mc, prog->start, opts, NULL, r);
     r->simulated = 1;
     if (st != CHECK_OK) {
         struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = r->machining_time_s,
@@ -147,22 +147,18 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
     return r->nproblems ? CHECK_ERR_VIOLATION : CHECK_OK;
 }
 
-/* Interprets the file, then check_canon(). */
-int check_program(struct check_machine *mc, const char *path, const struct check_opts *opts,
-                  struct check_result *r)
+/* The whole program interpreted into memory, then check_canon() (check_program's way for a
+ * plot, whose samples are spread over the planned time). */
+int check_program_whole(struct check_machine *mc, const char *path,
+                        const struct check_opts *opts, struct check_result *r)
 {
     struct canon_prog prog;
     struct check_problem p;
-    struct check_opts def;
-    if (!opts) {
-        check_opts_default(&def);
-        opts = &def;
-    }
     snprintf(r->program, sizeof r->program, "%s", path);
     canon_prog_init(&prog);
     int st = check_machine_interpret(mc, path, &prog, &p);
     if (st != CHECK_OK) {
-        result_header(mc, opts, r);
+        check_result_header(mc, opts, r);
         check_add_problem(r, &p);
     } else {
         st = check_canon(mc, &prog, opts, r);

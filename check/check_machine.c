@@ -176,14 +176,14 @@ double check_machine_tool_radius(struct check_machine *mc, int tool)
     return r;
 }
 
-/* Interprets a file (text NULL) or text held in memory into prog. */
-static int interpret(struct check_machine *mc, const char *path, const char *text, size_t len,
-                     struct canon_prog *prog, struct check_problem *pb)
+int check_machine_interp_new(struct check_machine *mc, struct interp **out,
+                             struct check_problem *pb)
 {
     struct interp *in = interp_create();
     struct interp **list = realloc(mc->interps, (mc->ninterps + 1) * sizeof *list);
     memset(pb, 0, sizeof *pb);
     pb->kind = CHECK_INTERP, pb->leg = -1, pb->time_s = -1, pb->count = 1;
+    *out = NULL;
     if (list)
         mc->interps = list;
     if (!in || !list) {
@@ -194,13 +194,24 @@ static int interpret(struct check_machine *mc, const char *path, const char *tex
     interp_set_start(in, mc->kins->home);
     interp_use_kins(in, mc->kins);       /* G43.4 and [KINS] PROGRAM_POINT */
     interp_set_ini(in, hal_ini_lookup, mc->hal);   /* #<_ini[..]..> */
-    memcpy(prog->start, mc->kins->home, sizeof prog->start);
-    mc->interps[mc->ninterps++] = in;   /* prog's commands point at in's file name */
+    mc->interps[mc->ninterps++] = in;   /* commands point at in's file name */
     /* the runner's settings, but the machine's parameter file is never written */
     if (interp_settings_apply(in, &mc->interp, mc->tt, INTERP_SETUP_PARAMS_READ_ONLY,
                               pb->message, sizeof pb->message) != INTERP_OK)
         return CHECK_ERR_CONFIG;
-    int st = CHECK_OK;
+    *out = in;
+    return CHECK_OK;
+}
+
+/* Interprets a file (text NULL) or text held in memory into prog. */
+static int interpret(struct check_machine *mc, const char *path, const char *text, size_t len,
+                     struct canon_prog *prog, struct check_problem *pb)
+{
+    struct interp *in;
+    int st = check_machine_interp_new(mc, &in, pb);
+    if (st)
+        return st;
+    memcpy(prog->start, mc->kins->home, sizeof prog->start);
     int ist = text ? interp_run_text(in, path, text, len, canon_prog_sink, prog)
                    : interp_run_file(in, path, canon_prog_sink, prog);
     if (ist != INTERP_OK) {

@@ -42,13 +42,49 @@ static inline int check_is_motion(enum canon_type t)
 void check_move_pose(const double from[KINS_POSE_DIM], const struct canon_cmd *c, double u,
                      double pose[KINS_POSE_DIM]);
 
+/* The reach pass one command at a time (a streamed check): where the previous move ended. */
+struct check_reach {
+    double from[KINS_POSE_DIM];
+    int from_tcp;                    /* from is the tool tip under G43.4, this tool length */
+    double from_len;
+};
+void check_reach_begin(struct check_reach *rs, const double start[KINS_POSE_DIM], int tcp,
+                       double tool_len_mm);
+/* A move's end and inside sampled through the inverse kinematics; problems into r. */
+void check_reach_cmd(struct check_machine *mc, struct check_reach *rs, const struct canon_cmd *c,
+                     struct check_result *r);
+
 /* Static pass: every move sampled through the inverse kinematics; reach problems into r.
  * Returns the number of problems found. */
 int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r);
 
-/* Servo-rate pass through motion_step (the program must be loaded and started). */
+/* What the servo-rate pass of a streamed program waits on (check_stream.c). */
+struct check_feed {
+    int (*wait)(void *ctx);          /* motion is short of plan: returns once it has more (1),
+                                      * or 0 when no more will come (the pass stops) */
+    double (*planned_s)(void *ctx);  /* the program's planned time once known, else < 0 */
+    void *ctx;
+};
+
+/* Servo-rate pass through motion_step (the program must be loaded, or a stream attached,
+ * and motion started; feed: NULL for a loaded program). */
 int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
-                   const struct check_opts *o, struct check_result *r);
+                   const struct check_opts *o, const struct check_feed *feed,
+                   struct check_result *r);
+
+/* check_program with the whole program in memory (for a trace). */
+int check_program_whole(struct check_machine *mc, const char *path,
+                        const struct check_opts *opts, struct check_result *r);
+
+/* The result's header fields (configuration, tolerances, schedule) from the machine. */
+void check_result_header(struct check_machine *mc, const struct check_opts *o,
+                         struct check_result *r);
+
+/* A new interpreter for one program, set up as the runner's (start at HOME, the kinematics'
+ * tool, the INI's settings, its parameter file read-only); kept in mc (the commands point at
+ * its file names). On failure pb says why. */
+int check_machine_interp_new(struct check_machine *mc, struct interp **out,
+                             struct check_problem *pb);
 
 #endif

@@ -115,11 +115,12 @@ void check_print_json(const struct check_result *r, FILE *f)
     fputs("}\n", f);
 }
 
-/* How often a measure was taken, in words. */
-static void schedule(char *buf, size_t len, double every_s)
+/* How often a measure was taken, in words (moved: the line changes the condition number
+ * waits for, check_sim.c). */
+static void schedule(char *buf, size_t len, double every_s, const char *moved)
 {
     if (every_s > 0)
-        snprintf(buf, len, "every %g ms and at each line change", every_s * 1e3);
+        snprintf(buf, len, "every %g ms and at each line change%s", every_s * 1e3, moved);
     else
         snprintf(buf, len, "at every servo period");
 }
@@ -142,15 +143,16 @@ void check_print_table(const struct check_result *r, FILE *f)
         print_duration(f, r->machining_time_s);
         fprintf(f, " (%ld servo periods of %.3f ms), path %.3f mm\n", r->periods,
                 r->servo_period_s * 1e3, r->length_mm);
-        char when[64];
-        schedule(when, sizeof when, r->deviation_every_s);
+        char when[120];
+        schedule(when, sizeof when, r->deviation_every_s, "");
         fprintf(f, "deviation       %.4g um max (line %d), %.3g deg; tolerance %g um; "
                 "measured %s\n", r->max_deviation_mm * 1e3, r->max_deviation_line,
                 r->max_deviation_deg, r->kin_tol_mm * 1e3, when);
         if (r->tip_measured)
             fprintf(f, "tool tip        %.4g um max from its path (line %d)\n",
                     r->max_tip_deviation_mm * 1e3, r->max_tip_deviation_line);
-        schedule(when, sizeof when, r->condition_every_s);
+        schedule(when, sizeof when, r->condition_every_s,
+                 " 1 mm or 0.5 deg on from the last");
         fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
                 r->max_condition, r->max_condition_line, r->condition_limit, when);
         fputs("leg   min mm     max mm     range mm         peak mm/s  limit   "

@@ -180,30 +180,42 @@ static void scan_move(struct check_machine *mc, const double from[KINS_POSE_DIM]
         leg_problem(mc, c, CHECK_LEG_RANGE, wpose, wL, r);
 }
 
+void check_reach_begin(struct check_reach *rs, const double start[KINS_POSE_DIM], int tcp,
+                       double tool_len_mm)
+{
+    memcpy(rs->from, start, sizeof rs->from);
+    rs->from_tcp = tcp;
+    rs->from_len = tool_len_mm;
+}
+
+void check_reach_cmd(struct check_machine *mc, struct check_reach *rs, const struct canon_cmd *c,
+                     struct check_result *r)
+{
+    double L[KINS_MAX_JOINTS];
+    if (!check_is_motion(c->type))
+        return;
+    if (c->tcp != rs->from_tcp || c->tool_len_mm != rs->from_len) {  /* G43.4 / G49 */
+        struct kins_tool_frame tf;
+        platform_of(mc, rs->from_tcp, rs->from_len, rs->from, rs->from);
+        if (c->tcp && kins_get_tool_frame(mc->kins, &tf) == KINS_OK)
+            kins_tcp_from_pose(&tf, c->tool_len_mm, rs->from, rs->from);
+        rs->from_tcp = c->tcp, rs->from_len = c->tool_len_mm;
+    }
+    if (cmd_inverse(mc, c, c->end, L) != KINS_OK)
+        leg_problem(mc, c, CHECK_UNREACHABLE, c->end, L, r);
+    else
+        scan_move(mc, rs->from, c, r);
+    memcpy(rs->from, c->end, sizeof rs->from);
+}
+
 /* The reach pass over every move of the program. */
 int check_scan_reach(struct check_machine *mc, const struct canon_prog *prog,
                      struct check_result *r)
 {
-    double from[KINS_POSE_DIM], L[KINS_MAX_JOINTS], from_len = prog->start_tool_len_mm;
-    int from_tcp = prog->start_tcp;
+    struct check_reach rs;
     size_t before = r->nproblems;
-    memcpy(from, prog->start, sizeof from);
-    for (size_t k = 0; k < prog->count; k++) {
-        const struct canon_cmd *c = &prog->cmds[k];
-        if (!check_is_motion(c->type))
-            continue;
-        if (c->tcp != from_tcp || c->tool_len_mm != from_len) {  /* G43.4 / G49: re-express */
-            struct kins_tool_frame tf;
-            platform_of(mc, from_tcp, from_len, from, from);
-            if (c->tcp && kins_get_tool_frame(mc->kins, &tf) == KINS_OK)
-                kins_tcp_from_pose(&tf, c->tool_len_mm, from, from);
-            from_tcp = c->tcp, from_len = c->tool_len_mm;
-        }
-        if (cmd_inverse(mc, c, c->end, L) != KINS_OK)
-            leg_problem(mc, c, CHECK_UNREACHABLE, c->end, L, r);
-        else
-            scan_move(mc, from, c, r);
-        memcpy(from, c->end, sizeof from);
-    }
+    check_reach_begin(&rs, prog->start, prog->start_tcp, prog->start_tool_len_mm);
+    for (size_t k = 0; k < prog->count; k++)
+        check_reach_cmd(mc, &rs, &prog->cmds[k], r);
     return (int)(r->nproblems - before);
 }

@@ -1,4 +1,5 @@
 /* check_sim.c: the servo-rate pass: motion_step on a simulated clock, legs, rates, deviation, singularity. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -8,6 +9,8 @@
 
 #define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
 #define MAX_PERIODS_FACTOR 2 /* the run stops at twice the planned time (a stuck planner) */
+#define COND_STEP_MM 1.0     /* a line change takes the condition number once the pose is */
+#define COND_STEP_DEG 0.5    /* this far from where it was last taken (the planner's knots) */
 
 /* State of the pass between periods. */
 struct sim {
@@ -26,6 +29,7 @@ struct sim {
     int line;                          /* program line of the previous period */
     const char *file;
     double next_dev_s, next_cond_s;    /* machine time of the next scheduled measure */
+    double cond_pose[KINS_POSE_DIM];   /* pose where the condition number was last taken */
     struct kins_tool_frame tf;         /* the machine's tool: the tip's deviation */
     int have_tf;
     int tip_line;                      /* a straight feed's tip line, its ends t0 t1 (the */
@@ -252,14 +256,30 @@ static void singularity(struct sim *s, const struct motion_out *out)
     check_add_problem(r, &p);
 }
 
-/* The scheduled measures of one period: at every line change, else on the schedule. */
+/* Whether the pose has moved COND_STEP_MM or COND_STEP_DEG from where the condition number
+ * was last taken. */
+static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
+{
+    double d2 = 0, da = 0;
+    for (int i = 0; i < 3; i++)
+        d2 += (pose[i] - s->cond_pose[i]) * (pose[i] - s->cond_pose[i]);
+    for (int i = 3; i < KINS_POSE_DIM; i++)
+        da = fmax(da, fabs(pose[i] - s->cond_pose[i]));
+    return d2 >= COND_STEP_MM * COND_STEP_MM || da >= COND_STEP_DEG;
+}
+
+/* The scheduled measures of one period: the deviation at every line change, the condition
+ * number at a line change the pose has moved on from (dense code changes line every few
+ * tenths of a millimetre, and a singular value decomposition costs ten servo periods), and
+ * both on their schedule. */
 static void measures(struct sim *s, const struct motion_out *out)
 {
     struct check_result *r = s->r;
     double t = out->time_elapsed_s;
     int changed = out->line != s->line || out->file != s->file;
-    if (changed || t >= s->next_cond_s) {
+    if ((changed && cond_moved(s, out->pose)) || t >= s->next_cond_s) {
         singularity(s, out);
+        memcpy(s->cond_pose, out->pose, sizeof s->cond_pose);
         s->next_cond_s = t + s->o->condition_every_s;
     }
     if (changed || t >= s->next_dev_s) {
@@ -295,35 +315,56 @@ static void leg_limits(struct sim *s)
     }
 }
 
+/* The period count past which motion counts as stuck: twice the planned time (a streamed
+ * program's once its planner has ended, none before: the planner paces it). */
+static long period_bound(const struct sim *s, double planned_s)
+{
+    return planned_s >= 0 ? (long)(MAX_PERIODS_FACTOR * planned_s / s->T) + 1000 : LONG_MAX;
+}
+
 /* Steps motion at the servo period to the program's end, measuring as it goes. */
 int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
-                   const struct check_opts *o, struct check_result *r)
+                   const struct check_opts *o, const struct check_feed *feed,
+                   struct check_result *r)
 {
     struct sim s = { .mc = mc, .o = o, .r = r, .nj = mc->kins->njoints,
                      .T = mc->mcfg.servo_period_s, .inv_T = 1 / mc->mcfg.servo_period_s };
     s.have_tf = kins_get_tool_frame(mc->kins, &s.tf) == KINS_OK;
     r->tip_measured = s.have_tf;
     struct motion_out out;
-    struct motion_plan_info info;
-    motion_plan_info(mc->motion, &info);
-    r->planned_time_s = info.time_s;
+    double planned_s = -1;
+    if (!feed) {
+        struct motion_plan_info info;
+        motion_plan_info(mc->motion, &info);
+        r->planned_time_s = planned_s = info.time_s;
+    }
     r->njoints = s.nj;
     leg_limits(&s);
     if (kins_inverse(mc->kins, start, s.L0) != KINS_OK)   /* motion starts here */
         return CHECK_ERR_KINS;
     memcpy(s.p0, start, sizeof s.p0);
+    for (int i = 0; i < KINS_POSE_DIM; i++)   /* the first line change takes it */
+        s.cond_pose[i] = HUGE_VAL;
     int st = MOTION_OK;
-    long max_periods = (long)(MAX_PERIODS_FACTOR * info.time_s / s.T) + 1000;
-    if (o->trace)
-        s.trace_every = check_trace_begin(o->trace, info.time_s, s.T);
+    long max_periods = period_bound(&s, planned_s);
+    if (o->trace && !feed)
+        s.trace_every = check_trace_begin(o->trace, planned_s, s.T);
+    memset(&out, 0, sizeof out);
+    motion_set_rates(mc->motion, false);   /* rates come from differences of set points */
     for (long n = 0; n < max_periods; n++) {
+        if (feed && motion_stream_starving(mc->motion)) {
+            if (!feed->wait(feed->ctx))
+                break;                  /* the planner stopped: nothing more to follow */
+            if (max_periods == LONG_MAX)
+                max_periods = period_bound(&s, feed->planned_s(feed->ctx));
+        }
         st = motion_step(mc->motion, s.T, &out);
         r->periods++;
         legs_period(&s, &out);
         if (s.have_tf)
             tip_period(&s, &out);
         measures(&s, &out);
-        if (o->trace && ++s.trace_count >= s.trace_every) {
+        if (o->trace && !feed && ++s.trace_count >= s.trace_every) {
             check_trace_add(o->trace, out.time_elapsed_s, s.nj, out.joint_pos, s.v0, out.pose);
             s.trace_count = 0;
         }
@@ -335,6 +376,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         if (out.state == MOTION_PAUSED)   /* M0/M1: the operator would press resume */
             motion_resume(mc->motion);
     }
+    motion_set_rates(mc->motion, true);
     if (s.tip_line)
         tip_flush(&s);
     r->machining_time_s = out.time_elapsed_s;

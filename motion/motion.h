@@ -326,6 +326,9 @@ bool motion_pose_known(const struct motion *m);
 /* Spindle (motion_step.c): whether programs planned from now on stop after M3/M4 and S
  * changes until the spindle reports it is at speed, and that report, each period. */
 void motion_set_wait_at_speed(struct motion *m, bool on);
+/* Off: motion_step computes the leg positions alone, joint_vel and pose_vel read 0 (a check
+ * that differences successive set points; a fifth less time per period). On by default. */
+void motion_set_rates(struct motion *m, bool on);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
 /* Tool changes: whether programs planned from now on stop at M6 until the changer is done,
  * and the changer's answer to request seq (the tool is then in the spindle). */

@@ -205,6 +205,8 @@ struct motion {
     size_t ios_done;         /* spindle and coolant commands applied since motion_start */
     struct motion_spindle io; /* the spindle and coolant as commanded now (kept from one
                               * program to the next; off after an abort or a fault) */
+    int no_rates;            /* motion_set_rates(m, false): legs only, no rates (a check
+                              * differences the set points itself) */
     int wait_at_speed;       /* plan a wait for the spindle after M3/M4/S (motion_hal: the
                               * at-speed input is wired) */
     int at_speed;            /* the spindle's at-speed input this period */

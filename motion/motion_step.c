@@ -333,27 +333,34 @@ static int evaluate(struct motion *m)
     if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
         v = 0;
     motion_seg_pose(p, sg, s, m->prog_pose);
-    motion_seg_tangent(p, sg, s, dp);
+    double vr = m->no_rates ? 0 : v;   /* the speed the rates are computed for */
+    if (vr != 0)
+        motion_seg_tangent(p, sg, s, dp);
+    else
+        memset(dp, 0, sizeof dp);
     m->tcp = sg->tcp;
     m->tool_len_mm = sg->tool_len_mm;
     m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
     memcpy(m->seg_from, sg->start, sizeof m->seg_from);
     memcpy(m->seg_to, sg->end, sizeof m->seg_to);
-    if (sg->tcp) {             /* G43.4: the path is the tip's; the platform's pose follows */
+    if (sg->tcp && vr == 0) {
+        kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
+        memset(m->pose_vel, 0, sizeof m->pose_vel);
+    } else if (sg->tcp) {      /* G43.4: the path is the tip's; the platform's pose follows */
         double pv[KINS_POSE_DIM];
         for (int i = 0; i < KINS_POSE_DIM; i++)
-            pv[i] = dp[i] * v;
+            pv[i] = dp[i] * vr;
         kins_tcp_to_pose_vel(&m->tf, sg->tool_len_mm, m->prog_pose, pv, m->pose, m->pose_vel);
     } else {
         memcpy(m->pose, m->prog_pose, sizeof m->pose);
         for (int i = 0; i < KINS_POSE_DIM; i++)
-            m->pose_vel[i] = dp[i] * v;
+            m->pose_vel[i] = dp[i] * vr;
     }
     m->path_vel = v;
     m->line = sg->line;
     m->file = sg->file;
     m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
-    if (v == 0) {
+    if (vr == 0) {
         memset(m->joint_vel, 0, sizeof m->joint_vel);
         return kins_inverse(m->kins, m->pose, m->joint_cmd);
     }
@@ -454,6 +461,12 @@ void motion_tool_changed(struct motion *m, unsigned seq)
         return;
     m->tool_done_seq = seq;
     m->tool.number = m->tool.request;
+}
+
+void motion_set_rates(struct motion *m, bool on)
+{
+    if (m)
+        m->no_rates = !on;
 }
 
 void motion_set_wait_at_speed(struct motion *m, bool on)

@@ -88,8 +88,9 @@ static int run_check(struct check_machine *mc, const struct args *a, struct chec
     check_trace_init(&trace);
     canon_prog_init(&prog);
     canon_prog_init(&contour);
-    if (a->plot_dir)
-        o.trace = &trace;
+    if (!a->plot_dir)   /* streamed: bounded memory, planner and servo pass side by side */
+        return check_program(mc, a->program, &o, res);
+    o.trace = &trace;
     snprintf(res->program, sizeof res->program, "%s", a->program);
     int st = check_machine_interpret(mc, a->program, &prog, &p);
     if (st != CHECK_OK) {
@@ -98,7 +99,7 @@ static int run_check(struct check_machine *mc, const struct args *a, struct chec
     } else {
         st = check_canon(mc, &prog, &o, res);
     }
-    if (a->plot_dir && res->simulated) {
+    if (res->simulated) {
         char err[512];
         if (mkdir(a->plot_dir, 0777) != 0 && errno != EEXIST)   /* one level, like mkdir */
             fprintf(stderr, "hexcnc check: cannot create %s: %s\n", a->plot_dir,
