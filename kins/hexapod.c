@@ -85,6 +85,69 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
     return hexapod_ws_full(h, pose);
 }
 
+/* sin and cos of a small angle d (rad): the series to the term that no longer counts below
+ * 1e-2 rad (the next is 1e-22 relative), else the library's. */
+static void small_sincos(double d, double *s, double *c)
+{
+    if (fabs(d) >= 1e-2) {
+        sincos(d, s, c);
+        return;
+    }
+    double d2 = d * d;
+    *s = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42)));
+    *c = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30 * (1 - d2 / 56)));
+}
+
+/* The orientation of a pose near one whose sines and cosines are known (sa ca ...): by the
+ * angle-sum formulas with the small differences, three sines and cosines fewer. */
+static void rot_near(const double pose[KINS_POSE_DIM], const double near[KINS_POSE_DIM],
+                     const double sc0[6], double t[3], struct hexapod_rot *o)
+{
+    double sc[6];
+    for (int i = 0; i < 3; i++) {
+        double sd, cd, s0 = sc0[2 * i], c0 = sc0[2 * i + 1];
+        small_sincos((near[KINS_A + i] - pose[KINS_A + i]) * HEXAPOD_RAD_PER_DEG, &sd, &cd);
+        sc[2 * i] = s0 * cd + c0 * sd;
+        sc[2 * i + 1] = c0 * cd - s0 * sd;
+        t[i] = near[KINS_X + i];
+    }
+    hexapod_rot_from_sc(o, sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]);
+}
+
+/* The planner's finite differences: the pose as hexapod_inverse does it, its neighbours'
+ * legs from the same sines and cosines. */
+static int hexapod_inverse_near(struct kins *k, const double pose[KINS_POSE_DIM],
+                                const double pm[KINS_POSE_DIM], const double pp[KINS_POSE_DIM],
+                                double *joints, double *joints_m, double *joints_p)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], sc[6];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        if (!isfinite(pose[j]) || !isfinite(pm[j]) || !isfinite(pp[j]))
+            return KINS_ERR_ARG;
+    for (int i = 0; i < 3; i++) {
+        sincos(pose[KINS_A + i] * HEXAPOD_RAD_PER_DEG, &sc[2 * i], &sc[2 * i + 1]);
+        t[i] = pose[KINS_X + i];
+    }
+    hexapod_rot_from_sc(&o, sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]);
+    hexapod_legs_eval(h, t, &o, &lg);
+    int st = hexapod_lengths_of(k, &lg, joints);
+    if (st == KINS_OK && !hexapod_ws_plain(h, pose, &o, &lg))
+        st = hexapod_ws_full(h, pose);
+    struct hexapod_rot on;
+    struct hexapod_legs ln;
+    double tn[3];
+    rot_near(pose, pm, sc, tn, &on);
+    hexapod_legs_eval(h, tn, &on, &ln);
+    hexapod_lengths_of(k, &ln, joints_m);
+    rot_near(pose, pp, sc, tn, &on);
+    hexapod_legs_eval(h, tn, &on, &ln);
+    hexapod_lengths_of(k, &ln, joints_p);
+    return st;
+}
+
 /* Why a pose is outside the workspace: a leg's length first, then the other limits. */
 static int hexapod_describe(struct kins *k, const double pose[KINS_POSE_DIM], char *msg,
                             size_t len)
@@ -304,6 +367,7 @@ const struct kins_ops kins_hexapod_ops = {
     .check = hexapod_check,
     .tool_point = hexapod_tool_point,
     .inverse_rates = hexapod_inverse_rates,
+    .inverse_near = hexapod_inverse_near,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

@@ -24,6 +24,6 @@ $(LIBDIR)/kins/trivial.so: $(KINS_TRIVIAL_SRCS:%.c=$(BUILD)/%.o)
 	$(call say,SO,$@)
 	$(Q)$(CC) $(LDFLAGS) $(KINS_SO_LDFLAGS) $^ -lm -o $@
 
-TESTS += test_kins test_kins_plugin
+TESTS += test_kins test_kins_plugin test_kins_shortcuts
 BENCHES += bench_kins
 SCRIPT_TESTS += tests/e2e/workspace_cli.sh

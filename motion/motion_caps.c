@@ -22,9 +22,14 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     motion_seg_pose(&m->plan, sg, s, o->pose);
     motion_seg_pose(&m->plan, sg, s - h, pm);
     motion_seg_pose(&m->plan, sg, s + h, pp);
-    int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
-    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pm, Lm); /* written even out of range */
-    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pp, Lp);
+    int st;
+    if (sg->tcp) {
+        st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
+        motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pm, Lm); /* written even out of range */
+        motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pp, Lp);
+    } else {
+        st = kins_inverse_near(m->kins, o->pose, pm, pp, o->L, Lm, Lp);
+    }
     for (int i = 0; i < KINS_POSE_DIM; i++) {
         o->dp[i] = (pp[i] - pm[i]) / (2 * h);
         o->d2p[i] = (pp[i] - 2 * o->pose[i] + pm[i]) / (h * h);

@@ -72,6 +72,13 @@ static int new_knots(const struct motion_plan *p, const struct motion_seg *sg, d
     if (sg->kind > SEG_ARC || sg->rotary)
         return 0;
     double eps = 1e-9 * (1 + sg->len), h = sg->len / (double)(sg->nk - 1);
+    /* Reaches from both ends that meet: every knot of sg lies in one and so every interval
+     * has a capped knot at each end, whose lower cap (the sharper arc's) holds over it. A knot
+     * where a reach ends would only let the speed rise towards the gentler arc: short moves
+     * between blends (dense CAM code) keep their two knots. */
+    if (sg->chord_mm[0] > 0 && sg->chord_mm[1] > 0 &&
+        sg->chord_mm[0] + sg->chord_mm[1] >= sg->len - eps)
+        return 0;
     for (int c = 0; c < 2; c++) {
         double x = cand[c];
         if (!(x > eps && x < sg->len - eps) || sg->chord_mm[c] <= 0)

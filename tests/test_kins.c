@@ -7,7 +7,6 @@
 
 #include "kins/hexapod.h"
 #include "kins/kins.h"
-#include "kins/kins_svd.h"
 #include "tests/test_kins_util.h"
 
 #define DEG (M_PI / 180.0)
@@ -276,54 +275,6 @@ START_TEST(test_singular_geometry)
     ck_assert_msg(chk.condition > 1e12, "condition %g", chk.condition);
     kins_free(k);
     free(c);
-}
-END_TEST
-
-/* A 6 x 6 with known singular values: U diag(s) V^T with U, V rotations in two planes. */
-static void known_matrix(const double s[6], double m[36])
-{
-    double u[36] = { 0 }, v[36] = { 0 }, c1 = cos(0.7), s1 = sin(0.7), c2 = cos(-1.1),
-           s2 = sin(-1.1);
-    for (int i = 0; i < 6; i++)
-        u[i * 6 + i] = v[i * 6 + i] = 1;
-    u[0] = c1, u[1] = -s1, u[6] = s1, u[7] = c1;         /* U turns rows 0,1 */
-    v[4 * 6 + 4] = c2, v[4 * 6 + 5] = -s2, v[5 * 6 + 4] = s2, v[5 * 6 + 5] = c2;
-    for (int i = 0; i < 6; i++)
-        for (int j = 0; j < 6; j++) {
-            double a = 0;
-            for (int k = 0; k < 6; k++)
-                a += u[i * 6 + k] * s[k] * v[j * 6 + k];
-            m[i * 6 + j] = a;
-        }
-}
-
-/* The condition number is the ratio of the extreme singular values: from the Gram matrix
- * where that is accurate, by SVD where it is not (and +inf for a rank-deficient matrix). */
-START_TEST(test_condition_number)
-{
-    double m[36], cond;
-    const double well[6] = { 3, 2.5, 2, 1.5, 1.2, 0.75 };      /* 4 */
-    known_matrix(well, m);
-    ck_assert_int_eq(kins_svd_condition(m, 6, 6, &cond), 0);
-    ck_assert_msg(fabs(cond / 4.0 - 1) < 1e-12, "condition %.15g", cond);
-    const double ill[6] = { 2, 1, 1, 1, 1, 2e-7 };             /* 1e7: the SVD's branch */
-    known_matrix(ill, m);
-    ck_assert_int_eq(kins_svd_condition(m, 6, 6, &cond), 0);
-    ck_assert_msg(fabs(cond / 1e7 - 1) < 1e-8, "condition %.15g", cond);
-    const double mid[6] = { 5, 4, 3, 2, 1, 5e-3 };             /* 1000: still the Gram's */
-    known_matrix(mid, m);
-    ck_assert_int_eq(kins_svd_condition(m, 6, 6, &cond), 0);
-    ck_assert_msg(fabs(cond / 1000.0 - 1) < 1e-9, "condition %.15g", cond);
-    const double rank5[6] = { 2, 1, 1, 1, 1, 0 };
-    known_matrix(rank5, m);
-    ck_assert_int_eq(kins_svd_condition(m, 6, 6, &cond), 0);
-    ck_assert_msg(cond > 1e15, "condition %g", cond);
-    double wide[2 * 3] = { 3, 0, 0, 0, 1, 0 };                  /* 2 x 3: 3 */
-    ck_assert_int_eq(kins_svd_condition(wide, 2, 3, &cond), 0);
-    ck_assert_double_eq_tol(cond, 3.0, 1e-12);
-    m[7] = NAN;
-    ck_assert_int_eq(kins_svd_condition(m, 6, 6, &cond), -1);
-    ck_assert_int_eq(kins_svd_condition(m, 10, 6, &cond), -1);
 }
 END_TEST
 
@@ -766,7 +717,6 @@ static Suite *kins_suite(void)
     tcase_add_test(tc, test_inverse_rates);
     tcase_add_test(tc, test_singular_geometry);
     tcase_add_test(tc, test_singular_pose);
-    tcase_add_test(tc, test_condition_number);
     tcase_add_test(tc, test_failures);
     tcase_add_test(tc, test_config_errors);
     tcase_add_test(tc, test_two_instances);
