@@ -80,6 +80,8 @@ struct canon_cmd {
     double feed_mm_min;    /* FEED, ARC: the feed in force (FEED_RATE: the new feed) */
     double inverse_time_min; /* FEED, ARC under G93: minutes the move must take, else 0 */
     double value;          /* DWELL s, PATH_MODE tol, SPINDLE_* rpm/dir, FEED_MODE */
+    double naive_tol_mm;   /* PATH_MODE under G64: Q, LinuxCNC's naive CAM tolerance (straight
+                            * feeds that stay within it of one line run as that line) */
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
     int spline;            /* FEED: a chord of a G5.1 spline, 1 the block's first, 2 the

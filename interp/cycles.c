@@ -244,6 +244,6 @@ int interp_cycle(struct interp *in, int g)
         CHP(cycle_hole(in, &c));
     }
     if (restore)
-        CHP(path_mode(in, in->path_mode, in->path_tol_mm));
+        CHP(interp_emit_path_mode(in));
     return 0;
 }

@@ -57,6 +57,17 @@ static int emit_simple(struct interp *in, enum canon_type t, double value, int i
     return interp_emit(in, &c);
 }
 
+int interp_emit_path_mode(struct interp *in)
+{
+    struct canon_cmd c;
+    interp_cmd_init(in, &c, CANON_PATH_MODE);
+    c.ivalue = in->path_mode;
+    c.value = in->path_mode == 640 ? in->path_tol_mm : 0.0;
+    c.naive_tol_mm = in->path_mode == 640 ? in->naive_cam_tol_mm : 0.0;
+    c.feed_mm_min = in->feed_mm_min;
+    return interp_emit(in, &c);
+}
+
 void interp_modal_save(const struct interp *in, struct modal_save *m)
 {
     m->valid = 1;
@@ -86,12 +97,12 @@ int interp_modal_restore(struct interp *in, const struct modal_save *m)
         in->feed_mm_min = m->feed_mm_min;
         CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
     }
-    if (in->path_mode != m->path_mode || in->path_tol_mm != m->path_tol_mm) {
+    if (in->path_mode != m->path_mode || in->path_tol_mm != m->path_tol_mm ||
+        in->naive_cam_tol_mm != m->naive_cam_tol_mm) {
         in->path_mode = m->path_mode, in->path_tol_mm = m->path_tol_mm;
-        CHP(emit_simple(in, CANON_PATH_MODE, in->path_mode == 640 ? in->path_tol_mm : 0.0,
-                        in->path_mode));
+        in->naive_cam_tol_mm = m->naive_cam_tol_mm;
+        CHP(interp_emit_path_mode(in));
     }
-    in->naive_cam_tol_mm = m->naive_cam_tol_mm;
     if (in->spindle_rpm != m->spindle_rpm) {
         in->spindle_rpm = m->spindle_rpm;
         CHP(emit_simple(in, CANON_SPINDLE_SPEED, in->spindle_rpm, 0));
@@ -372,12 +383,13 @@ static int exec_modes(struct interp *in)
         if (in->path_tol_mm < 0)
             return interp_fail(in, INTERP_ERR_WORD, W('p'), "G64 P (blend tolerance) must not "
                                "be negative");
-        in->naive_cam_tol_mm = b->g[13] == 640 && W('q') ? interp_len_mm(in, V('q')) : 0.0;
+        /* Q absent: P's value, as LinuxCNC takes it */
+        in->naive_cam_tol_mm = b->g[13] != 640 ? 0.0 : W('q') ? interp_len_mm(in, V('q'))
+                                                               : in->path_tol_mm;
         if (in->naive_cam_tol_mm < 0)
             return interp_fail(in, INTERP_ERR_WORD, W('q'), "G64 Q (naive CAM tolerance) must "
                                "not be negative");
-        CHP(emit_simple(in, CANON_PATH_MODE, b->g[13] == 640 ? in->path_tol_mm : 0.0,
-                        b->g[13]));
+        CHP(interp_emit_path_mode(in));
     }
     if (b->g[3] >= 0)
         in->incremental = b->g[3] == 910;

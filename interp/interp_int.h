@@ -223,6 +223,8 @@ struct interp {
     int normcol[INTERP_LINE_MAX];/* original column of each norm char */
 };
 
+/* A PATH_MODE command for the path mode, G64 P and Q in force (exec.c). */
+int interp_emit_path_mode(struct interp *in);
 /* exec.c: M70..M73 state: fills a save; restores one (emitting what changed). */
 void interp_modal_save(const struct interp *in, struct modal_save *m);
 int interp_modal_restore(struct interp *in, const struct modal_save *m);

@@ -199,9 +199,13 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
         snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", (int)c->value);
         break;
     case CANON_PATH_MODE:
-        if (c->ivalue == 640)
+        if (c->ivalue == 640) {   /* and the naive CAM tolerance, on a line of its own */
             snprintf(tmp, sizeof tmp, "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, %f)\n",
                      c->value * k);
+            puts_(p, tmp);
+            line_start(p, c);
+            snprintf(tmp, sizeof tmp, "SET_NAIVECAM_TOLERANCE(%.4f)\n", c->naive_tol_mm * k);
+        }
         else
             snprintf(tmp, sizeof tmp, "SET_MOTION_CONTROL_MODE(%s)\n",
                      c->ivalue == 611 ? "CANON_EXACT_STOP" : "CANON_EXACT_PATH");

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "motion/motion_blend.h"
+#include "motion/motion_merge.h"
 #include "motion/motion_priv.h"
 
 /* Formats the instance's message. */
@@ -126,10 +127,19 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     m->fault_status = MOTION_OK;
     /* G64 P corners become tangent arcs first (motion_blend.c); the planner then treats
      * them like any programmed arc */
-    struct canon_prog blended;
+    struct canon_prog blended, merged;
     struct motion_blend_abc *abc = NULL;
-    size_t nblends = 0;
-    int st = motion_blend_program(&m->cfg, prog, &blended, &nblends, &abc);
+    size_t nblends = 0, nmerged = 0;
+    int st = 0;
+    canon_prog_init(&merged);
+    if (motion_merge_wanted(prog)) {   /* G64 Q: runs of straight feeds as single lines */
+        st = motion_merge_program(prog, &merged, &nmerged) ? MOTION_ERR_NOMEM : 0;
+        prog = &merged;
+    }
+    if (!st)
+        st = motion_blend_program(&m->cfg, prog, &blended, &nblends, &abc);
+    else
+        canon_prog_init(&blended);
     if (st)
         motion_set_msg(m, "out of memory planning the program");
     if (!st)
@@ -139,18 +149,20 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     if (!st)
         st = motion_plan_profile(m, m->msg, sizeof m->msg);
     m->plan.info.blends = nblends;
+    m->plan.info.merged = nmerged;
     double L[KINS_MAX_JOINTS];
     if (!st && m->plan.nseg == 0 && kins_inverse(m->kins, prog->start, L) != KINS_OK) {
         motion_set_msg(m, "the program's start position is outside the machine's "
                  "reach");
         st = MOTION_ERR_UNREACHABLE;
     }
+    memcpy(m->start_pose, prog->start, sizeof m->start_pose);
+    canon_prog_free(&merged);          /* (prog pointed at it: not used below) */
     if (st) {
         motion_plan_free(&m->plan);
         return fail(m, st, err, errlen);
     }
-    memcpy(m->start_pose, prog->start, sizeof m->start_pose);
-    memcpy(m->pose, prog->start, sizeof m->pose);
+    memcpy(m->pose, m->start_pose, sizeof m->pose);
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);

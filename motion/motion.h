@@ -142,6 +142,7 @@ struct motion_plan_info {
     int limited_by_legs;     /* samples where leg limits lowered the speed below the feed */
     int limited_by_kin_tol;  /* samples where the kinematic-error bound lowered it */
     size_t blends;           /* G64 P corners rounded by a tangent arc (motion_blend.h) */
+    size_t merged;           /* straight feeds that G64 Q ran inside a longer line */
     size_t stops_held;       /* stops where the path changes direction, held for one set-point
                               * period so that a set point lands on them (docs/motion.md) */
 };

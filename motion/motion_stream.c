@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "motion/motion_blend.h"
+#include "motion/motion_merge.h"
 #include "motion/motion_priv.h"
 
 /*
@@ -52,6 +53,7 @@ struct motion_stream {
     int ended;
     int status;                     /* first error (then nothing more is planned) */
     char err[400];
+    struct motion_merge merge;      /* G64 Q: runs of straight feeds held until they end */
 };
 
 static bool is_move(enum canon_type t)
@@ -82,6 +84,7 @@ int motion_stream_create(struct motion *m, const double start[KINS_POSE_DIM],
     memcpy(s->start0, start, sizeof s->start0);
     const struct motion_config *c = &m->cfg;
     s->tol_mm = c->blend_tol_mm;    /* a program starts in G64 (LinuxCNC's default) */
+    motion_merge_init(&s->merge, start, 0, 0, 0);
     double acc = c->max_lin_acc_mm_s2;
     for (int j = 0; j < m->nj; j++)
         acc = fmin(acc, c->joint[j].max_acc_mm_s2);
@@ -368,10 +371,10 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     return publish(s, c);
 }
 
-int motion_stream_add(struct motion_stream *s, const struct canon_cmd *cmd)
+/* One command past the G64 Q filter into the window. */
+static int take(void *ctx, const struct canon_cmd *cmd)
 {
-    if (s->status)
-        return s->status;
+    struct motion_stream *s = ctx;
     if (s->ended)
         return MOTION_OK;       /* after M2/M30 nothing runs (motion_path_build's rule) */
     if (s->n + 1 >= s->cap) {       /* one spare: shift_window may need it */
@@ -397,18 +400,28 @@ int motion_stream_add(struct motion_stream *s, const struct canon_cmd *cmd)
     return MOTION_OK;
 }
 
+int motion_stream_add(struct motion_stream *s, const struct canon_cmd *cmd)
+{
+    if (s->status)
+        return s->status;
+    int st = motion_merge_add(&s->merge, cmd, take, s);
+    return st ? st : s->status;
+}
+
 int motion_stream_finish(struct motion_stream *s)
 {
     if (s->status)
         return s->status;
-    return plan_window(s, true, false);
+    int st = motion_merge_flush(&s->merge, take, s);
+    return st ? st : plan_window(s, true, false);
 }
 
 int motion_stream_sync(struct motion_stream *s)
 {
     if (s->status)
         return s->status;
-    return plan_window(s, true, true);
+    int st = motion_merge_flush(&s->merge, take, s);
+    return st ? st : plan_window(s, true, true);
 }
 
 const char *motion_stream_error(const struct motion_stream *s)
@@ -420,6 +433,7 @@ void motion_stream_info(const struct motion_stream *s, struct motion_stream_info
 {
     memset(out, 0, sizeof *out);
     out->plan = s->info;
+    out->plan.merged = s->merge.merged;
     out->windows = s->windows;
     out->entry_shortfall = s->deficit;
     out->window_capacity = s->cap;

@@ -109,7 +109,11 @@ START_TEST(g64_q_is_stored)
     interp_get_view(in, &v);
     ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.0127, 1e-12);  /* inch to mm */
     canon_prog_free(&p);
-    ck_assert_int_eq(run_on(in, "G21 G64 P0.02\nM2\n", &p), 0);
+    ck_assert_int_eq(run_on(in, "G21 G64 P0.02\nM2\n", &p), 0);   /* no Q: P's, as rs274 */
+    interp_get_view(in, &v);                                       /* prints it */
+    ck_assert_double_eq_tol(v.naive_cam_tol_mm, 0.02, 1e-15);
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G21 G64\nM2\n", &p), 0);
     interp_get_view(in, &v);
     ck_assert_double_eq(v.naive_cam_tol_mm, 0.0);
     canon_prog_free(&p);

@@ -220,6 +220,24 @@ START_TEST(machine_words)
 }
 END_TEST
 
+/* G64's Q (the naive CAM tolerance) as rs274 prints it: Q absent takes P's value, G64 alone
+ * and G61 have none, inches are converted, M72 puts back the Q it saved. */
+START_TEST(naive_cam_tolerance)
+{
+    struct canon_prog p;
+    interp_ok("G21\nG64 P0.02\nG64 P0.02 Q0.005\nG64\nG64 Q0.03\nG61\nG20 G64 P0.001 Q0.002\n"
+              "G21 G64 P0.01 Q0.004\nM70\nG64 P0.05 Q0.05\nM72\nM30\n", &p);
+    const double q[] = { 0.02, 0.005, 0, 0.03, 0, 0.0508, 0.004, 0.05, 0.004 };
+    for (int k = 0; k < (int)(sizeof q / sizeof q[0]); k++)
+        ck_assert_msg(fabs(nth(&p, CANON_PATH_MODE, k)->naive_tol_mm - q[k]) < 1e-12,
+                      "PATH_MODE %d: Q %.6f, expected %.6f", k,
+                      nth(&p, CANON_PATH_MODE, k)->naive_tol_mm, q[k]);
+    ck_assert_int_eq(nth(&p, CANON_PATH_MODE, 8)->ivalue, 640);
+    ck_assert_double_eq_tol(nth(&p, CANON_PATH_MODE, 8)->value, 0.01, 1e-12);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* G141 blocks are resolved like G1 (offsets, units) and handed to the compensation. The
  * tool comes in along the compensated line, 10 mm before its start (from the contour line
  * itself it would cut the wall's start: the gouge check refuses that). */
@@ -323,6 +341,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, offsets_g10_l20_and_homes);
     tcase_add_test(tc, tool_length);
     tcase_add_test(tc, machine_words);
+    tcase_add_test(tc, naive_cam_tolerance);
     tcase_add_test(tc, g141_hand_off);
     tcase_add_test(tc, g5_1_quadratic_spline);
     suite_add_tcase(s, tc);
