@@ -34,13 +34,16 @@ static struct canon_setting *canon_setting_dup(const struct canon_setting *s)
 {
     size_t tool = s->tool ? sizeof *s->tool : 0;
     size_t params = s->nparams * sizeof *s->params;
-    struct canon_setting *d = malloc(sizeof *d + tool + params);
+    size_t text = s->text ? strlen(s->text) + 1 : 0;
+    struct canon_setting *d = malloc(sizeof *d + tool + params + text);
     if (!d)
         return NULL;
     unsigned char *after = (unsigned char *)(d + 1);
     d->tool = NULL;
     d->nparams = s->nparams;
     d->params = NULL;
+    d->note = s->note;
+    d->text = NULL;
     if (tool) {
         memcpy(after, s->tool, tool);
         d->tool = (const struct tool_entry *)after;
@@ -48,6 +51,10 @@ static struct canon_setting *canon_setting_dup(const struct canon_setting *s)
     if (params) {
         memcpy(after + tool, s->params, params);
         d->params = (const struct canon_param *)(after + tool);
+    }
+    if (text) {
+        memcpy(after + tool + params, s->text, text);
+        d->text = (const char *)(after + tool + params);
     }
     return d;
 }

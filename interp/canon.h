@@ -26,7 +26,8 @@ enum canon_type {
     CANON_TOOL_CHANGE,     /* M6 (value 0) or M61 Q (value 1: the number only, no change):
                             * ivalue = the tool now in the spindle */
     CANON_COOLANT,         /* M7 (ivalue 7), M8 (8), M9 (9) */
-    CANON_COMMENT,         /* ( ... ): text */
+    CANON_COMMENT,         /* ( ... ): text; ivalue a CANON_NOTE_* for an active comment
+                            * (its text then expanded: printers show rs274's MESSAGE, LOG...) */
     CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */
     CANON_PROGRAM_END,     /* M2 / M30 (ivalue 2 or 30) */
     CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]) */
@@ -65,11 +66,27 @@ struct canon_param {
 
 struct tool_entry;
 
-/* The payload of CANON_SETTING: what the machine saves when it executes the line. */
+/* What a comment asks of the machine when its line executes (LinuxCNC's active comments). */
+enum canon_note {
+    CANON_NOTE_NONE = 0,
+    CANON_NOTE_MSG,        /* (MSG, text): a message to the operator */
+    CANON_NOTE_DEBUG,      /* (DEBUG, text #1 #<name>): the same, parameters in their values */
+    CANON_NOTE_PRINT,      /* (PRINT, text): on the controller's standard error */
+    CANON_NOTE_LOGOPEN,    /* (LOGOPEN, file): the log file, new */
+    CANON_NOTE_LOGAPPEND,  /* (LOGAPPEND, file): the log file, added to */
+    CANON_NOTE_LOG,        /* (LOG, text): a line in the log file */
+    CANON_NOTE_LOGCLOSE,   /* (LOGCLOSE) */
+};
+
+/* The payload of CANON_SETTING: what the machine saves (or says, or logs) when it executes
+ * the line. */
 struct canon_setting {
     const struct tool_entry *tool; /* the tool's whole entry after G10 L1, or NULL */
     size_t nparams;                /* persistent parameters the line changed */
     const struct canon_param *params;
+    enum canon_note note;          /* a comment's action, or CANON_NOTE_NONE */
+    const char *text;              /* its text, parameters expanded (a log file: its path,
+                                    * relative ones from the program's folder) */
 };
 
 struct canon_cmd {

@@ -626,12 +626,8 @@ int interp_execute(struct interp *in)
     b->plane_before = in->plane;
     if (!comp && !block_empty(b))
         CHP(flush_comp5(in));
-    if (b->has_comment) {
-        struct canon_cmd c;
-        interp_cmd_init(in, &c, CANON_COMMENT);
-        c.text = b->comment;
-        CHP(interp_emit(in, &c));
-    }
+    if (b->has_comment)
+        CHP(interp_comment(in, b->comment));
     double tool_before[6], pos_before[6];
     memcpy(tool_before, in->tool, sizeof tool_before);
     CHP(exec_machine_words(in));

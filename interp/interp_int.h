@@ -223,6 +223,9 @@ struct interp {
     int normcol[INTERP_LINE_MAX];/* original column of each norm char */
 };
 
+/* messages.c: a line's ( ) comment: COMMENT, and for (MSG,) (DEBUG,) (PRINT,) (LOG...) the
+ * SETTING the machine acts on when the line executes. */
+int interp_comment(struct interp *in, const char *text);
 /* A PATH_MODE command for the path mode, G64 P and Q in force (exec.c). */
 int interp_emit_path_mode(struct interp *in);
 /* exec.c: M70..M73 state: fills a save; restores one (emitting what changed). */

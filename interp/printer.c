@@ -186,7 +186,7 @@ static void put_offsets(struct interp_printer *p, const struct interp_view *v, i
 static void put_other(struct interp_printer *p, const struct interp_view *v,
                       const struct canon_cmd *c)
 {
-    char tmp[300];
+    char tmp[700];
     double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
     switch (c->type) {
     case CANON_DWELL: put_call(p, "DWELL", &c->value, 1, 4); return;
@@ -233,12 +233,20 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
         snprintf(tmp, sizeof tmp, "SET_%s_OUTPUT_VALUE(%d,%f)\n", c->immediate ? "AUX" :
                  "MOTION", c->ivalue, c->value);
         break;
-    case CANON_COMMENT:
-        if (c->text && strncasecmp(c->text, "msg,", 4) == 0)
-            snprintf(tmp, sizeof tmp, "MESSAGE(\"%s\")\n", c->text + 4);
+    case CANON_COMMENT: {
+        static const char *const call[] = {
+            [CANON_NOTE_NONE] = "COMMENT", [CANON_NOTE_MSG] = "MESSAGE",
+            [CANON_NOTE_DEBUG] = "MESSAGE", [CANON_NOTE_LOGOPEN] = "LOGOPEN",
+            [CANON_NOTE_LOGAPPEND] = "LOGAPPEND", [CANON_NOTE_LOG] = "LOG",
+        };
+        if (c->ivalue == CANON_NOTE_LOGCLOSE)
+            snprintf(tmp, sizeof tmp, "LOGCLOSE()\n");
         else
-            snprintf(tmp, sizeof tmp, "COMMENT(\"%s\")\n", c->text ? c->text : "");
+            snprintf(tmp, sizeof tmp, "%s(\"%s\")\n", c->ivalue > 0 && c->ivalue <=
+                     CANON_NOTE_LOG && call[c->ivalue] ? call[c->ivalue] : "COMMENT",
+                     c->text ? c->text : "");
         break;
+    }
     case CANON_PAUSE:
         snprintf(tmp, sizeof tmp, "%s\n", c->ivalue ? "OPTIONAL_PROGRAM_STOP()" : "PROGRAM_STOP()");
         break;
@@ -253,6 +261,11 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
 {
     struct interp_printer *p = ctx;
     struct interp_view v;
+    if (c->type == CANON_COMMENT && c->ivalue == CANON_NOTE_PRINT) {   /* rs274: the text, */
+        puts_(p, c->text ? c->text : "");                            /* no call */
+        puts_(p, "\n");
+        return p->failed ? -1 : 0;
+    }
     if (c->type == CANON_SETTING || c->type == CANON_WAIT_INPUT)  /* rs274 prints no such call */
         return 0;
     interp_get_view(p->in, &v);

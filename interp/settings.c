@@ -84,6 +84,8 @@ static int file_writable(const char *path, const char *what, char *err, size_t e
 int interp_setting_check(const struct interp *in, const struct canon_setting *s, char *err,
                          size_t errlen)
 {
+    if ((s->note == CANON_NOTE_LOGOPEN || s->note == CANON_NOTE_LOGAPPEND) && s->text)
+        CHP(file_writable(s->text, "log file", err, errlen));
     if (s->nparams && in->param_path)
         CHP(file_writable(in->param_path, "parameter file", err, errlen));
     if (s->tool && in->tt && in->tt->path[0])
@@ -91,7 +93,8 @@ int interp_setting_check(const struct interp *in, const struct canon_setting *s,
     return INTERP_OK;
 }
 
-/* Applies an executed setting to in's parameters and tool table, then saves their files. */
+/* Applies an executed setting to in's parameters and tool table, then saves their files (a
+ * comment's action is the machine's: nothing here). */
 int interp_setting_apply(struct interp *in, const struct canon_setting *s, char *err,
                          size_t errlen)
 {

@@ -82,6 +82,7 @@ struct runner {
     struct tooltable *store_tt;         /* its tool table */
     size_t settings_applied;            /* settings saved so far in this run */
     char save_err[800];                 /* why a save failed ("" when none has) */
+    FILE *log;                          /* the program's (LOGOPEN,) file, open ("" NULL) */
 
     /* The task's own pins, as LinuxCNC's iocontrol: the HAL files wire them to the e-stop
      * chain. user-enable-out is the operator's "machine on"; user-request-enable pulses for
@@ -135,6 +136,10 @@ int runner_settings_load(struct runner *r, const struct canon_prog *prog, char *
                          size_t errlen);
 void runner_settings_apply(struct runner *r);
 void runner_settings_free(struct runner *r);
+/* What a setting does, in words ("changes the tool table", "opens a log file"). */
+const char *runner_setting_what(const struct canon_setting *s);
+/* Closes the program's log file, if one is open. */
+void runner_log_close(struct runner *r);
 /* The interpreter settings are saved through, for a streamed run (its settings come later). */
 int runner_settings_store(struct runner *r, char *err, size_t errlen);
 

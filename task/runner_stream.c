@@ -75,9 +75,9 @@ static int take(struct stream_sink *k, const struct canon_cmd *c)
         if (k->store) {
             char msg[700], text[800];
             if (interp_setting_check(k->store, c->setting, msg, sizeof msg) != INTERP_OK) {
-                snprintf(text, sizeof text, "%s:%d: this line changes %s, saved when the line "
-                         "executes, but %s", c->file, c->line, c->setting->tool
-                         ? "the tool table" : "persistent parameters", msg);
+                snprintf(text, sizeof text, "%s:%d: this line %s, saved when the line "
+                         "executes, but %s", c->file, c->line,
+                         runner_setting_what(c->setting), msg);
                 return sink_fail(k, RUNNER_ERR_CONFIG, "%s", text);
             }
         }

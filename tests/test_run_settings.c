@@ -246,6 +246,33 @@ START_TEST(unwritable_param_file)
 }
 END_TEST
 
+/* (LOGOPEN,) is written when its line executes, like a setting: into a folder that does
+ * not exist, the program is refused at load naming the line; loading writes nothing, the
+ * run writes its lines, relative paths from the program's folder. */
+START_TEST(log_file_as_lines_execute)
+{
+    struct machine m;
+    machine_init(&m, NULL);
+    char err[1024], log[160];
+    spit(m.prog, "G0 X0 Y0 Z645\n(LOGOPEN,/nonexistent-hexcnc-dir/p.log)\nG1 X10 F2\nM2\n");
+    struct runner *r = machine_runner(&m);
+    ck_assert_int_eq(runner_load_program(r, m.prog, err, sizeof err), RUNNER_ERR_CONFIG);
+    ck_assert_msg(strstr(err, "p.ngc:2:") && strstr(err, "opens a log file") &&
+                  strstr(err, "/nonexistent-hexcnc-dir"), "%s", err);
+    snprintf(log, sizeof log, "%s/p.log", m.dir);
+    spit(m.prog, "G0 X0 Y0 Z645\n#1=7\n(LOGOPEN,p.log)\n(LOG,one #1)\nG1 X10 F2\n"
+                 "(LOG,two)\nM2\n");
+    ck_assert_msg(runner_load_program(r, m.prog, err, sizeof err) == RUNNER_OK, "%s", err);
+    ck_assert(access(log, F_OK) != 0);                  /* loading writes nothing */
+    ck_assert_msg(runner_start(r, err, sizeof err) == RUNNER_OK, "%s", err);
+    ck_assert_msg(runner_run(r, NULL, NULL, NULL, err, sizeof err) == RUNNER_OK, "%s", err);
+    ck_assert_str_eq(slurp(log), "one 7.000000\ntwo\n");
+    runner_destroy(r);
+    unlink(log);
+    machine_free(&m);
+}
+END_TEST
+
 static Suite *run_settings_suite(void)
 {
     Suite *s = suite_create("run_settings");
@@ -256,6 +283,7 @@ static Suite *run_settings_suite(void)
     tcase_add_test(tc, faulted_run_saves_executed_lines_only);
     tcase_add_test(tc, refused_program_saves_nothing);
     tcase_add_test(tc, unwritable_param_file);
+    tcase_add_test(tc, log_file_as_lines_execute);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -346,6 +346,30 @@ def plain_session(tmp):
           "result" in r and st["motion"] == "done" and abs(end[0] - here[0] - 2) < 1e-6 and
           max(abs(a - b) for a, b in zip(end[1:], here[1:])) < 1e-6, (r, here, end))
 
+    # active comments: (MSG,) and (DEBUG,) reach the operator and (LOG...) the log file as
+    # their lines execute; `hexcnc check` of the same program writes no file
+    prog = os.path.join(tmp, "notes.ngc")
+    log = os.path.join(tmp, "notes.log")
+    open(prog, "w").write("G21 G90\n#1=2.5\n#<depth>=-1.25\n(MSG, tool change next)\n"
+                          "(DEBUG, depth #<depth> at #1, #<nothing>)\n(LOGOPEN,notes.log)\n"
+                          "G1 X[%.4f + 1] F3000\n(LOG,x=#<_x> depth=#<depth>)\n(LOGCLOSE)\n"
+                          "(LOG,after the close)\nM2\n" % here[0])
+    chk = subprocess.run([BIN, "check", os.path.join(SIM, "tmu-hexapod.ini"), prog],
+                         capture_output=True, text=True)
+    check("check of a program that logs: passes, writes no log file",
+          chk.returncode == 0 and not os.path.exists(log), (chk.returncode, chk.stdout[-300:]))
+    c.notes.clear()
+    c.ok("program.open", path=prog)
+    c.ok("program.run")
+    st = c.wait()
+    msgs = c.messages()
+    check("(MSG,) and (DEBUG,) reach the operator, parameters in their values",
+          st["motion"] == "done" and " tool change next" in msgs and
+          " depth -1.250000 at 2.500000, ######" in msgs, (st["motion"], msgs))
+    text = open(log).read() if os.path.exists(log) else None
+    check("(LOGOPEN,) (LOG,) (LOGCLOSE): the log file beside the program, one line",
+          text == "x=%.6f depth=-1.250000\n" % (here[0] + 1), text)
+
     # M66: a time-out, a wait until an input is set, an analog input read at once; the
     # branches after each take the machine's answer (#5399)
     c.ok("hal.set", name="motion.analog-in-00", value=2.5)
