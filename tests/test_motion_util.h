@@ -113,6 +113,36 @@ static inline void tm_arc(struct canon_prog *p, int line, const double *end, con
         abort();
 }
 
+/* n small arcs of radius r mm, each sweeping sweep_deg, in the XY plane at height z: two
+ * counter-clockwise (G3), two clockwise (G2), and so on, each joined to the last at its
+ * tangent turned by kink_deg (0: tangent joints where the curvature changes sign), after a
+ * G64 P tol_mm. The path of LinuxCNC's issue 3773 (small G3 segments of radius about 4 mm). */
+static inline void tm_small_arcs(struct canon_prog *p, int n, double r, double sweep_deg,
+                                 double kink_deg, double feed_mm_min, double z, double tol_mm)
+{
+    const double rad = M_PI / 180, nz[3] = { 0, 0, 1 };
+    double at[6] = { 0, 0, z, 0, 0, 0 }, head = 0;
+    canon_prog_init(p);
+    memcpy(p->start, at, sizeof at);
+    struct canon_cmd pm;
+    memset(&pm, 0, sizeof pm);
+    pm.type = CANON_PATH_MODE, pm.line = 1, pm.file = "test.ngc", pm.ivalue = 640;
+    pm.value = tol_mm;
+    if (canon_prog_sink(p, &pm))
+        abort();
+    for (int i = 0; i < n; i++) {
+        int ccw = (i / 2) % 2 == 0;
+        double side = ccw ? 1 : -1, c[3], e[6];
+        c[0] = at[0] - side * r * sin(head), c[1] = at[1] + side * r * cos(head), c[2] = z;
+        double a0 = atan2(at[1] - c[1], at[0] - c[0]), a1 = a0 + side * sweep_deg * rad;
+        memcpy(e, at, sizeof e);
+        e[0] = c[0] + r * cos(a1), e[1] = c[1] + r * sin(a1);
+        tm_arc(p, i + 2, e, c, nz, ccw ? 1 : -1, feed_mm_min);
+        head += side * sweep_deg * rad + kink_deg * rad;
+        memcpy(at, e, sizeof at);
+    }
+}
+
 /* What a run measured. */
 struct tm_stats {
     int steps;
