@@ -106,18 +106,6 @@ static void tip_of(const struct sim *s, const struct motion_out *out, const doub
     memcpy(tip, prog, 3 * sizeof *tip);
 }
 
-/* Distance of p from the segment a..b (from a when they coincide). */
-static double dist_seg(const double p[3], const double a[3], const double b[3])
-{
-    double d[3], w[3], n2 = 0, u = 0, e2 = 0;
-    for (int i = 0; i < 3; i++)
-        d[i] = b[i] - a[i], w[i] = p[i] - a[i], n2 += d[i] * d[i], u += w[i] * d[i];
-    u = n2 > 1e-24 ? fmin(1, fmax(0, u / n2)) : 0;
-    for (int i = 0; i < 3; i++)
-        e2 += (w[i] - u * d[i]) * (w[i] - u * d[i]);
-    return sqrt(e2);
-}
-
 /* The largest tip deviation of the move just left, as a problem when beyond the tolerance. */
 static void tip_flush(struct sim *s)
 {
@@ -187,7 +175,7 @@ static void tip_period(struct sim *s, const struct motion_out *out)
         return;
     double tip[3];
     tip_of(s, out, out->pose, tip);
-    tip_record(s, out, dist_seg(tip, s->tip_t0, s->tip_t1));
+    tip_record(s, out, motion_dist_seg(tip, s->tip_t0, s->tip_t1));
 }
 
 /* Kinematic deviation between the previous set point and this one: the legs at mid-chord
@@ -222,11 +210,11 @@ static double deviation(struct sim *s, const struct motion_out *out, double *ang
         double tm[3], t0[3], t1[3];
         tip_of(s, out, P, tm);
         if (s->tip_line && !s->tip_fresh) {
-            tip_record(s, out, dist_seg(tm, s->tip_t0, s->tip_t1));
+            tip_record(s, out, motion_dist_seg(tm, s->tip_t0, s->tip_t1));
         } else if (out->seg_kind) {
             tip_of(s, out, s->p0, t0);
             tip_of(s, out, out->pose, t1);
-            tip_record(s, out, dist_seg(tm, t0, t1));
+            tip_record(s, out, motion_dist_seg(tm, t0, t1));
         }
     }
     return sqrt(e2);

@@ -327,6 +327,8 @@ bool motion_pose_known(const struct motion *m);
 /* Spindle (motion_step.c): whether programs planned from now on stop after M3/M4 and S
  * changes until the spindle reports it is at speed, and that report, each period. */
 void motion_set_wait_at_speed(struct motion *m, bool on);
+/* Distance of point p from the segment a..b (X Y Z, mm); from a when the two coincide. */
+double motion_dist_seg(const double p[3], const double a[3], const double b[3]);
 /* Off: motion_step computes the leg positions alone, joint_vel and pose_vel read 0 (a check
  * that differences successive set points; a fifth less time per period). On by default. */
 void motion_set_rates(struct motion *m, bool on);

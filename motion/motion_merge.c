@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "motion/motion.h"
 #include "motion/motion_merge.h"
 
 void motion_merge_init(struct motion_merge *g, const double start[KINS_POSE_DIM], int tcp,
@@ -28,8 +29,7 @@ static int holdable(const struct motion_merge *g, const struct canon_cmd *c)
     return c->end[0] != g->at[0] || c->end[1] != g->at[1] || c->end[2] != g->at[2];
 }
 
-/* Distance of p from the segment a..b. */
-static double dist_seg(const double p[3], const double a[3], const double b[3])
+double motion_dist_seg(const double p[3], const double a[3], const double b[3])
 {
     double d[3], w[3], n2 = 0, u = 0, e2 = 0;
     for (int i = 0; i < 3; i++)
@@ -48,7 +48,7 @@ static int joins(const struct motion_merge *g, const struct canon_cmd *c)
         c->file != g->last.file)
         return 0;
     for (int k = 0; k < g->n; k++)
-        if (dist_seg(g->pts[k], g->at, c->end) > g->tol_mm)
+        if (motion_dist_seg(g->pts[k], g->at, c->end) > g->tol_mm)
             return 0;
     return 1;
 }
