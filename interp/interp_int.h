@@ -4,6 +4,7 @@
 
 #include <stdarg.h>
 
+#include "interp/ccomp.h"
 #include "interp/comp5.h"
 #include "interp/interp.h"
 #include "kins/kins.h"
@@ -218,6 +219,7 @@ struct interp {
     struct oword ow;             /* O-word control flow */
     struct modal_save m70;       /* the state M70 saved, for M72 */
     struct comp5 comp;           /* G141/G142 run in progress */
+    struct ccomp cc;             /* G41/G42 cutter compensation and its queued move */
     struct interp_block blk;     /* the block being worked on */
     char norm[INTERP_LINE_MAX];  /* the line lowercased without spaces and comments */
     int normcol[INTERP_LINE_MAX];/* original column of each norm char */
