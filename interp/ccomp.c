@@ -141,6 +141,11 @@ static int check_before(struct interp *in)
         return refuse(in, b->gcol[2], "a change of plane");
     if (b->m[6] == 6)
         return refuse(in, b->mcol[6], "a tool change (M6)");
+    if (b->m[9] == 72 && in->m70.valid &&
+        (in->m70.plane != in->plane || in->m70.coord_system != in->coord_system ||
+         memcmp(in->m70.tool, in->tool, sizeof in->tool)))
+        return refuse(in, b->mcol[9], "M72 restoring another plane, coordinate system or "
+                      "tool length offset");
     if (b->m[5] >= 62 && b->m[5] <= 68)
         return refuse(in, b->mcol[5], b->m[5] == 66 ? "waiting on an input (M66)"
                                                    : "setting an output (M62..M65, M67, M68)");
