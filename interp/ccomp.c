@@ -39,7 +39,7 @@ int ccomp_start(const struct interp *in, double s[2])
 }
 
 /* The radius (program units) G41/G42 D<tool> take: half the tool's diameter (with its wear),
- * as LinuxCNC; a negative one swaps the side. D absent: the tool in the spindle. */
+ * as LinuxCNC; a negative one swaps the side. D absent or D0: the tool in the spindle. */
 static int tool_radius(struct interp *in, int g, double *r)
 {
     int t = in->current_tool, col = W('d') ? W('d') : in->blk.gcol[7];
@@ -50,13 +50,16 @@ static int tool_radius(struct interp *in, int g, double *r)
                                g / 10, t);
     }
     *r = 0.0;
-    if (t == 0 && !W('d'))
-        return 0;  /* no tool in the spindle: LinuxCNC's empty spindle has diameter 0 */
+    int spindle = t == 0 || !W('d');
+    if (t == 0)     /* D0 is the tool in the spindle too, as in LinuxCNC */
+        t = in->current_tool;
+    if (t == 0)
+        return 0;   /* no tool in the spindle: LinuxCNC's empty spindle has diameter 0 */
     if (!in->tt)
         return interp_fail(in, INTERP_ERR_TOOL, col, "G%d: the radius of tool %d%s comes from "
                            "the tool table, and there is none (give one with -t or [EMCIO] "
                            "TOOL_TABLE), or give the diameter with G%d.1 D<diameter>", g / 10, t,
-                           W('d') ? "" : " (in the spindle)", g / 10);
+                           spindle ? " (in the spindle)" : "", g / 10);
     const struct tool_entry *e = tooltable_find(in->tt, t);
     if (!e)
         return interp_fail(in, INTERP_ERR_TOOL, col, "G%d: tool %d is not in the tool table%s%s",

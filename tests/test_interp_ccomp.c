@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "interp/tooltable.h"
 #include "tests/test_interp_util.h"
 
 #define TOL 1e-9
@@ -157,6 +158,44 @@ START_TEST(ccomp_refusals)
 }
 END_TEST
 
+/* The radius from the tool table: D n is half tool n's diameter plus wear; D0 and no D are
+ * the tool in the spindle; an empty spindle gives radius 0: moves are not offset. */
+START_TEST(ccomp_radius_from_the_table)
+{
+    static const char table[] = "T1 P1 D10\nT2 P2 D6\n";
+    struct tooltable tt;
+    char err[256];
+    ck_assert_int_eq(tooltable_parse(&tt, table, "t.tbl", err, sizeof err), TOOLTABLE_OK);
+    const char *progs[] = {
+        "G41 D2 G1 X0 Y0 F100\nX20\nG40 X30 Y10\nM2\n",
+        "T2 M6\nG41 G1 X0 Y0 F100\nX20\nG40 X30 Y10\nM2\n",
+        "T2 M6\nG41 D0 G1 X0 Y0 F100\nX20\nG40 X30 Y10\nM2\n",
+        "G41.1 D6 G1 X0 Y0 F100\nX20\nG40 X30 Y10\nM2\n",
+    };
+    for (int i = 0; i < 4; i++) {
+        struct interp *in = interp_create();
+        struct canon_prog p;
+        interp_set_tooltable(in, &tt);
+        char text[200];
+        snprintf(text, sizeof text, "G0 X-10 Y-10\n%s", progs[i]);
+        ck_assert_int_eq(run_on(in, text, &p), INTERP_OK);
+        /* the move along X ends 3 mm left of it (+Y) */
+        ck_assert_pose(nth(&p, CANON_FEED, 1)->end, 20, 3, 0, 0, 0, 0, TOL);
+        canon_prog_free(&p);
+        interp_destroy(in);
+    }
+    struct interp *in = interp_create();
+    struct canon_prog p;
+    interp_set_tooltable(in, &tt);
+    ck_assert_int_eq(run_on(in, "G41 G1 X0 Y0 F100\nX20\nG40 X30\nM2\n", &p), INTERP_OK);
+    ck_assert_pose(nth(&p, CANON_FEED, 1)->end, 20, 0, 0, 0, 0, 0, TOL);  /* no tool */
+    canon_prog_free(&p);
+    ck_assert_int_eq(run_on(in, "G41 D7 G1 X0 Y0 F100\nM2\n", &p), INTERP_ERR_TOOL);
+    canon_prog_free(&p);
+    interp_destroy(in);
+}
+END_TEST
+
 static Suite *ccomp_suite(void)
 {
     Suite *s = suite_create("interp_ccomp");
@@ -166,6 +205,7 @@ static Suite *ccomp_suite(void)
     tcase_add_test(tc, ccomp_queue_keeps_the_order);
     tcase_add_test(tc, ccomp_side_swap_and_offsets);
     tcase_add_test(tc, ccomp_refusals);
+    tcase_add_test(tc, ccomp_radius_from_the_table);
     suite_add_tcase(s, tc);
     return s;
 }
