@@ -176,7 +176,8 @@ double ccomp_sweep(double x1, double y1, double cx, double cy, int turn, double 
     return (double)((b - a) + (turn + 1) * (2 * CC_PI_L));
 }
 
-/* Sends every queued command on, in order; the N column is the block's now (rs274's). */
+/* Sends every queued command on, in order; the N column is the block's now (rs274's); under
+ * G43.4 the moves carry the tool centre point state, as every command does. */
 int ccomp_dequeue(struct interp *in)
 {
     struct ccomp *cc = &in->cc;
@@ -186,7 +187,7 @@ int ccomp_dequeue(struct interp *in)
         c.has_n = in->blk.n_present;
         c.n_number = in->blk.n_number;
         c.n_digits = in->blk.n_digits;
-        if (in->sink(in->sink_ctx, &c)) {
+        if (interp_comp_sink(in, &c)) {  /* stamps the tool centre point state */
             cc->n = 0;
             return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the "
                                "program");

@@ -232,7 +232,8 @@ int interp_modal_restore(struct interp *in, const struct modal_save *m);
 /* spline.c: G5.1 (quadratic B-spline) as straight feeds. */
 int interp_spline(struct interp *in);
 
-/* The canon sink G141/G142 emit through (exec.c): stamps the tool centre point state. */
+/* The canon sink G141/G142 and the G41/G42 queue emit through (exec.c): stamps the tool
+ * centre point state. */
 int interp_comp_sink(void *ctx, const struct canon_cmd *cmd);
 
 /* Records the first error (printf-style message) and returns status. */

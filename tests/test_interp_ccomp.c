@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "interp/tooltable.h"
+#include "kins/kins.h"
 #include "tests/test_interp_util.h"
 
 #define TOL 1e-9
@@ -196,6 +197,31 @@ START_TEST(ccomp_radius_from_the_table)
 }
 END_TEST
 
+/* Under tool centre point control (PROGRAM_POINT = TOOL_TIP) the moves the queue holds are
+ * the tool tip's, and say so, as every other command does. */
+START_TEST(ccomp_moves_carry_the_tcp_state)
+{
+    static const struct kins_tool_frame tf = {0, {0, 0, 780}, {0, 0, -1}, 60, 1};
+    struct interp *in = interp_create();
+    struct canon_prog p;
+    interp_set_tool_frame(in, &tf);
+    ck_assert_int_eq(run_on(in, "G0 X-10 Y-10 Z600\nG41.1 D4 G1 X0 Y0 F100\nX20\nY20\n"
+                                "G40 X30 Y30\nM2\n", &p), INTERP_OK);
+    int moves = 0;
+    for (size_t i = 0; i < p.count; i++) {
+        const struct canon_cmd *c = &p.cmds[i];
+        if (c->type == CANON_FEED || c->type == CANON_ARC || c->type == CANON_TRAVERSE) {
+            moves++;
+            ck_assert_int_eq(c->tcp, 1);
+            ck_assert_double_eq(c->tool_len_mm, 60);
+        }
+    }
+    ck_assert_int_eq(moves, 6);  /* rapid, entry, X20, corner arc, Y20, exit */
+    canon_prog_free(&p);
+    interp_destroy(in);
+}
+END_TEST
+
 static Suite *ccomp_suite(void)
 {
     Suite *s = suite_create("interp_ccomp");
@@ -206,6 +232,7 @@ static Suite *ccomp_suite(void)
     tcase_add_test(tc, ccomp_side_swap_and_offsets);
     tcase_add_test(tc, ccomp_refusals);
     tcase_add_test(tc, ccomp_radius_from_the_table);
+    tcase_add_test(tc, ccomp_moves_carry_the_tcp_state);
     suite_add_tcase(s, tc);
     return s;
 }
