@@ -100,11 +100,17 @@ int interp_arc(struct interp *in, int g)
     struct plane_axes p = plane_of(in->plane);
     int ccw = g == 30, turns = 1;
     double end[6], cur[6], s[2], e[2], c[2] = {0, 0};
+    if (in->cc.arc_not_allowed)
+        return interp_fail(in, INTERP_ERR_CCOMP, in->blk.g[1] >= 0 ? in->blk.gcol[1] : 0,
+                           "the move after G40 must be straight, not an arc: the tool is "
+                           "still beside the contour, a radius away from the arc's start");
     interp_target(in, 0, end);
     interp_prog_pos(in, cur);
     int ax[2] = {p.a1, p.a2};
+    double from[2] = {cur[ax[0]], cur[ax[1]]};
+    ccomp_start(in, from);  /* under G41/G42: the programmed point, not the tool's */
     for (int i = 0; i < 2; i++) { /* the ends in program units, as LinuxCNC computes arcs */
-        s[i] = cur[ax[i]];
+        s[i] = from[i];
         e[i] = !W(letter[ax[i]]) ? s[i] : in->incremental ? s[i] + V(letter[ax[i]])
                                                            : V(letter[ax[i]]);
     }
@@ -122,6 +128,8 @@ int interp_arc(struct interp *in, int g)
     else
         CHP(centre_from_ijk(in, &p, s, c));
     CHP(check_radii(in, s, e, c));
+    if (ccomp_active(in))
+        return ccomp_arc(in, g, s, e, c, ccw ? turns : -turns, end);
 
     struct canon_cmd cmd;
     interp_cmd_init(in, &cmd, CANON_ARC);

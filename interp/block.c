@@ -8,16 +8,17 @@
 /* G codes this interpreter runs, x10, with their modal group (LinuxCNC's numbering). */
 static const struct { int code, group; } g_table[] = {
     {0, 1},    {10, 1},   {20, 1},   {30, 1},   {40, 0},   {100, 0},  {170, 2},  {180, 2},
-    {190, 2},  {200, 6},  {210, 6},  {280, 0},  {281, 0},  {300, 0},  {301, 0},  {400, 7},
-    {430, 8},  {431, 8},  {432, 8},  {434, 8},  {490, 8},  {530, 0},  {540, 12}, {550, 12}, {560, 12}, {570, 12},
-    {580, 12}, {590, 12}, {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13},
-    {730, 1},  {800, 1},  {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},
-    {901, 4},  {910, 3},  {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},
-    {940, 5},  {980, 10}, {990, 10}, {1410, 0}, {1420, 0}, {51, 1},  {520, 0},
+    {190, 2},  {200, 6},  {210, 6},  {410, 7},  {411, 7},  {420, 7},  {421, 7},  {280, 0},
+    {281, 0},  {300, 0},  {301, 0},  {400, 7},  {430, 8},  {431, 8},  {432, 8},  {434, 8},
+    {490, 8},  {530, 0},  {540, 12}, {550, 12}, {560, 12}, {570, 12}, {580, 12}, {590, 12},
+    {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13}, {730, 1},  {800, 1},
+    {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},  {901, 4},  {910, 3},
+    {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},  {940, 5},  {980, 10},
+    {990, 10}, {1410, 0}, {1420, 0}, {51, 1},   {520, 0},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {50, 52, 55, 61, 331, 382, 383, 384, 385, 411, 421, 840,
+static const int g_unsupported[] = {50, 52, 55, 61, 331, 382, 383, 384, 385, 840,
                                     860, 870, 880, 950};
 
 /* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
@@ -43,7 +44,7 @@ static const char *code_str(int c10, char *buf)
     return buf;
 }
 
-/* Files G<v> in its modal group; refuses unknown codes, G41/G42 and a second code of a group. */
+/* Files G<v> in its modal group; refuses unknown codes and a second code of a group. */
 int interp_add_g(struct interp *in, double v, int column)
 {
     struct interp_block *b = &in->blk;
@@ -52,11 +53,6 @@ int interp_add_g(struct interp *in, double v, int column)
     if (fabs(v * 10.0 - r) > 0.001 || v < 0 || v > 10000)
         return interp_fail(in, INTERP_ERR_WORD, column, "G%g is not a G code", v);
     int c = (int)r;
-    if (c == 410 || c == 420)
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, column,
-                           "G%d cutter compensation is not available on this machine: put G141 "
-                           "(right) or G142 (left) with W (tool radius) on each compensated block",
-                           c / 10);
     for (size_t i = 0; i < sizeof g_table / sizeof g_table[0]; i++) {
         if (g_table[i].code != c)
             continue;
@@ -182,6 +178,7 @@ static int word_used(const struct interp *in, char w)
     const struct interp_block *b = &in->blk;
     int g0 = b->g[0], m = block_motion(in);
     int comp = g0 == 1410 || g0 == 1420;
+    int ccomp = b->g[7] >= 410;   /* G41, G41.1, G42, G42.1 */
     int arc = !comp && g0 < 0 && (m == 20 || m == 30);
     int cycle = !comp && g0 < 0 && is_cycle(m);
     switch (w) {
@@ -193,9 +190,10 @@ static int word_used(const struct interp *in, char w)
     case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640 ||
                      b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68;
     case 'e': return b->m[5] >= 66 && b->m[5] <= 68;
-    case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98;
+    case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98 || ccomp;
     case 'h': return b->g[8] == 430 || b->g[8] == 432 || b->g[8] == 434;
-    case 'd': case 'w': return comp;
+    case 'd': return comp || ccomp;
+    case 'w': return comp;
     default: return 1;
     }
 }
@@ -211,9 +209,9 @@ static int check_unused(struct interp *in)
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
         "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G82/G89 (dwell) and M62..M66",
         "Q is used by the peck cycles G73 and G83, G10, G64, M61, M66, M67 and M68",
-        "L is used by G10, canned cycles (repeats) and M66",
+        "L is used by G10, canned cycles (repeats), G41.1/G42.1 and M66",
         "H is used by G43, G43.2 (tool length offsets) and G43.4 (tool centre point control)",
-        "D (tool for the radius) is only used with G141/G142",
+        "D is used by G41/G42 and G141/G142 (tool number) and G41.1/G42.1 (diameter)",
         "W (tool radius) is only used with G141/G142",
         "E is the analog input of M66 and the analog output of M67 and M68",
     };

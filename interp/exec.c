@@ -28,10 +28,13 @@ static void stamp_tcp(const struct interp *in, struct canon_cmd *c)
     c->tool_len_mm = in->tcp_on ? in->tcp_len_mm : 0;
 }
 
-/* Hands a command to the sink; a refusal stops the run. */
+/* Hands a command to the sink (or, behind a G41/G42 move that waits for its corner, to the
+ * queue); a refusal stops the run. */
 int interp_emit(struct interp *in, struct canon_cmd *c)
 {
     stamp_tcp(in, c);
+    if (ccomp_holds(in, c->type))
+        return ccomp_hold(in, c);
     if (in->sink(in->sink_ctx, c))
         return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the program");
     return 0;
@@ -364,12 +367,17 @@ static int exec_modes(struct interp *in)
     struct interp_block *b = &in->blk;
     if (b->g[2] >= 0)
         in->plane = b->g[2] / 10;
-    if (b->g[6] >= 0)
+    if (b->g[6] >= 0 && in->inch != (b->g[6] == 200)) {
         in->inch = b->g[6] == 200;
+        if (in->cc.side != CCOMP_OFF)  /* compensation works in program units */
+            ccomp_scale(in, in->inch ? 1.0 / MM_PER_INCH : MM_PER_INCH);
+    }
     /* F is in the units in force (inch/min under G20, else FEED_UNITS) */
     in->feed_mm_min = in->inch ? in->f_word * MM_PER_INCH : in->f_word * in->feed_factor;
     if (W('f') && !in->inverse_time)
         CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+    if (b->g[7] >= 0)
+        CHP(ccomp_mode(in, b->g[7]));
     if (b->g[8] >= 0)
         CHP(interp_tool_length(in, b->g[8]));
     if (b->g[12] >= 0) {
@@ -532,6 +540,9 @@ static int exec_motion(struct interp *in)
         if (m == 10)
             CHP(interp_need_feed(in, "G1"));
         interp_target(in, g0 == 530, t);
+        in->cc.arc_not_allowed = 0;
+        if (ccomp_active(in))
+            return ccomp_straight(in, m, t);
         return interp_straight(in, m == 0 ? CANON_TRAVERSE : CANON_FEED, t);
     }
     if (m == 20 || m == 30) {
@@ -564,10 +575,14 @@ static int exec_stop(struct interp *in)
             return 0;
         m = 2;               /* the main program's M99 ends it */
     }
+    if (m == 0 || m == 1 || m == 2 || m == 30)
+        CHP(ccomp_flush(in));  /* a stop sends the queued G41/G42 move, as rs274 */
     if (m == 0 || m == 1)
         return emit_simple(in, CANON_PAUSE, 0, m);
     if (m != 2 && m != 30)
         return 0;
+    in->cc.side = CCOMP_OFF;  /* LinuxCNC's end-of-program resets */
+    in->cc.first = 1;
     if (in->coord_system != 1) {
         interp_select_coord(in, 1);
         CHP(interp_emit_offsets(in));
@@ -615,6 +630,7 @@ int interp_execute(struct interp *in)
 {
     struct interp_block *b = &in->blk;
     CHP(interp_check_block(in));
+    CHP(ccomp_check_block(in));
     for (int i = 0; i < b->nassign; i++) {
         if (b->assign_named[i])
             interp_named_set(in, b->assign_idx[i], b->assign_val[i]);

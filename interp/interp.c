@@ -27,6 +27,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_SINK] = "stopped by the command consumer",
     [INTERP_ERR_CONFIG] = "bad interpreter setting in the INI file",
     [INTERP_ERR_CANCELLED] = "stopped by the operator",
+    [INTERP_ERR_CCOMP] = "G41/G42 cutter compensation error",
 };
 
 /* The fixed text of a status (the message of a run is in struct interp_error). */
@@ -89,6 +90,7 @@ struct interp *interp_create(void)
     in->feed_factor = 1.0;
     modal_defaults(in);
     comp5_init(&in->comp);
+    ccomp_reset(&in->cc);
     return in;
 }
 
@@ -100,6 +102,7 @@ void interp_destroy(struct interp *in)
     interp_named_free(in);
     oword_free(in);
     comp5_free(&in->comp);
+    ccomp_free(&in->cc);
     free(in->param_path);
     free(in);
 }
@@ -292,6 +295,7 @@ static int percent_line(struct interp *in, int first)
         return interp_fail(in, INTERP_ERR_SYNTAX, 1, "a '%%' line may only open the program (on "
                            "its first line) and then close it");
     in->ended = 1;
+    CHP(ccomp_flush(in));    /* the last compensated move ends where it was placed */
     int rc = comp5_flush(&in->comp, interp_comp_sink, in);
     if (rc)
         return interp_comp5_fail(in);
@@ -377,6 +381,7 @@ int interp_run_text(struct interp *in, const char *file_name, const char *text, 
     in->sink_ctx = ctx;
     comp5_free(&in->comp);
     comp5_init(&in->comp);
+    ccomp_reset(&in->cc);
     interp_named_clear_locals(in); /* #<name> belongs to one program, #<_name> stays */
     interp_settings_begin(in);     /* settings are reported, never saved, from here */
     return run_lines(in, text, len);

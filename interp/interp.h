@@ -28,6 +28,7 @@ enum interp_status {
     INTERP_ERR_SINK,          /* the canon sink asked to stop */
     INTERP_ERR_CONFIG,        /* a bad interpreter setting in the machine's INI file */
     INTERP_ERR_CANCELLED,     /* the cancel flag was set (Ctrl-C) while the program was read */
+    INTERP_ERR_CCOMP,         /* G41/G42 cutter compensation refused the path or the code */
     INTERP_STATUS_COUNT
 };
 const char *interp_strerror(int status);

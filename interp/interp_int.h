@@ -4,6 +4,7 @@
 
 #include <stdarg.h>
 
+#include "interp/ccomp.h"
 #include "interp/comp5.h"
 #include "interp/interp.h"
 #include "kins/kins.h"
@@ -218,6 +219,7 @@ struct interp {
     struct oword ow;             /* O-word control flow */
     struct modal_save m70;       /* the state M70 saved, for M72 */
     struct comp5 comp;           /* G141/G142 run in progress */
+    struct ccomp cc;             /* G41/G42 cutter compensation and its queued move */
     struct interp_block blk;     /* the block being worked on */
     char norm[INTERP_LINE_MAX];  /* the line lowercased without spaces and comments */
     int normcol[INTERP_LINE_MAX];/* original column of each norm char */
@@ -235,7 +237,8 @@ int interp_modal_restore(struct interp *in, const struct modal_save *m);
 /* spline.c: G5.1 (quadratic B-spline) as straight feeds. */
 int interp_spline(struct interp *in);
 
-/* The canon sink G141/G142 emit through (exec.c): stamps the tool centre point state. */
+/* The canon sink G141/G142 and the G41/G42 queue emit through (exec.c): stamps the tool
+ * centre point state. */
 int interp_comp_sink(void *ctx, const struct canon_cmd *cmd);
 
 /* Records the first error (printf-style message) and returns status. */

@@ -2,7 +2,9 @@
 # Runs `hexcnc interp` on tests/interp_expected/*.ngc and compares its motion lines
 # (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL), outputs (M62..M68) and active comments
 # (MESSAGE, LOG...) with those in NAME.out, which LinuxCNC's
-# `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists). The first column
+# `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists; rs274 alone reads a
+# tool table in inches, so where NAME.rs274.tbl exists, the same tools in inches, rs274 is
+# given that one instead). The first column
 # (rs274's output line counter) is left out: the two print different non-motion lines.
 # With rs274 installed and REGEN=1 the .out files are made again. sub_NAME.ngc files hold
 # subroutines (o<sub_NAME> sub) that the programs call: they are found beside the program.
@@ -21,7 +23,9 @@ for ngc in "$dir"/*.ngc; do
     opt=""
     [ -f "$dir/$name.tbl" ] && opt="-t $name.tbl"
     if [ "${REGEN:-0}" = 1 ]; then
-        (cd "$dir" && rs274 -g $opt "$name.ngc" > "$name.out" 2>/dev/null)
+        rsopt=$opt
+        [ -f "$dir/$name.rs274.tbl" ] && rsopt="-t $name.rs274.tbl"
+        (cd "$dir" && rs274 -g $rsopt "$name.ngc" > "$name.out" 2>/dev/null)
     fi
     motion < "$dir/$name.out" > "$tmp/expected"
     if ! (cd "$dir" && "$bin" interp $opt "$name.ngc") > "$tmp/out" 2> "$tmp/err"; then

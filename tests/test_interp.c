@@ -397,9 +397,9 @@ START_TEST(modal_groups)
     ck_assert_int_eq(fail_of("G2 G141 X1 W1 F1\nM2\n").status, INTERP_ERR_MODAL);
     ck_assert_int_eq(fail_of("G1 X1 R2 F1\nM2\n").status, INTERP_ERR_WORD);
     ck_assert_int_eq(fail_of("G1 X1 X2 F1\nM2\n").status, INTERP_ERR_WORD);
-    e = fail_of("G41 G1 X1 F1\nM2\n");
-    ck_assert_int_eq(e.status, INTERP_ERR_UNSUPPORTED);
-    ck_assert_ptr_nonnull(strstr(e.message, "G141"));
+    e = fail_of("G41 G42 G1 X1 F1\nM2\n");  /* G40..G42 are modal group 7 */
+    ck_assert_int_eq(e.status, INTERP_ERR_MODAL);
+    ck_assert_ptr_nonnull(strstr(e.message, "modal group 7"));
     e = fail_of("G1 X1 F1 O100\nM2\n");  /* an O-word is a line of its own */
     ck_assert_ptr_nonnull(strstr(e.message, "must start its line"));
 }
