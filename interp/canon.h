@@ -29,7 +29,9 @@ enum canon_type {
     CANON_COMMENT,         /* ( ... ): text */
     CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */
     CANON_PROGRAM_END,     /* M2 / M30 (ivalue 2 or 30) */
-    CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]) */
+    CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]:
+                            * work + G92 + tool, as if unrotated) or the coordinate system's
+                            * rotation about Z did (value, deg: G10 L2 R) */
     CANON_SETTING,         /* a setting the machine keeps (setting): a tool-table entry (G10
                             * L1) and/or persistent parameters #5161..#5390 (G10 L2/L20,
                             * G28.1/G30.1, G92, G54..G59.3, #n=) changed by this line. It

@@ -225,11 +225,17 @@ double interp_len_mm(const struct interp *in, double v)
 /* The current pose in program coordinates: offsets removed, program units. */
 void interp_prog_pos(const struct interp *in, double prog[6])
 {
-    for (int i = 0; i < 6; i++) {
+    for (int i = 0; i < 6; i++)
         prog[i] = in->pos[i] - in->g5x[i] - in->g92[i] - in->tool[i];
-        if (i < 3 && in->inch)
-            prog[i] /= MM_PER_INCH;
+    if (in->rot_deg != 0.0) {   /* X Y in the rotated frame (rotation.c) */
+        double q[2];
+        interp_rotated_pos(in, q);
+        prog[AX_X] = q[0] - in->g92[AX_X];
+        prog[AX_Y] = q[1] - in->g92[AX_Y];
     }
+    if (in->inch)
+        for (int i = 0; i < 3; i++)
+            prog[i] /= MM_PER_INCH;
 }
 
 /* Axis words to a machine target: absent axes stay, G91 adds, G90 adds the offsets. */
@@ -248,6 +254,17 @@ void interp_target(struct interp *in, int machine, double t[6])
             t[i] = in->pos[i] + v;
         else
             t[i] = v + in->g5x[i] + in->g92[i] + in->tool[i];
+    }
+    if (in->rot_deg != 0.0 && !machine && (W('x') || W('y'))) {
+        /* X Y in the rotated frame: G91 steps along the turned axes, as LinuxCNC */
+        double cur[6], p[2];
+        interp_prog_pos(in, cur);
+        for (int i = 0; i < 2; i++) {
+            p[i] = cur[i];
+            if (W(ax[i]))
+                p[i] = in->incremental && !in->blk.polar_inc ? cur[i] + V(ax[i]) : V(ax[i]);
+        }
+        interp_xy_to_machine(in, p[0], p[1], t);
     }
 }
 

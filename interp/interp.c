@@ -241,6 +241,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     memcpy(v->g5x_mm, in->g5x, sizeof v->g5x_mm);
     memcpy(v->g92_mm, in->g92, sizeof v->g92_mm);
     memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
+    v->xy_rotation_deg = in->rot_deg;
     v->tcp = in->tcp_on;
     v->tcp_len_mm = in->tcp_len_mm;
     v->feed_factor = in->feed_factor;

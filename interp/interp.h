@@ -143,6 +143,7 @@ struct interp_view {
     double g5x_mm[6];         /* offset of the active coordinate system (mm, deg) */
     double g92_mm[6];         /* G92 offset (mm, deg) */
     double tool_mm[6];        /* tool length offset (Z only for G43 H; 0 under G43.4) */
+    double xy_rotation_deg;   /* the coordinate system's rotation about Z (G10 L2 R), deg */
     int tcp;                  /* tool centre point control (G43.4) is on */
     double tcp_len_mm;        /* its tool length, mm */
     double feed_factor;       /* see interp_set_feed_factor */
@@ -161,6 +162,10 @@ struct interp_view {
     int selected_tool;        /* T of the last T word */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
+/* A machine pose (mm, deg) in the program coordinates of view v: offsets and the rotation
+ * removed, inches under G20 (what rs274 prints, what a display shows). */
+void interp_view_to_program(const struct interp_view *v, const double machine[6],
+                            double prog[6]);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */
 double interp_param(const struct interp *in, int n);
 

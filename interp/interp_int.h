@@ -26,6 +26,9 @@ enum {
     PARAM_G92 = 5211,            /* 5211..5216: G92 offsets */
     PARAM_COORD = 5220,          /* active coordinate system 1..9 */
     PARAM_G54 = 5221,            /* 5221..5226 G54, then every 20 up to 5381 (G59.3) */
+    PARAM_ROT = 9,               /* PARAM_G54 + 20 n + PARAM_ROT: that system's rotation about
+                                  * Z, deg (#5230 for G54, G10 L2 R) */
+    PARAM_POS = 5420,            /* 5420..5428: the current point, program frame (read-only) */
     PARAM_PERSIST_LO = 5161,
     PARAM_PERSIST_HI = 5390,
 };
@@ -194,6 +197,7 @@ struct interp {
     double naive_cam_tol_mm;     /* G64 Q: LinuxCNC's "naive CAM detector" tolerance; stored
                                   * and reported, not used by the planner (docs/gcode.md) */
     double g5x[6];               /* active work offset, mm/deg */
+    double rot_deg;              /* the active system's rotation about Z, deg (rotation.c) */
     double g92[6];               /* active G92 offset */
     double tool[6];              /* active tool length offset (0 under G43.4) */
     struct kins_tool_frame tf;   /* where the machine's tool is (interp_set_tool_frame) */
@@ -303,6 +307,17 @@ void interp_target(struct interp *in, int machine, double target[6]);
 int interp_straight(struct interp *in, enum canon_type t, const double end[6]);
 /* Checks a feed move has a feed (F in force, or F in the block under G93). */
 int interp_need_feed(struct interp *in, const char *what);
+
+/* rotation.c: the active system's rotation about Z (G10 L2 R). */
+void interp_rotate_xy(double *x, double *y, double deg);
+/* Program X Y (program units) to machine X Y (mm), offsets and rotation applied. */
+void interp_xy_to_machine(const struct interp *in, double px, double py, double m[2]);
+/* The current point in the rotated frame (program X Y + G92), mm. */
+void interp_rotated_pos(const struct interp *in, double q[2]);
+/* G10 L2/L20 X Y (and L2 R) on system sys when a rotation is involved (offsets.c). */
+void interp_g10_rotated(struct interp *in, int l, int sys);
+/* G28/G30 with X or Y alone under a rotation: the machine X Y of the home move (t[0..1]). */
+void interp_home_rotated(const struct interp *in, int base, double t[2]);
 
 /* arc.c */
 int interp_arc(struct interp *in, int g);

@@ -14,3 +14,5 @@ BENCHES += bench_interp
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh tests/linuxcnc_tooltables.sh \
                 tests/linuxcnc_corpus.sh
 LIB_SRCS += interp/interp_setup.c
+LIB_SRCS += interp/rotation.c
+TESTS += test_interp_rotation

@@ -96,14 +96,11 @@ static void put_call(struct interp_printer *p, const char *name, const double *v
     put(p, ")\n", 2);
 }
 
-/* Machine pose to program coordinates: what rs274 prints (offsets removed, inch units). */
+/* Machine pose to program coordinates: what rs274 prints (offsets and rotation removed,
+ * inch units). */
 static void to_program(const struct interp_view *v, const double m[6], double out[6])
 {
-    for (int i = 0; i < 6; i++) {
-        out[i] = m[i] - v->g5x_mm[i] - v->g92_mm[i] - v->tool_mm[i];
-        if (i < 3 && v->inch)
-            out[i] /= MM_PER_INCH;
-    }
+    interp_view_to_program(v, m, out);
 }
 
 /* ARC_FEED(first end, second end, first centre, second centre, turns, axis end, A, B, C). */
@@ -158,7 +155,8 @@ static void put_offsets(struct interp_printer *p, const struct interp_view *v, i
 {
     double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
     char tmp[48];
-    if (all || v->coord_system != p->coord || memcmp(v->g5x_mm, p->g5x, sizeof p->g5x)) {
+    int g5x = all || v->coord_system != p->coord || memcmp(v->g5x_mm, p->g5x, sizeof p->g5x);
+    if (g5x) {
         line_start(p, NULL);
         put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_G5X_OFFSET(%d, ", v->coord_system));
         put_six(p, v->g5x_mm, k, ", ");
@@ -176,6 +174,12 @@ static void put_offsets(struct interp_printer *p, const struct interp_view *v, i
         put_six(p, v->tool_mm, k, " ");
         puts_(p, ", 0.0000 0.0000 0.0000)\n");
     }
+    if (all || v->xy_rotation_deg != p->rot_deg || g5x) {  /* rs274: after each SET_G5X */
+        line_start(p, NULL);
+        put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_XY_ROTATION(%.4f)\n",
+                                     v->xy_rotation_deg));
+    }
+    p->rot_deg = v->xy_rotation_deg;
     p->coord = v->coord_system;
     memcpy(p->g5x, v->g5x_mm, sizeof p->g5x);
     memcpy(p->g92, v->g92_mm, sizeof p->g92);
@@ -295,6 +299,7 @@ void interp_printer_init(struct interp_printer *p, const struct interp *in, int 
     struct interp_view v;
     interp_get_view(in, &v);
     p->inch = v.inch;
+    p->rot_deg = v.xy_rotation_deg;
 }
 
 /* The set-up lines rs274 prints before the program. */
@@ -305,8 +310,6 @@ int interp_printer_preamble(struct interp_printer *p)
     line_start(p, NULL);
     puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
     put_offsets(p, &v, 1);
-    line_start(p, NULL);
-    puts_(p, "SET_XY_ROTATION(0.0000)\n");
     line_start(p, NULL);
     puts_(p, "SET_FEED_REFERENCE(CANON_XYZ)\n");
     return p->failed ? -1 : 0;

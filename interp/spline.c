@@ -37,7 +37,10 @@ int interp_spline(struct interp *in)
                                "C: a quadratic spline lies in the XY plane");
     double end[6], p0[2] = { in->pos[0], in->pos[1] };
     interp_target(in, 0, end);
-    double p1[2] = { p0[0] + interp_len_mm(in, V('i')), p0[1] + interp_len_mm(in, V('j')) };
+    double d[2] = { interp_len_mm(in, V('i')), interp_len_mm(in, V('j')) };
+    if (in->rot_deg != 0.0)
+        interp_rotate_xy(&d[0], &d[1], in->rot_deg);   /* I J turn with the system */
+    double p1[2] = { p0[0] + d[0], p0[1] + d[1] };
     double q[2] = { p0[0] - 2 * p1[0] + end[0], p0[1] - 2 * p1[1] + end[1] };
     double n = ceil(sqrt(hypot(q[0], q[1]) / (4 * SPLINE_TOL_MM)));
     int pieces = n < 1 ? 1 : n > SPLINE_MAX_CHORDS ? SPLINE_MAX_CHORDS : (int)n;
