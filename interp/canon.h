@@ -84,8 +84,9 @@ struct canon_cmd {
     double value;          /* DWELL s, PATH_MODE tol, SPINDLE_* rpm/dir, FEED_MODE */
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
-    int spline;            /* FEED: a chord of a G5.1 spline, 1 the block's first, 2 the
-                            * others (printers show rs274's one NURBS_FEED line) */
+    int spline;            /* FEED: a chord of a G5/G5.1 spline or a G5.3 NURBS, 1 the
+                            * block's first (ivalue: its control points), 2 the others
+                            * (printers show rs274's one NURBS_FEED(ivalue, ...) line) */
     int tcp;               /* under tool centre point control (G43.4): end (and an arc's
                             * geometry) is the tool tip and orientation (kins_tcp_to_pose
                             * gives the platform's pose), tool_len_mm the tool's length */

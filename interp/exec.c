@@ -518,7 +518,7 @@ int interp_polar_words(struct interp *in)
 static int exec_motion(struct interp *in)
 {
     struct interp_block *b = &in->blk;
-    int g0 = b->g[0];
+    int g0 = b->g[0], prev_motion = in->motion;
     CHP(interp_polar_words(in));
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
@@ -545,12 +545,15 @@ static int exec_motion(struct interp *in)
         CHP(interp_need_feed(in, m == 20 ? "G2" : "G3"));
         return interp_arc(in, m);
     }
-    if (m == 51) {
-        if (!axis && !W('i') && !W('j'))
+    if (m == 50 || m == 51) {
+        in->motion = prev_motion;   /* G5 and G5.1 leave the motion mode as it was (rs274) */
+        if (!axis && !W('i') && !W('j') && !W('p') && !W('q'))
             return 0;
-        CHP(interp_need_feed(in, "G5.1"));
-        return interp_spline(in);
+        CHP(interp_need_feed(in, m == 50 ? "G5" : "G5.1"));
+        return m == 50 ? interp_spline_cubic(in) : interp_spline(in);
     }
+    if (m == 52)
+        return b->g[1] == 52 || axis ? interp_nurbs_point(in, prev_motion) : 0;
     if (m >= 0 && axis)
         return interp_cycle(in, m);
     return 0;
@@ -647,6 +650,8 @@ int interp_execute(struct interp *in)
         CHP(interp_home(in, g0));
     else if ((g0 >= 920 && g0 <= 923) || g0 == 520)
         CHP(interp_g92(in, g0));
+    else if (g0 == 53)
+        CHP(interp_nurbs_end(in));
     if (comp && b->g[1] >= 0)
         in->motion = b->g[1]; /* G1 beside G141/G142 is modal as usual */
     if (comp)

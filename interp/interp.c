@@ -100,6 +100,7 @@ void interp_destroy(struct interp *in)
     interp_named_free(in);
     oword_free(in);
     comp5_free(&in->comp);
+    interp_nurbs_free(&in->nurbs);
     free(in->param_path);
     free(in);
 }

@@ -72,6 +72,17 @@ struct named_table {
     size_t nslot;
 };
 
+/* G5.2 control points collected until G5.3 (nurbs.c). */
+struct nurbs_point {
+    double x, y;                 /* machine frame, mm */
+    double w;                    /* weight (P) */
+};
+struct nurbs {
+    struct nurbs_point *pt;      /* [0] is where the curve starts */
+    int n, cap;
+    int order;                   /* L: 3 (quadratic) unless a G5.2 gave more */
+};
+
 /* O-words (oword.c): the texts lines are read from, the open conditions and loops, the
  * subroutines known so far and the calls in progress. Positions are (text, line index). */
 #define OWORD_LABEL_MAX 72       /* "123" or "<name>" as normalised, with the brackets */
@@ -218,6 +229,9 @@ struct interp {
     int flood, mist;             /* M8, M7 on (M9 turns both off) */
     double spindle_rpm;
     double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
+    double g5_ij[2];             /* G5 without I J starts with these (program units): -P -Q
+                                  * of the last G5, as LinuxCNC keeps them */
+    struct nurbs nurbs;          /* G5.2 points waiting for G5.3 */
 
     struct oword ow;             /* O-word control flow */
     struct modal_save m70;       /* the state M70 saved, for M72 */
@@ -231,8 +245,20 @@ struct interp {
 void interp_modal_save(const struct interp *in, struct modal_save *m);
 int interp_modal_restore(struct interp *in, const struct modal_save *m);
 
-/* spline.c: G5.1 (quadratic B-spline) as straight feeds. */
+/* spline.c: G5 (cubic) and G5.1 (quadratic) splines as straight feeds (chords) that leave
+ * the curve by at most SPLINE_TOL_MM; the planner follows them exactly. */
+#define SPLINE_TOL_MM 1e-4
+#define SPLINE_MAX_CHORDS 100000
 int interp_spline(struct interp *in);
+int interp_spline_cubic(struct interp *in);
+/* Emits chords pts[1..n] from pts[0] (machine X Y, mm) as one spline block; ncp is the
+ * number of control points printers show (rs274's NURBS_FEED(ncp, ...)). */
+int interp_spline_emit(struct interp *in, const double (*pts)[2], int n, int ncp);
+/* nurbs.c: G5.2 (a control point; prev_motion the motion mode before the block) and G5.3
+ * (the curve). */
+int interp_nurbs_point(struct interp *in, int prev_motion);
+int interp_nurbs_end(struct interp *in);
+void interp_nurbs_free(struct nurbs *nb);
 
 /* The canon sink G141/G142 emit through (exec.c): stamps the tool centre point state. */
 int interp_comp_sink(void *ctx, const struct canon_cmd *cmd);

@@ -268,7 +268,8 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
     if (c->type == CANON_FEED && c->spline) {   /* rs274 prints a spline as one line */
         if (c->spline == 1) {
             line_start(p, c);
-            puts_(p, "NURBS_FEED(3, ...)\n");
+            char tmp[40];
+            put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "NURBS_FEED(%d, ...)\n", c->ivalue));
         }
         return p->failed ? -1 : 0;
     }
