@@ -17,8 +17,9 @@ enum canon_type {
     CANON_FEED,            /* G1 (and compensated G141/G142 lines): straight feed to end */
     CANON_ARC,             /* G2/G3 (and the corner arcs of G141/G142): arc/helix to end */
     CANON_DWELL,           /* G4: seconds */
-    CANON_FEED_RATE,       /* F changed: feed_mm_min */
-    CANON_FEED_MODE,       /* G93/G94: value = 1 for inverse time, 0 for units/min */
+    CANON_FEED_RATE,       /* F changed: feed_mm_min (G95, ivalue 1: value = F per rev) */
+    CANON_FEED_MODE,       /* G93/G94/G95: value = 1 for inverse time, 0 for units/min, 2 for
+                            * feed per revolution (moves still carry feed_mm_min: F x S) */
     CANON_PATH_MODE,       /* G61 (value 0) / G64 (value = blend tolerance mm, 0 = none) */
     CANON_SPINDLE_SPEED,   /* S: value = rpm */
     CANON_SPINDLE_ON,      /* M3 (value = +1) / M4 (value = -1) */

@@ -62,6 +62,7 @@ void interp_modal_save(const struct interp *in, struct modal_save *m)
     m->valid = 1;
     m->inch = in->inch, m->plane = in->plane, m->incremental = in->incremental;
     m->arc_absolute = in->arc_absolute, m->inverse_time = in->inverse_time;
+    m->per_rev = in->per_rev;
     m->coord_system = in->coord_system, m->retract_old_z = in->retract_old_z;
     m->path_mode = in->path_mode, m->path_tol_mm = in->path_tol_mm;
     m->naive_cam_tol_mm = in->naive_cam_tol_mm;
@@ -78,13 +79,14 @@ int interp_modal_restore(struct interp *in, const struct modal_save *m)
     in->inch = m->inch, in->plane = m->plane, in->incremental = m->incremental;
     in->arc_absolute = m->arc_absolute, in->retract_old_z = m->retract_old_z;
     in->f_word = m->f_word;
-    if (in->inverse_time != m->inverse_time) {
+    if (in->inverse_time != m->inverse_time || in->per_rev != m->per_rev) {
         in->inverse_time = m->inverse_time;
-        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+        in->per_rev = m->per_rev;
+        CHP(emit_simple(in, CANON_FEED_MODE, interp_feed_mode_value(in), 0));
     }
     if (in->feed_mm_min != m->feed_mm_min) {
         in->feed_mm_min = m->feed_mm_min;
-        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+        CHP(emit_simple(in, CANON_FEED_RATE, in->f_word, in->per_rev));
     }
     if (in->path_mode != m->path_mode || in->path_tol_mm != m->path_tol_mm) {
         in->path_mode = m->path_mode, in->path_tol_mm = m->path_tol_mm;
@@ -291,7 +293,7 @@ int interp_need_feed(struct interp *in, const char *what)
     if (in->f_word <= 0.0)
         return interp_fail(in, INTERP_ERR_WORD, col, "%s with zero feed rate: give an F word "
                            "first", what);
-    return 0;
+    return in->per_rev ? interp_need_spindle(in, what, col) : 0;
 }
 
 /* F, S, T, M6, M3/M4/M5, M7/M8/M9 and G4: the first steps of LinuxCNC's order. */
@@ -300,7 +302,8 @@ static int exec_machine_words(struct interp *in)
     struct interp_block *b = &in->blk;
     if (b->g[5] >= 0) {
         in->inverse_time = b->g[5] == 930;
-        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+        in->per_rev = b->g[5] == 950;
+        CHP(emit_simple(in, CANON_FEED_MODE, interp_feed_mode_value(in), 0));
     }
     if (W('f')) {
         if (V('f') < 0)
@@ -373,9 +376,9 @@ static int exec_modes(struct interp *in)
     if (b->g[6] >= 0)
         in->inch = b->g[6] == 200;
     /* F is in the units in force (inch/min under G20, else FEED_UNITS) */
-    in->feed_mm_min = in->inch ? in->f_word * MM_PER_INCH : in->f_word * in->feed_factor;
+    in->feed_mm_min = interp_feed_mm_min(in);
     if (W('f') && !in->inverse_time)
-        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+        CHP(emit_simple(in, CANON_FEED_RATE, in->f_word, in->per_rev));
     if (b->g[8] >= 0)
         CHP(interp_tool_length(in, b->g[8]));
     if (b->g[12] >= 0) {
@@ -583,6 +586,7 @@ static int exec_stop(struct interp *in)
     in->plane = 17;
     in->incremental = 0;
     in->inverse_time = 0;
+    in->per_rev = 0;
     in->motion = 10;
     in->spindle_dir = 0;
     CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));

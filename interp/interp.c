@@ -254,6 +254,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     v->motion = in->motion;
     v->incremental = in->incremental;
     v->inverse_time = in->inverse_time;
+    v->per_rev = in->per_rev;
     v->feed_mm_min = in->feed_mm_min;
     v->spindle_dir = in->spindle_dir;
     v->spindle_rpm = in->spindle_rpm;

@@ -155,6 +155,7 @@ struct interp_view {
     int motion;               /* group 1 modal code x10 (0 G0, 10 G1, ...), -1: G80 */
     int incremental;          /* 1 under G91 */
     int inverse_time;         /* 1 under G93 */
+    int per_rev;              /* 1 under G95 (feed per revolution) */
     double feed_mm_min;       /* F in force, mm/min */
     int spindle_dir;          /* 1 (M3), -1 (M4), 0 (M5) */
     double spindle_rpm;       /* S in force */

@@ -122,6 +122,7 @@ struct ow_sub {                  /* a subroutine: where its `sub` line is */
 struct modal_save {
     int valid;
     int inch, plane, incremental, arc_absolute, inverse_time, coord_system, retract_old_z;
+    int per_rev;
     int path_mode;
     double path_tol_mm, naive_cam_tol_mm, feed_mm_min, f_word, spindle_rpm;
     int spindle_dir, mist, flood;
@@ -201,6 +202,8 @@ struct interp {
     int incremental;             /* G91 */
     int arc_absolute;            /* G90.1 (IJK absolute) */
     int inverse_time;            /* G93 */
+    int per_rev;                 /* G95: F is mm (G20: inch) per spindle revolution, run as
+                                  * F x the commanded S (feed.c) */
     int coord_system;            /* 1..9 */
     int retract_old_z;           /* G98 */
     int path_mode;               /* 610, 611 or 640 */
@@ -331,6 +334,11 @@ void interp_prog_pos(const struct interp *in, double prog[6]); /* current pos, p
 /* Resolves axis words to a machine target (G90/G91, offsets, units; G53 when machine). */
 void interp_target(struct interp *in, int machine, double target[6]);
 int interp_straight(struct interp *in, enum canon_type t, const double end[6]);
+/* feed.c: G95, feed per revolution. The feed in mm/min a block runs at (G94 and G95);
+ * the feed mode command's value (0 G94, 1 G93, 2 G95); the checks of a feed move under G95. */
+double interp_feed_mm_min(const struct interp *in);
+int interp_feed_mode_value(const struct interp *in);
+int interp_need_spindle(struct interp *in, const char *what, int col);
 /* Checks a feed move has a feed (F in force, or F in the block under G93). */
 int interp_need_feed(struct interp *in, const char *what);
 

@@ -194,13 +194,13 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
     double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
     switch (c->type) {
     case CANON_DWELL: put_call(p, "DWELL", &c->value, 1, 4); return;
-    case CANON_FEED_RATE: {
-        double f = c->feed_mm_min * (v->inch ? k : 1.0 / v->feed_factor);
+    case CANON_FEED_RATE: {   /* G95 (ivalue 1): F per revolution as written */
+        double f = c->ivalue ? c->value : c->feed_mm_min * (v->inch ? k : 1.0 / v->feed_factor);
         put_call(p, "SET_FEED_RATE", &f, 1, 4);
         return;
     }
     case CANON_FEED_MODE:
-        snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", (int)c->value);
+        snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", c->value == 2.0); /* rs274: 1 G95 */
         break;
     case CANON_PATH_MODE:
         if (c->ivalue == 640)

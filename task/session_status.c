@@ -60,7 +60,7 @@ static json_t *gcodes(const struct session *s)
         snprintf(buf, sizeof buf, "G%d", v.motion / 10);
     json_array_insert_new(a, 0, json_string(buf));
     json_array_append_new(a, json_string(v.incremental ? "G91" : "G90"));
-    json_array_append_new(a, json_string(v.inverse_time ? "G93" : "G94"));
+    json_array_append_new(a, json_string(v.inverse_time ? "G93" : v.per_rev ? "G95" : "G94"));
     if (v.tcp)
         json_array_append_new(a, json_string("G43.4"));
     return a;
