@@ -49,7 +49,7 @@ int interp_nurbs_point(struct interp *in, int prev_motion)
 {
     struct nurbs *nb = &in->nurbs;
     const struct interp_block *b = &in->blk;
-    int col = b->gcol[1] ? b->gcol[1] : W('x') ? W('x') : W('y');
+    int col = b->g[1] >= 0 ? b->gcol[1] : W('x') ? W('x') : W('y');
     if (in->plane != 17)
         return interp_fail(in, INTERP_ERR_MODAL, col, "G5.2: a NURBS must be in the XY plane "
                            "(G17); G%d is in force", in->plane);
@@ -166,12 +166,11 @@ static int chords_between(const struct nurbs *nb, struct chords *c, double u0,
         nurbs_at(nb, u0 + (u1 - u0) * s / NURBS_SAMPLES, q);
         worst = fmax(worst, seg_dist(p0, p1, q));
     }
-    if (worst > SPLINE_TOL_MM / 2 && depth < NURBS_MAX_DEPTH) {
+    if (!(worst <= SPLINE_TOL_MM / 2) && depth < NURBS_MAX_DEPTH) {
         double um = 0.5 * (u0 + u1), pm[2];
         nurbs_at(nb, um, pm);
-        if (chords_between(nb, c, u0, p0, um, pm, depth + 1))
-            return -1;
-        return chords_between(nb, c, um, pm, u1, p1, depth + 1);
+        int rc = chords_between(nb, c, u0, p0, um, pm, depth + 1);
+        return rc ? rc : chords_between(nb, c, um, pm, u1, p1, depth + 1);
     }
     if (c->n > SPLINE_MAX_CHORDS)
         return -2;

@@ -20,6 +20,10 @@ int interp_spline_emit(struct interp *in, const double (*pts)[2], int n, int ncp
     double total = 0;
     for (int k = 1; k <= n; k++)     /* the curve's length along the chords */
         total += hypot(pts[k][0] - pts[k - 1][0], pts[k][1] - pts[k - 1][1]);
+    if (!isfinite(total))
+        return interp_fail(in, INTERP_ERR_WORD, in->blk.g[1] >= 0 ? in->blk.gcol[1]
+                           : in->blk.g[0] >= 0 ? in->blk.gcol[0] : 0, "the curve's points are "
+                           "out of range (its length overflows)");
     for (int k = 1; k <= n; k++) {
         struct canon_cmd cmd;
         interp_cmd_init(in, &cmd, CANON_FEED);
@@ -53,7 +57,7 @@ static int bezier(struct interp *in, const double p[4][2], int deg)
         m = fmax(m, hypot(p[i][0] - 2 * p[i + 1][0] + p[i + 2][0],
                           p[i][1] - 2 * p[i + 1][1] + p[i + 2][1]));
     double n = ceil(sqrt((deg == 2 ? 1.0 : 3.0) * m / (4 * SPLINE_TOL_MM)));
-    int pieces = n < 1 ? 1 : n > SPLINE_MAX_CHORDS ? SPLINE_MAX_CHORDS : (int)n;
+    int pieces = !(n >= 1) ? 1 : n > SPLINE_MAX_CHORDS ? SPLINE_MAX_CHORDS : (int)n;
     double (*pts)[2] = malloc((size_t)(pieces + 1) * sizeof *pts);
     if (!pts)
         return interp_fail(in, INTERP_ERR_NOMEM, 0, "out of memory");
@@ -76,7 +80,7 @@ static int spline_check(struct interp *in, const char *name)
 {
     const struct interp_block *b = &in->blk;
     if (in->plane != 17)
-        return interp_fail(in, INTERP_ERR_MODAL, b->gcol[1] ? b->gcol[1] : 0, "%s: splines "
+        return interp_fail(in, INTERP_ERR_MODAL, b->g[1] >= 0 ? b->gcol[1] : 0, "%s: splines "
                            "must be in the XY plane (G17); G%d is in force", name, in->plane);
     static const char others[] = "zabc";
     for (int k = 0; k < 4; k++)
