@@ -13,6 +13,7 @@
 #define NURBS_SAMPLES 8          /* a chord is tested at 7 points inside it */
 #define NURBS_MAX_DEPTH 40       /* halvings of a knot span */
 
+/* Frees the points collected (the interpreter's end). */
 void interp_nurbs_free(struct nurbs *nb)
 {
     free(nb->pt);
@@ -134,15 +135,13 @@ static double seg_dist(const double a[2], const double b[2], const double q[2])
     return hypot(q[0] - a[0] - t * dx, q[1] - a[1] - t * dy);
 }
 
-/* The chords of the curve.
- * Within a knot span the curve is one smooth rational polynomial; over a short step of u it
- * is close to a parabola, whose distance from the chord is sampled finely (7 points) and held
- * to half the tolerance before the chord is taken, else the step is halved. */
+/* The chord ends made so far (machine X Y, mm; [0] the curve's start). */
 struct chords {
     double (*pt)[2];
     int n, cap;
 };
 
+/* Appends a chord end; -1 when out of memory. */
 static int chord_push(struct chords *c, const double p[2])
 {
     if (c->n == c->cap) {
@@ -158,6 +157,10 @@ static int chord_push(struct chords *c, const double p[2])
     return 0;
 }
 
+/* The chords from p0 = C(u0) to p1 = C(u1) within one knot span. There the curve is one
+ * smooth rational polynomial; over a short step of u it is close to a parabola, whose
+ * distance from the chord is sampled finely (7 points) and held to half the tolerance
+ * before the chord is taken, else the step is halved. -2: more than SPLINE_MAX_CHORDS. */
 static int chords_between(const struct nurbs *nb, struct chords *c, double u0,
                           const double p0[2], double u1, const double p1[2], int depth)
 {
