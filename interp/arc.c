@@ -139,6 +139,14 @@ int interp_arc(struct interp *in, int g)
                                 in->tool[ax[i]];
     cmd.arc.center[p.n] = in->pos[p.n];
     cmd.arc.normal[p.n] = 1.0;
+    if (in->rot_deg != 0.0) {  /* the centre and the plane turn with the coordinate system */
+        double pc[6], m[2];
+        interp_prog_pos(in, pc);
+        pc[ax[0]] = c[0], pc[ax[1]] = c[1];
+        interp_xy_to_machine(in, pc[AX_X], pc[AX_Y], m);
+        cmd.arc.center[AX_X] = m[0], cmd.arc.center[AX_Y] = m[1];
+        interp_rotate_xy(&cmd.arc.normal[AX_X], &cmd.arc.normal[AX_Y], in->rot_deg);
+    }
     cmd.arc.rotation = ccw ? turns : -turns;
     cmd.arc.plane = in->plane;
     cmd.feed_mm_min = in->feed_mm_min;

@@ -14,12 +14,12 @@ static const struct { int code, group; } g_table[] = {
     {591, 12}, {592, 12}, {593, 12}, {610, 13}, {611, 13}, {640, 13}, {730, 1},  {800, 1},
     {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},  {901, 4},  {910, 3},
     {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},  {940, 5},  {980, 10},
-    {990, 10}, {1410, 0}, {1420, 0}, {51, 1},   {520, 0},
+    {990, 10}, {1410, 0}, {1420, 0}, {51, 1},   {520, 0},  {50, 1},   {52, 1},   {53, 0},
+    {950, 5},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {50, 52, 55, 61, 331, 382, 383, 384, 385, 840,
-                                    860, 870, 880, 950};
+static const int g_unsupported[] = {55, 61, 331, 382, 383, 384, 385, 840, 860, 870, 880};
 
 /* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
  * or "not yet". */
@@ -159,7 +159,7 @@ static int check_axis_users(struct interp *in)
                            code_str(g0 >= 0 ? g0 : b->g[8], s), code_str(g1, s2));
     if (!g0_axes && has_axis(b) && block_motion(in) < 0)
         return interp_fail(in, INTERP_ERR_MODAL, first_axis_col(b), "axis words with no motion "
-                           "mode in force (after G80 give G0, G1, G2, G3 or a cycle)");
+                           "mode in force (after G80 or G5.3 give G0, G1, G2, G3 or a cycle)");
     if (g0 == 530) {
         int m = block_motion(in);
         if ((m != 0 && m != 10) || !has_axis(b))
@@ -181,16 +181,20 @@ static int word_used(const struct interp *in, char w)
     int ccomp = b->g[7] >= 410;   /* G41, G41.1, G42, G42.1 */
     int arc = !comp && g0 < 0 && (m == 20 || m == 30);
     int cycle = !comp && g0 < 0 && is_cycle(m);
+    int spline = !comp && g0 < 0;                      /* G5, G5.1 (with m) */
+    int nurbs = spline && m == 52 && (b->g[1] == 52 || has_axis(b));  /* a G5.2 point */
     switch (w) {
-    case 'i': case 'j': return arc || g0 == 100 || (!comp && g0 < 0 && m == 51);
+    case 'i': case 'j': return arc || g0 == 100 || (spline && (m == 51 || m == 50));
     case 'k': return arc || g0 == 100;
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 || b->m[4] == 98 ||
-                     (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66);
+                     (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66) ||
+                     (spline && m == 50) || nurbs;
     case 'q': return (cycle && (m == 730 || m == 830)) || g0 == 100 || b->g[13] == 640 ||
-                     b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68;
+                     b->m[6] == 61 || b->m[5] == 66 || b->m[5] == 67 || b->m[5] == 68 ||
+                     (spline && m == 50);
     case 'e': return b->m[5] >= 66 && b->m[5] <= 68;
-    case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98 || ccomp;
+    case 'l': return cycle || g0 == 100 || b->m[5] == 66 || b->m[4] == 98 || ccomp || nurbs;
     case 'h': return b->g[8] == 430 || b->g[8] == 432 || b->g[8] == 434;
     case 'd': return comp || ccomp;
     case 'w': return comp;
@@ -207,9 +211,10 @@ static int check_unused(struct interp *in)
         "I, J and K are arc centre words: use them with G2 or G3",
         "I, J and K are arc centre words: use them with G2 or G3",
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
-        "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G82/G89 (dwell) and M62..M66",
-        "Q is used by the peck cycles G73 and G83, G10, G64, M61, M66, M67 and M68",
-        "L is used by G10, canned cycles (repeats), G41.1/G42.1 and M66",
+        "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G5, G5.2, G82/G89 (dwell) and "
+        "M62..M66",
+        "Q is used by the peck cycles G73 and G83, G5, G10, G64, M61, M66, M67 and M68",
+        "L is used by G10, G5.2, canned cycles (repeats), G41.1/G42.1 and M66",
         "H is used by G43, G43.2 (tool length offsets) and G43.4 (tool centre point control)",
         "D is used by G41/G42 and G141/G142 (tool number) and G41.1/G42.1 (diameter)",
         "W (tool radius) is only used with G141/G142",

@@ -17,8 +17,9 @@ enum canon_type {
     CANON_FEED,            /* G1 (and compensated G141/G142 lines): straight feed to end */
     CANON_ARC,             /* G2/G3 (and the corner arcs of G141/G142): arc/helix to end */
     CANON_DWELL,           /* G4: seconds */
-    CANON_FEED_RATE,       /* F changed: feed_mm_min */
-    CANON_FEED_MODE,       /* G93/G94: value = 1 for inverse time, 0 for units/min */
+    CANON_FEED_RATE,       /* F changed: feed_mm_min (G95, ivalue 1: value = F per rev) */
+    CANON_FEED_MODE,       /* G93/G94/G95: value = 1 for inverse time, 0 for units/min, 2 for
+                            * feed per revolution (moves still carry feed_mm_min: F x S) */
     CANON_PATH_MODE,       /* G61 (value 0) / G64 (value = blend tolerance mm, 0 = none) */
     CANON_SPINDLE_SPEED,   /* S: value = rpm */
     CANON_SPINDLE_ON,      /* M3 (value = +1) / M4 (value = -1) */
@@ -30,7 +31,9 @@ enum canon_type {
                             * (its text then expanded: printers show rs274's MESSAGE, LOG...) */
     CANON_PAUSE,           /* M0 (ivalue 0) / M1 optional stop (ivalue 1) */
     CANON_PROGRAM_END,     /* M2 / M30 (ivalue 2 or 30) */
-    CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]) */
+    CANON_OFFSETS,         /* informational: the total offset in force changed (offset[]:
+                            * work + G92 + tool, as if unrotated) or the coordinate system's
+                            * rotation about Z did (value, deg: G10 L2 R) */
     CANON_SETTING,         /* a setting the machine keeps (setting): a tool-table entry (G10
                             * L1) and/or persistent parameters #5161..#5390 (G10 L2/L20,
                             * G28.1/G30.1, G92, G54..G59.3, #n=) changed by this line. It
@@ -101,8 +104,9 @@ struct canon_cmd {
                             * feeds that stay within it of one line run as that line) */
     int ivalue;            /* TOOL_CHANGE tool, COOLANT code, PAUSE/PROGRAM_END code */
     int compensated;       /* FEED, ARC: 141 or 142 when made by G141/G142, else 0 */
-    int spline;            /* FEED: a chord of a G5.1 spline, 1 the block's first, 2 the
-                            * others (printers show rs274's one NURBS_FEED line) */
+    int spline;            /* FEED: a chord of a G5/G5.1 spline or a G5.3 NURBS, 1 the
+                            * block's first (ivalue: its control points), 2 the others
+                            * (printers show rs274's one NURBS_FEED(ivalue, ...) line) */
     int tcp;               /* under tool centre point control (G43.4): end (and an arc's
                             * geometry) is the tool tip and orientation (kins_tcp_to_pose
                             * gives the platform's pose), tool_len_mm the tool's length */

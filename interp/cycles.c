@@ -51,6 +51,8 @@ static int cyc_move(struct interp *in, const struct cycle *c, enum canon_type t,
     p[c->ax.w] = z;
     for (int i = 0; i < 3; i++)
         m[i] = interp_len_mm(in, p[i]) + in->g5x[i] + in->g92[i] + in->tool[i];
+    if (in->rot_deg != 0.0)
+        interp_xy_to_machine(in, p[AX_X], p[AX_Y], m);
     for (int i = 3; i < 6; i++)
         m[i] = in->pos[i];
     return interp_straight(in, t, m);

@@ -76,6 +76,7 @@ void interp_modal_save(const struct interp *in, struct modal_save *m)
     m->valid = 1;
     m->inch = in->inch, m->plane = in->plane, m->incremental = in->incremental;
     m->arc_absolute = in->arc_absolute, m->inverse_time = in->inverse_time;
+    m->per_rev = in->per_rev;
     m->coord_system = in->coord_system, m->retract_old_z = in->retract_old_z;
     m->path_mode = in->path_mode, m->path_tol_mm = in->path_tol_mm;
     m->naive_cam_tol_mm = in->naive_cam_tol_mm;
@@ -92,13 +93,14 @@ int interp_modal_restore(struct interp *in, const struct modal_save *m)
     in->inch = m->inch, in->plane = m->plane, in->incremental = m->incremental;
     in->arc_absolute = m->arc_absolute, in->retract_old_z = m->retract_old_z;
     in->f_word = m->f_word;
-    if (in->inverse_time != m->inverse_time) {
+    if (in->inverse_time != m->inverse_time || in->per_rev != m->per_rev) {
         in->inverse_time = m->inverse_time;
-        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+        in->per_rev = m->per_rev;
+        CHP(emit_simple(in, CANON_FEED_MODE, interp_feed_mode_value(in), 0));
     }
     if (in->feed_mm_min != m->feed_mm_min) {
         in->feed_mm_min = m->feed_mm_min;
-        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+        CHP(emit_simple(in, CANON_FEED_RATE, in->f_word, in->per_rev));
     }
     if (in->path_mode != m->path_mode || in->path_tol_mm != m->path_tol_mm ||
         in->naive_cam_tol_mm != m->naive_cam_tol_mm) {
@@ -239,11 +241,17 @@ double interp_len_mm(const struct interp *in, double v)
 /* The current pose in program coordinates: offsets removed, program units. */
 void interp_prog_pos(const struct interp *in, double prog[6])
 {
-    for (int i = 0; i < 6; i++) {
+    for (int i = 0; i < 6; i++)
         prog[i] = in->pos[i] - in->g5x[i] - in->g92[i] - in->tool[i];
-        if (i < 3 && in->inch)
-            prog[i] /= MM_PER_INCH;
+    if (in->rot_deg != 0.0) {   /* X Y in the rotated frame (rotation.c) */
+        double q[2];
+        interp_rotated_pos(in, q);
+        prog[AX_X] = q[0] - in->g92[AX_X];
+        prog[AX_Y] = q[1] - in->g92[AX_Y];
     }
+    if (in->inch)
+        for (int i = 0; i < 3; i++)
+            prog[i] /= MM_PER_INCH;
 }
 
 /* Axis words to a machine target: absent axes stay, G91 adds, G90 adds the offsets. */
@@ -262,6 +270,17 @@ void interp_target(struct interp *in, int machine, double t[6])
             t[i] = in->pos[i] + v;
         else
             t[i] = v + in->g5x[i] + in->g92[i] + in->tool[i];
+    }
+    if (in->rot_deg != 0.0 && !machine && (W('x') || W('y'))) {
+        /* X Y in the rotated frame: G91 steps along the turned axes, as LinuxCNC */
+        double cur[6], p[2];
+        interp_prog_pos(in, cur);
+        for (int i = 0; i < 2; i++) {
+            p[i] = cur[i];
+            if (W(ax[i]))
+                p[i] = in->incremental && !in->blk.polar_inc ? cur[i] + V(ax[i]) : V(ax[i]);
+        }
+        interp_xy_to_machine(in, p[0], p[1], t);
     }
 }
 
@@ -288,7 +307,7 @@ int interp_need_feed(struct interp *in, const char *what)
     if (in->f_word <= 0.0)
         return interp_fail(in, INTERP_ERR_WORD, col, "%s with zero feed rate: give an F word "
                            "first", what);
-    return 0;
+    return in->per_rev ? interp_need_spindle(in, what, col) : 0;
 }
 
 /* F, S, T, M6, M3/M4/M5, M7/M8/M9 and G4: the first steps of LinuxCNC's order. */
@@ -297,7 +316,8 @@ static int exec_machine_words(struct interp *in)
     struct interp_block *b = &in->blk;
     if (b->g[5] >= 0) {
         in->inverse_time = b->g[5] == 930;
-        CHP(emit_simple(in, CANON_FEED_MODE, in->inverse_time, 0));
+        in->per_rev = b->g[5] == 950;
+        CHP(emit_simple(in, CANON_FEED_MODE, interp_feed_mode_value(in), 0));
     }
     if (W('f')) {
         if (V('f') < 0)
@@ -373,9 +393,9 @@ static int exec_modes(struct interp *in)
             ccomp_scale(in, in->inch ? 1.0 / MM_PER_INCH : MM_PER_INCH);
     }
     /* F is in the units in force (inch/min under G20, else FEED_UNITS) */
-    in->feed_mm_min = in->inch ? in->f_word * MM_PER_INCH : in->f_word * in->feed_factor;
+    in->feed_mm_min = interp_feed_mm_min(in);
     if (W('f') && !in->inverse_time)
-        CHP(emit_simple(in, CANON_FEED_RATE, 0, 0));
+        CHP(emit_simple(in, CANON_FEED_RATE, in->f_word, in->per_rev));
     if (b->g[7] >= 0)
         CHP(ccomp_mode(in, b->g[7]));
     if (b->g[8] >= 0)
@@ -521,7 +541,7 @@ int interp_polar_words(struct interp *in)
 static int exec_motion(struct interp *in)
 {
     struct interp_block *b = &in->blk;
-    int g0 = b->g[0];
+    int g0 = b->g[0], prev_motion = in->motion;
     CHP(interp_polar_words(in));
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
@@ -551,12 +571,15 @@ static int exec_motion(struct interp *in)
         CHP(interp_need_feed(in, m == 20 ? "G2" : "G3"));
         return interp_arc(in, m);
     }
-    if (m == 51) {
-        if (!axis && !W('i') && !W('j'))
+    if (m == 50 || m == 51) {
+        in->motion = prev_motion;   /* G5 and G5.1 leave the motion mode as it was (rs274) */
+        if (!axis && !W('i') && !W('j') && !W('p') && !W('q'))
             return 0;
-        CHP(interp_need_feed(in, "G5.1"));
-        return interp_spline(in);
+        CHP(interp_need_feed(in, m == 50 ? "G5" : "G5.1"));
+        return m == 50 ? interp_spline_cubic(in) : interp_spline(in);
     }
+    if (m == 52)
+        return b->g[1] == 52 || axis ? interp_nurbs_point(in, prev_motion) : 0;
     if (m >= 0 && axis)
         return interp_cycle(in, m);
     return 0;
@@ -590,6 +613,7 @@ static int exec_stop(struct interp *in)
     in->plane = 17;
     in->incremental = 0;
     in->inverse_time = 0;
+    in->per_rev = 0;
     in->motion = 10;
     in->spindle_dir = 0;
     CHP(emit_simple(in, CANON_SPINDLE_STOP, 0, 0));
@@ -654,6 +678,8 @@ int interp_execute(struct interp *in)
         CHP(interp_home(in, g0));
     else if ((g0 >= 920 && g0 <= 923) || g0 == 520)
         CHP(interp_g92(in, g0));
+    else if (g0 == 53)
+        CHP(interp_nurbs_end(in));
     if (comp && b->g[1] >= 0)
         in->motion = b->g[1]; /* G1 beside G141/G142 is modal as usual */
     if (comp)

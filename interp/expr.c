@@ -244,6 +244,12 @@ static int read_parameter(struct interp *in, int *pos, double *out)
     if (idx < 1 || idx >= INTERP_NPARAMS)
         return interp_fail(in, INTERP_ERR_PARAM, col, "parameter number #%d out of range "
                            "(1 to %d)", idx, INTERP_NPARAMS - 1);
+    if (idx >= PARAM_POS && idx < PARAM_POS + 6) { /* the current point, as #<_x> .. */
+        double prog[6];
+        interp_prog_pos(in, prog);
+        *out = prog[idx - PARAM_POS];
+        return 0;
+    }
     *out = in->params[idx];
     return 0;
 }

@@ -103,6 +103,7 @@ void interp_destroy(struct interp *in)
     oword_free(in);
     comp5_free(&in->comp);
     ccomp_free(&in->cc);
+    interp_nurbs_free(&in->nurbs);
     free(in->param_path);
     free(in);
 }
@@ -244,6 +245,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     memcpy(v->g5x_mm, in->g5x, sizeof v->g5x_mm);
     memcpy(v->g92_mm, in->g92, sizeof v->g92_mm);
     memcpy(v->tool_mm, in->tool, sizeof v->tool_mm);
+    v->xy_rotation_deg = in->rot_deg;
     v->tcp = in->tcp_on;
     v->tcp_len_mm = in->tcp_len_mm;
     v->feed_factor = in->feed_factor;
@@ -255,6 +257,7 @@ void interp_get_view(const struct interp *in, struct interp_view *v)
     v->motion = in->motion;
     v->incremental = in->incremental;
     v->inverse_time = in->inverse_time;
+    v->per_rev = in->per_rev;
     v->feed_mm_min = in->feed_mm_min;
     v->spindle_dir = in->spindle_dir;
     v->spindle_rpm = in->spindle_rpm;

@@ -144,6 +144,7 @@ struct interp_view {
     double g5x_mm[6];         /* offset of the active coordinate system (mm, deg) */
     double g92_mm[6];         /* G92 offset (mm, deg) */
     double tool_mm[6];        /* tool length offset (Z only for G43 H; 0 under G43.4) */
+    double xy_rotation_deg;   /* the coordinate system's rotation about Z (G10 L2 R), deg */
     int tcp;                  /* tool centre point control (G43.4) is on */
     double tcp_len_mm;        /* its tool length, mm */
     double feed_factor;       /* see interp_set_feed_factor */
@@ -155,6 +156,7 @@ struct interp_view {
     int motion;               /* group 1 modal code x10 (0 G0, 10 G1, ...), -1: G80 */
     int incremental;          /* 1 under G91 */
     int inverse_time;         /* 1 under G93 */
+    int per_rev;              /* 1 under G95 (feed per revolution) */
     double feed_mm_min;       /* F in force, mm/min */
     int spindle_dir;          /* 1 (M3), -1 (M4), 0 (M5) */
     double spindle_rpm;       /* S in force */
@@ -162,6 +164,10 @@ struct interp_view {
     int selected_tool;        /* T of the last T word */
 };
 void interp_get_view(const struct interp *in, struct interp_view *v);
+/* A machine pose (mm, deg) in the program coordinates of view v: offsets and the rotation
+ * removed, inches under G20 (what rs274 prints, what a display shows). */
+void interp_view_to_program(const struct interp_view *v, const double machine[6],
+                            double prog[6]);
 /* Numbered parameter #n (1..5602), or 0 when out of range. */
 double interp_param(const struct interp *in, int n);
 

@@ -27,6 +27,9 @@ enum {
     PARAM_G92 = 5211,            /* 5211..5216: G92 offsets */
     PARAM_COORD = 5220,          /* active coordinate system 1..9 */
     PARAM_G54 = 5221,            /* 5221..5226 G54, then every 20 up to 5381 (G59.3) */
+    PARAM_ROT = 9,               /* PARAM_G54 + 20 n + PARAM_ROT: that system's rotation about
+                                  * Z, deg (#5230 for G54, G10 L2 R) */
+    PARAM_POS = 5420,            /* 5420..5428: the current point, program frame (read-only) */
     PARAM_PERSIST_LO = 5161,
     PARAM_PERSIST_HI = 5390,
 };
@@ -70,6 +73,17 @@ struct named_table {
     size_t nslot;
 };
 
+/* G5.2 control points collected until G5.3 (nurbs.c). */
+struct nurbs_point {
+    double x, y;                 /* machine frame, mm */
+    double w;                    /* weight (P) */
+};
+struct nurbs {
+    struct nurbs_point *pt;      /* [0] is where the curve starts */
+    int n, cap;
+    int order;                   /* L: 3 (quadratic) unless a G5.2 gave more */
+};
+
 /* O-words (oword.c): the texts lines are read from, the open conditions and loops, the
  * subroutines known so far and the calls in progress. Positions are (text, line index). */
 #define OWORD_LABEL_MAX 72       /* "123" or "<name>" as normalised, with the brackets */
@@ -109,6 +123,7 @@ struct ow_sub {                  /* a subroutine: where its `sub` line is */
 struct modal_save {
     int valid;
     int inch, plane, incremental, arc_absolute, inverse_time, coord_system, retract_old_z;
+    int per_rev;
     int path_mode;
     double path_tol_mm, naive_cam_tol_mm, feed_mm_min, f_word, spindle_rpm;
     int spindle_dir, mist, flood;
@@ -188,6 +203,8 @@ struct interp {
     int incremental;             /* G91 */
     int arc_absolute;            /* G90.1 (IJK absolute) */
     int inverse_time;            /* G93 */
+    int per_rev;                 /* G95: F is mm (G20: inch) per spindle revolution, run as
+                                  * F x the commanded S (feed.c) */
     int coord_system;            /* 1..9 */
     int retract_old_z;           /* G98 */
     int path_mode;               /* 610, 611 or 640 */
@@ -195,6 +212,7 @@ struct interp {
     double naive_cam_tol_mm;     /* G64 Q: LinuxCNC's "naive CAM detector" tolerance; stored
                                   * and reported, not used by the planner (docs/gcode.md) */
     double g5x[6];               /* active work offset, mm/deg */
+    double rot_deg;              /* the active system's rotation about Z, deg (rotation.c) */
     double g92[6];               /* active G92 offset */
     double tool[6];              /* active tool length offset (0 under G43.4) */
     struct kins_tool_frame tf;   /* where the machine's tool is (interp_set_tool_frame) */
@@ -215,6 +233,9 @@ struct interp {
     int flood, mist;             /* M8, M7 on (M9 turns both off) */
     double spindle_rpm;
     double comp_radius_mm;       /* W (or D's radius) of the open G141/G142 run, 0 = none */
+    double g5_ij[2];             /* G5 without I J starts with these (program units): -P -Q
+                                  * of the last G5, as LinuxCNC keeps them */
+    struct nurbs nurbs;          /* G5.2 points waiting for G5.3 */
 
     struct oword ow;             /* O-word control flow */
     struct modal_save m70;       /* the state M70 saved, for M72 */
@@ -234,8 +255,20 @@ int interp_emit_path_mode(struct interp *in);
 void interp_modal_save(const struct interp *in, struct modal_save *m);
 int interp_modal_restore(struct interp *in, const struct modal_save *m);
 
-/* spline.c: G5.1 (quadratic B-spline) as straight feeds. */
+/* spline.c: G5 (cubic) and G5.1 (quadratic) splines as straight feeds (chords) that leave
+ * the curve by at most SPLINE_TOL_MM; the planner follows them exactly. */
+#define SPLINE_TOL_MM 1e-4
+#define SPLINE_MAX_CHORDS 100000
 int interp_spline(struct interp *in);
+int interp_spline_cubic(struct interp *in);
+/* Emits chords pts[1..n] from pts[0] (machine X Y, mm) as one spline block; ncp is the
+ * number of control points printers show (rs274's NURBS_FEED(ncp, ...)). */
+int interp_spline_emit(struct interp *in, const double (*pts)[2], int n, int ncp);
+/* nurbs.c: G5.2 (a control point; prev_motion the motion mode before the block) and G5.3
+ * (the curve). */
+int interp_nurbs_point(struct interp *in, int prev_motion);
+int interp_nurbs_end(struct interp *in);
+void interp_nurbs_free(struct nurbs *nb);
 
 /* The canon sink G141/G142 and the G41/G42 queue emit through (exec.c): stamps the tool
  * centre point state. */
@@ -309,8 +342,24 @@ void interp_prog_pos(const struct interp *in, double prog[6]); /* current pos, p
 /* Resolves axis words to a machine target (G90/G91, offsets, units; G53 when machine). */
 void interp_target(struct interp *in, int machine, double target[6]);
 int interp_straight(struct interp *in, enum canon_type t, const double end[6]);
+/* feed.c: G95, feed per revolution. The feed in mm/min a block runs at (G94 and G95);
+ * the feed mode command's value (0 G94, 1 G93, 2 G95); the checks of a feed move under G95. */
+double interp_feed_mm_min(const struct interp *in);
+int interp_feed_mode_value(const struct interp *in);
+int interp_need_spindle(struct interp *in, const char *what, int col);
 /* Checks a feed move has a feed (F in force, or F in the block under G93). */
 int interp_need_feed(struct interp *in, const char *what);
+
+/* rotation.c: the active system's rotation about Z (G10 L2 R). */
+void interp_rotate_xy(double *x, double *y, double deg);
+/* Program X Y (program units) to machine X Y (mm), offsets and rotation applied. */
+void interp_xy_to_machine(const struct interp *in, double px, double py, double m[2]);
+/* The current point in the rotated frame (program X Y + G92), mm. */
+void interp_rotated_pos(const struct interp *in, double q[2]);
+/* G10 L2/L20 X Y (and L2 R) on system sys when a rotation is involved (offsets.c). */
+void interp_g10_rotated(struct interp *in, int l, int sys);
+/* G28/G30 with X or Y alone under a rotation: the machine X Y of the home move (t[0..1]). */
+void interp_home_rotated(const struct interp *in, int base, double t[2]);
 
 /* arc.c */
 int interp_arc(struct interp *in, int g);

@@ -92,6 +92,9 @@ static int read_assignment(struct interp *in, int *pos)
         if (idx < 1 || idx >= INTERP_NPARAMS)
             return interp_fail(in, INTERP_ERR_PARAM, col, "parameter number #%d out of range "
                                "(1 to %d)", idx, INTERP_NPARAMS - 1);
+        if (idx >= PARAM_POS && idx <= PARAM_POS + 8)
+            return interp_fail(in, INTERP_ERR_PARAM, col, "#%d is read-only: #5420..#5428 "
+                               "tell the current position", idx);
     }
     if (in->norm[*pos] != '=') {
         if (named)

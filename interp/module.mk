@@ -11,7 +11,10 @@ TESTS += test_comp5 test_comp5_join test_comp5_gouge test_tooltable test_tooltab
 SCRIPT_TESTS += tests/paper_programs.sh tests/comp5_gouge_cli.sh
 TESTS += test_interp test_interp_number test_interp_motion test_interp_setup test_interp_cycles test_interp_named
 TESTS += test_interp_params test_interp_ccomp
-BENCHES += bench_interp
+BENCHES += bench_interp bench_oword
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh tests/linuxcnc_tooltables.sh \
                 tests/linuxcnc_corpus.sh
 LIB_SRCS += interp/interp_setup.c
+LIB_SRCS += interp/rotation.c interp/nurbs.c interp/feed.c
+TESTS += test_interp_spline test_interp_feed
+TESTS += test_interp_rotation

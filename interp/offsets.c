@@ -75,12 +75,19 @@ static int g10_coord(struct interp *in, int l, int p)
     if (p < 0 || p > 9)
         return interp_fail(in, INTERP_ERR_WORD, W('p'), "G10 L%d P%d: P selects the coordinate "
                            "system, 1 (G54) to 9 (G59.3), or 0 for the active one", l, p);
-    if (W('r') && V('r') != 0.0)  /* R0: no rotation, as CAM posts write it */
-        return interp_fail(in, INTERP_ERR_UNSUPPORTED, W('r'), "G10 L%d R%g (rotation of the "
-                           "coordinate system) is not supported yet (only R0)", l, V('r'));
+    if (W('r') && l == 20)
+        return interp_fail(in, INTERP_ERR_WORD, W('r'), "G10 L20 takes no R word: set the "
+                           "rotation of the coordinate system with G10 L2 P%d R", p);
     int sys = p == 0 ? in->coord_system : p, base = PARAM_G54 + 20 * (sys - 1);
+    /* a rotation (the system's, the one given, or the active one) turns X and Y */
+    int rotated = (W('r') && V('r') != 0.0) || in->params[base + PARAM_ROT] != 0.0 ||
+                  (sys == in->coord_system && in->rot_deg != 0.0);
+    if (rotated)
+        interp_g10_rotated(in, l, sys);
+    else if (W('r'))
+        in->params[base + PARAM_ROT] = V('r');   /* R0 */
     for (int i = 0; i < 6; i++) {
-        if (!W(axis_letter[i]))
+        if (!W(axis_letter[i]) || (rotated && i < 2))
             continue;
         double v = axis_mm(in, i);
         in->params[base + i] = l == 2 ? v : in->pos[i] - in->g92[i] - in->tool[i] - v;
@@ -133,6 +140,8 @@ int interp_home(struct interp *in, int g)
     CHP(interp_straight(in, CANON_TRAVERSE, t));
     for (int i = 0; i < 6; i++)
         t[i] = all || W(axis_letter[i]) ? in->params[base + i] : in->pos[i];
+    if (in->rot_deg != 0.0 && !all && W('x') != W('y'))
+        interp_home_rotated(in, base, t);
     return interp_straight(in, CANON_TRAVERSE, t);
 }
 
@@ -144,10 +153,15 @@ int interp_g92(struct interp *in, int g)
         if (!any_axis(in))
             return interp_fail(in, INTERP_ERR_WORD, in->blk.gcol[0], "G92 needs at least one "
                                "axis word (the value the current point should have)");
+        double q[2];
+        interp_rotated_pos(in, q);  /* G92 is measured in the rotated frame */
         for (int i = 0; i < 6; i++) {
             if (!W(axis_letter[i]))
                 continue;
-            in->g92[i] = in->pos[i] - in->g5x[i] - in->tool[i] - axis_mm(in, i);
+            if (i < 2 && in->rot_deg != 0.0)
+                in->g92[i] = q[i] - axis_mm(in, i);
+            else
+                in->g92[i] = in->pos[i] - in->g5x[i] - in->tool[i] - axis_mm(in, i);
         }
         for (int i = 0; i < 6; i++)
             in->params[PARAM_G92 + i] = in->g92[i];

@@ -92,7 +92,8 @@ int interp_params_load(struct interp *in, const char *path)
     return rc;
 }
 
-/* Whether LinuxCNC writes parameter n to its file (the 9-axis blocks of offsets). */
+/* Whether LinuxCNC writes parameter n to its file (the 9-axis blocks of offsets and each
+ * system's rotation). */
 static int persistent(int n)
 {
     if (n < PARAM_PERSIST_LO || n > PARAM_PERSIST_HI)
@@ -103,7 +104,7 @@ static int persistent(int n)
         return 1;
     if (n >= 5210 && n <= 5220)
         return 1;
-    return n >= 5221 && (n - 5221) % 20 < 9;
+    return n >= 5221 && (n - 5221) % 20 < 10;   /* X..W and the rotation R */
 }
 
 /* Whether parameter n is one the parameter file keeps (for settings.c). */
@@ -142,14 +143,16 @@ void interp_select_coord(struct interp *in, int system)
     in->params[PARAM_COORD] = system;
     for (int i = 0; i < 6; i++)
         in->g5x[i] = in->params[PARAM_G54 + 20 * (system - 1) + i];
+    in->rot_deg = in->params[PARAM_G54 + 20 * (system - 1) + PARAM_ROT];
 }
 
-/* Tells the sink the total offset now in force (work + G92 + tool). */
+/* Tells the sink the total offset now in force (work + G92 + tool) and the rotation. */
 int interp_emit_offsets(struct interp *in)
 {
     struct canon_cmd c;
     interp_cmd_init(in, &c, CANON_OFFSETS);
     for (int i = 0; i < 6; i++)
         c.offset[i] = in->g5x[i] + in->g92[i] + in->tool[i];
+    c.value = in->rot_deg;
     return interp_emit(in, &c);
 }

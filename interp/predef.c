@@ -8,6 +8,7 @@ enum predef {
     PD_X, PD_Y, PD_Z, PD_A, PD_B, PD_C,                         /* program frame */
     PD_ABS_X, PD_ABS_Y, PD_ABS_Z, PD_ABS_A, PD_ABS_B, PD_ABS_C, /* machine frame */
     PD_METRIC, PD_IMPERIAL, PD_ABSOLUTE, PD_INCREMENTAL, PD_INVERSE_TIME, PD_UNITS_PER_MINUTE,
+    PD_UNITS_PER_REV,
     PD_PLANE, PD_COORD_SYSTEM, PD_RETRACT_R_PLANE, PD_RETRACT_OLD_Z, PD_IJK_ABSOLUTE,
     PD_MOTION_MODE, PD_FEED, PD_RPM, PD_SPINDLE_ON, PD_SPINDLE_CW, PD_CURRENT_TOOL,
     PD_SELECTED_TOOL, PD_FLOOD, PD_MIST, PD_TASK, PD_CALL_LEVEL, PD_LINE,
@@ -19,7 +20,8 @@ static const struct { const char *name; enum predef id; } predef_table[] = {
     {"_abs_a", PD_ABS_A}, {"_abs_b", PD_ABS_B}, {"_abs_c", PD_ABS_C},
     {"_metric", PD_METRIC}, {"_imperial", PD_IMPERIAL}, {"_absolute", PD_ABSOLUTE},
     {"_incremental", PD_INCREMENTAL}, {"_inverse_time", PD_INVERSE_TIME},
-    {"_units_per_minute", PD_UNITS_PER_MINUTE}, {"_plane", PD_PLANE},
+    {"_units_per_minute", PD_UNITS_PER_MINUTE}, {"_units_per_rev", PD_UNITS_PER_REV},
+    {"_plane", PD_PLANE},
     {"_coord_system", PD_COORD_SYSTEM}, {"_retract_r_plane", PD_RETRACT_R_PLANE},
     {"_retract_old_z", PD_RETRACT_OLD_Z}, {"_ijk_absolute_mode", PD_IJK_ABSOLUTE},
     {"_motion_mode", PD_MOTION_MODE}, {"_feed", PD_FEED}, {"_rpm", PD_RPM},
@@ -59,7 +61,8 @@ static double predef_value(const struct interp *in, enum predef id)
     case PD_ABSOLUTE: return !in->incremental;
     case PD_INCREMENTAL: return in->incremental;
     case PD_INVERSE_TIME: return in->inverse_time;
-    case PD_UNITS_PER_MINUTE: return !in->inverse_time;
+    case PD_UNITS_PER_MINUTE: return !in->inverse_time && !in->per_rev;
+    case PD_UNITS_PER_REV: return in->per_rev;
     case PD_PLANE: return in->plane * 10;
     case PD_COORD_SYSTEM: return coord_code(in->coord_system);
     case PD_RETRACT_R_PLANE: return !in->retract_old_z;

@@ -96,14 +96,11 @@ static void put_call(struct interp_printer *p, const char *name, const double *v
     put(p, ")\n", 2);
 }
 
-/* Machine pose to program coordinates: what rs274 prints (offsets removed, inch units). */
+/* Machine pose to program coordinates: what rs274 prints (offsets and rotation removed,
+ * inch units). */
 static void to_program(const struct interp_view *v, const double m[6], double out[6])
 {
-    for (int i = 0; i < 6; i++) {
-        out[i] = m[i] - v->g5x_mm[i] - v->g92_mm[i] - v->tool_mm[i];
-        if (i < 3 && v->inch)
-            out[i] /= MM_PER_INCH;
-    }
+    interp_view_to_program(v, m, out);
 }
 
 /* ARC_FEED(first end, second end, first centre, second centre, turns, axis end, A, B, C). */
@@ -158,7 +155,8 @@ static void put_offsets(struct interp_printer *p, const struct interp_view *v, i
 {
     double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
     char tmp[48];
-    if (all || v->coord_system != p->coord || memcmp(v->g5x_mm, p->g5x, sizeof p->g5x)) {
+    int g5x = all || v->coord_system != p->coord || memcmp(v->g5x_mm, p->g5x, sizeof p->g5x);
+    if (g5x) {
         line_start(p, NULL);
         put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_G5X_OFFSET(%d, ", v->coord_system));
         put_six(p, v->g5x_mm, k, ", ");
@@ -176,6 +174,12 @@ static void put_offsets(struct interp_printer *p, const struct interp_view *v, i
         put_six(p, v->tool_mm, k, " ");
         puts_(p, ", 0.0000 0.0000 0.0000)\n");
     }
+    if (all || v->xy_rotation_deg != p->rot_deg || g5x) {  /* rs274: after each SET_G5X */
+        line_start(p, NULL);
+        put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "SET_XY_ROTATION(%.4f)\n",
+                                     v->xy_rotation_deg));
+    }
+    p->rot_deg = v->xy_rotation_deg;
     p->coord = v->coord_system;
     memcpy(p->g5x, v->g5x_mm, sizeof p->g5x);
     memcpy(p->g92, v->g92_mm, sizeof p->g92);
@@ -190,13 +194,13 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
     double k = v->inch ? 1.0 / MM_PER_INCH : 1.0;
     switch (c->type) {
     case CANON_DWELL: put_call(p, "DWELL", &c->value, 1, 4); return;
-    case CANON_FEED_RATE: {
-        double f = c->feed_mm_min * (v->inch ? k : 1.0 / v->feed_factor);
+    case CANON_FEED_RATE: {   /* G95 (ivalue 1): F per revolution as written */
+        double f = c->ivalue ? c->value : c->feed_mm_min * (v->inch ? k : 1.0 / v->feed_factor);
         put_call(p, "SET_FEED_RATE", &f, 1, 4);
         return;
     }
     case CANON_FEED_MODE:
-        snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", (int)c->value);
+        snprintf(tmp, sizeof tmp, "SET_FEED_MODE(0, %d)\n", c->value == 2.0); /* rs274: 1 G95 */
         break;
     case CANON_PATH_MODE:
         if (c->ivalue == 640) {   /* and the naive CAM tolerance, on a line of its own */
@@ -281,7 +285,8 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
     if (c->type == CANON_FEED && c->spline) {   /* rs274 prints a spline as one line */
         if (c->spline == 1) {
             line_start(p, c);
-            puts_(p, "NURBS_FEED(3, ...)\n");
+            char tmp[40];
+            put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "NURBS_FEED(%d, ...)\n", c->ivalue));
         }
         return p->failed ? -1 : 0;
     }
@@ -312,6 +317,7 @@ void interp_printer_init(struct interp_printer *p, const struct interp *in, int 
     struct interp_view v;
     interp_get_view(in, &v);
     p->inch = v.inch;
+    p->rot_deg = v.xy_rotation_deg;
 }
 
 /* The set-up lines rs274 prints before the program. */
@@ -322,8 +328,6 @@ int interp_printer_preamble(struct interp_printer *p)
     line_start(p, NULL);
     puts_(p, v.inch ? "USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n" : "USE_LENGTH_UNITS(CANON_UNITS_MM)\n");
     put_offsets(p, &v, 1);
-    line_start(p, NULL);
-    puts_(p, "SET_XY_ROTATION(0.0000)\n");
     line_start(p, NULL);
     puts_(p, "SET_FEED_REFERENCE(CANON_XYZ)\n");
     return p->failed ? -1 : 0;

@@ -22,6 +22,7 @@ struct interp_printer {
     int inch;                    /* units last announced */
     int coord;                   /* offsets last announced: coordinate system, */
     double g5x[6], g92[6], tool[6]; /* work, G92 and tool offsets (mm, deg) */
+    double rot_deg;              /* rotation about Z (G10 L2 R), deg */
     int failed;                  /* a write failed */
     size_t len;                  /* bytes waiting in buf */
     char buf[INTERP_PRINTER_BUF];

@@ -60,7 +60,7 @@ static json_t *gcodes(const struct session *s)
         snprintf(buf, sizeof buf, "G%d", v.motion / 10);
     json_array_insert_new(a, 0, json_string(buf));
     json_array_append_new(a, json_string(v.incremental ? "G91" : "G90"));
-    json_array_append_new(a, json_string(v.inverse_time ? "G93" : "G94"));
+    json_array_append_new(a, json_string(v.inverse_time ? "G93" : v.per_rev ? "G95" : "G94"));
     if (v.tcp)
         json_array_append_new(a, json_string("G43.4"));
     return a;
@@ -112,12 +112,14 @@ json_t *session_status(struct session *s)
     } else {
         tcp = 0;
     }
-    double off[KINS_POSE_DIM], pcmd[KINS_POSE_DIM], pact[KINS_POSE_DIM];
-    for (int i = 0; i < KINS_POSE_DIM; i++) {
-        off[i] = v.g5x_mm[i] + v.g92_mm[i] + v.tool_mm[i];
-        pcmd[i] = tcmd[i] - off[i];
-        pact[i] = ok ? tact[i] - off[i] : (double)NAN;
-    }
+    double pcmd[KINS_POSE_DIM], pact[KINS_POSE_DIM];
+    struct interp_view vmm = v;   /* the program's position in mm, offsets and rotation off */
+    vmm.inch = 0;
+    interp_view_to_program(&vmm, tcmd, pcmd);
+    interp_view_to_program(&vmm, tact, pact);
+    if (!ok)
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            pact[i] = (double)NAN;
     json_t *legs = json_array();
     for (int i = 0; i < s->nj; i++)
         json_array_append_new(legs, json_pack("{s:f, s:f, s:f, s:f, s:f}", "length",
