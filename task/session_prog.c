@@ -210,9 +210,10 @@ void session_check_poll(struct session *s, bool wait)
         result = json_pack("{s:b, s:[{s:i, s:s}]}", "ok", 0, "problems", "line",
                            session_error_line(s->check_err), "text", s->check_err);
     } else {
-        result = json_pack("{s:b, s:[], s:f, s:f, s:I}", "ok", 1, "problems", "time_s",
+        result = json_pack("{s:b, s:[], s:f, s:f, s:I, s:I}", "ok", 1, "problems", "time_s",
                            s->check_info.time_s, "length_mm", s->check_info.length_mm,
-                           "segments", (json_int_t)s->check_info.segments);
+                           "segments", (json_int_t)s->check_info.segments,
+                           "merged", (json_int_t)s->check_info.merged);
     }
     for (int i = 0; i < SESSION_MAX_CLIENTS && s->check_id; i++) {
         struct session_client *c = s->cl[i];
