@@ -120,13 +120,29 @@ int ccomp_mode(struct interp *in, int g)
         return comp_on(in, g);
     if (cc->side != CCOMP_OFF && cc->radius > 0.0 && !cc->first) {
         /* the last move ends where it was placed; the next one starts from there to its
-         * programmed point; in->pos is the programmed point already */
+         * programmed point; in->pos is the programmed point already (as LinuxCNC's
+         * interpreter keeps it, until a tool change reads back where the tool is:
+         * ccomp_tool_change) */
+        cc->sent_valid = 0;
         CHP(ccomp_flush(in));
+        cc->resync = cc->sent_valid;
         cc->arc_not_allowed = 1;
     }
     cc->side = CCOMP_OFF;
     cc->first = 1;
     return 0;
+}
+
+void ccomp_tool_change(struct interp *in)
+{
+    struct ccomp *cc = &in->cc;
+    if (cc->resync) {
+        int ax[3];
+        ccomp_axes(in, ax);
+        in->pos[ax[0]] = cc->sent_end[ax[0]];
+        in->pos[ax[1]] = cc->sent_end[ax[1]];
+    }
+    cc->resync = 0;
 }
 
 /* The error for code `what` (at column col) while compensation is on. */

@@ -38,6 +38,9 @@ struct ccomp {
     int endpoint_valid;         /* ... when known */
     struct ccomp_item *q;       /* the queue, oldest first */
     int n, cap;
+    double sent_end[6];         /* the end of the last compensated move sent on (in->pos's */
+    int sent_valid;             /* frame): where the tool is when G40 comes */
+    int resync;                 /* G40 left the tool there and no move has come since */
 };
 
 /* "G41", "G42.1", ... for the code g (x10: 410, 421, ...). */
@@ -52,6 +55,10 @@ int ccomp_holds(const struct interp *in, enum canon_type t);
 /* Appends a command behind the queued move. */
 int ccomp_hold(struct interp *in, const struct canon_cmd *c);
 
+/* M6: the present point becomes where the tool is, if G40 left it beside the programmed
+ * point and nothing has moved since (rs274 reads the machine's position back at a tool
+ * change). */
+void ccomp_tool_change(struct interp *in);
 /* G40 (g = 400), G41/G42 (410/420), G41.1/G42.1 (411/421) of the current block. */
 int ccomp_mode(struct interp *in, int g);
 /* The checks LinuxCNC makes on a block while compensation is on (before it runs). */

@@ -192,6 +192,10 @@ int ccomp_dequeue(struct interp *in)
             return interp_fail(in, INTERP_ERR_SINK, 0, "the command consumer stopped the "
                                "program");
         }
+        if (c.type == CANON_TRAVERSE || c.type == CANON_FEED || c.type == CANON_ARC) {
+            memcpy(cc->sent_end, c.end, sizeof cc->sent_end);
+            cc->sent_valid = 1;
+        }
     }
     cc->n = 0;
     return 0;

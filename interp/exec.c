@@ -33,6 +33,8 @@ static void stamp_tcp(const struct interp *in, struct canon_cmd *c)
 int interp_emit(struct interp *in, struct canon_cmd *c)
 {
     stamp_tcp(in, c);
+    if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
+        in->cc.resync = 0;              /* (a move after G40: the tool is where it says) */
     if (ccomp_holds(in, c->type))
         return ccomp_hold(in, c);
     if (in->sink(in->sink_ctx, c))
@@ -343,6 +345,7 @@ static int exec_machine_words(struct interp *in)
     if (b->m[5] >= 0)  /* M62..M68 after the tool selection, before M6 (LinuxCNC's order) */
         CHP(exec_io(in, b));
     if (b->m[6] == 6) {
+        ccomp_tool_change(in);
         in->current_tool = in->selected_tool;
         CHP(emit_simple(in, CANON_TOOL_CHANGE, 0, in->current_tool));
     } else if (b->m[6] == 61) {  /* M61 Q: the tool in the spindle is n, nothing moves */

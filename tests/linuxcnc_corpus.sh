@@ -9,8 +9,8 @@
 # where rs274 or the programs are not installed.
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
-MIN_ACCEPTED=164     # of the programs rs274 accepts (measured: 164 of 169)
-MIN_IDENTICAL=162    # of those, motion identical to rs274's (measured: 162)
+MIN_ACCEPTED=165     # of the programs rs274 accepts (measured: 165 of 169)
+MIN_IDENTICAL=164    # of those, motion identical to rs274's (measured: 164)
 if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ] ||
    [ ! -f /usr/share/doc/linuxcnc/examples/sample-configs/sim/sim.tbl ]; then
     echo "SKIP linuxcnc_corpus: rs274 or LinuxCNC's programs are not installed (linuxcnc-uspace)"
@@ -20,17 +20,23 @@ tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 # Both run with LinuxCNC's sim tool table, as a machinist runs programs with the machine's
 # table: rs274 alone reads a table in inches (its machine units), hexcnc in mm, so hexcnc
-# gets the same tools with every length (X Y Z U V W D) times 25.4
+# gets the same tools with every length (X Y Z U V W D) in mm as rs274 has them: divided by
+# rs274's own factor, 0.03937007874016 in/mm (not 1/25.4 exactly: a tool of D0.201 is
+# 5.1054 mm less 1.6e-13 to rs274, which moves a compensated arc's last digit)
 tbl=/usr/share/doc/linuxcnc/examples/sample-configs/sim/sim.tbl
 awk '{ out = ""
        for (i = 1; i <= NF; i++) {
            t = $i
            if (t ~ /^;/) { for (j = i; j <= NF; j++) out = out " " $j; break }
            c = substr(t, 1, 1)
-           if (c ~ /[XYZUVWDxyzuvwd]/) t = sprintf("%s%.6f", c, substr(t, 2) * 25.4)
+           if (c ~ /[XYZUVWDxyzuvwd]/)
+               t = sprintf("%s%.17g", c, substr(t, 2) / 0.03937007874016)
            out = out " " t
        }
        print substr(out, 2) }' "$tbl" > "$tmp/tools_mm.tbl"
+# rs274 keeps its tool data in $HOME/.tool.mmap, truncated by every run: each run here gets
+# a HOME of its own, so that other rs274 runs on the machine cannot pull it from under it
+mkdir "$tmp/home"
 # A zero rs274 prints with a minus sign (-0.0000: a value of about -1e-16 after a rounding
 # that differs in the last bit) is the zero it is.
 motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL' | cut -c7- |
@@ -42,7 +48,8 @@ total=0; reference=0; accepted=0; identical=0
 while IFS= read -r f; do
     total=$((total + 1))
     d=$(dirname "$f"); b=$(basename "$f")
-    (cd "$d" && timeout 20 rs274 -t "$tbl" -g "$b" < /dev/null > "$tmp/rs.out" 2> /dev/null) || continue
+    (cd "$d" && HOME="$tmp/home" timeout 20 rs274 -t "$tbl" -g "$b" < /dev/null \
+        > "$tmp/rs.out" 2> /dev/null) || continue
     reference=$((reference + 1))
     if ! (cd "$d" && timeout 20 "$bin" interp -t "$tmp/tools_mm.tbl" "$b" < /dev/null > "$tmp/hx.out" 2> "$tmp/hx.err")
     then
