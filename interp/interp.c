@@ -27,6 +27,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_SINK] = "stopped by the command consumer",
     [INTERP_ERR_CONFIG] = "bad interpreter setting in the INI file",
     [INTERP_ERR_CANCELLED] = "stopped by the operator",
+    [INTERP_ERR_PROBE] = "a probe move did not find what it sought",
 };
 
 /* The fixed text of a status (the message of a run is in struct interp_error). */

@@ -3,7 +3,8 @@ LIB_SRCS += interp/canon.c
 LIB_SRCS += interp/interp.c interp/lexer.c interp/number.c interp/expr.c interp/block.c \
             interp/exec.c interp/arc.c interp/cycles.c interp/offsets.c interp/params.c \
             interp/printer.c interp/named.c interp/predef.c interp/settings.c \
-            interp/oword.c interp/oword_fanuc.c interp/spline.c
+            interp/oword.c interp/oword_fanuc.c interp/spline.c \
+            interp/probe.c interp/probe_model.c
 LIB_SRCS += interp/comp5.c interp/comp5_join.c interp/comp5_gouge.c interp/tooltable.c \
             interp/tooltable_parse.c interp/tooltable_file.c
 TESTS += test_comp5 test_comp5_join test_comp5_gouge test_tooltable test_tooltable_file

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Runs `hexcnc interp` on tests/interp_expected/*.ngc and compares its motion lines
-# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED, DWELL) and outputs (M62..M68) with those in NAME.out, which LinuxCNC's
+# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, STRAIGHT_PROBE, ARC_FEED, DWELL) and outputs (M62..M68) with those in NAME.out, which LinuxCNC's
 # `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists). The first column
 # (rs274's output line counter) is left out: the two print different non-motion lines.
 # With rs274 installed and REGEN=1 the .out files are made again. sub_NAME.ngc files hold
@@ -12,7 +12,7 @@ tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 pass=0; fail=0
 # (a zero rs274 prints as -0.0000, about -1e-16 after a last-bit rounding, is the zero it is)
-motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|DWELL|_OUTPUT_(BIT|VALUE)' |
+motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|STRAIGHT_PROBE|ARC_FEED|DWELL|_OUTPUT_(BIT|VALUE)' |
            cut -c7- | sed -E 's/-(0\.0+)([,)])/\1\2/g'; }
 for ngc in "$dir"/*.ngc; do
     name=$(basename "$ngc" .ngc)
