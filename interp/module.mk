@@ -10,7 +10,7 @@ LIB_SRCS += interp/comp5.c interp/comp5_join.c interp/comp5_gouge.c interp/toolt
 TESTS += test_comp5 test_comp5_join test_comp5_gouge test_tooltable test_tooltable_file
 SCRIPT_TESTS += tests/paper_programs.sh tests/comp5_gouge_cli.sh
 TESTS += test_interp test_interp_number test_interp_motion test_interp_setup test_interp_cycles test_interp_named
-TESTS += test_interp_params
+TESTS += test_interp_params test_interp_probe
 BENCHES += bench_interp
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh tests/linuxcnc_tooltables.sh \
                 tests/linuxcnc_corpus.sh
