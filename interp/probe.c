@@ -120,7 +120,8 @@ int interp_probe(struct interp *in, int g)
     c.feed_mm_min = in->feed_mm_min;
     c.ivalue = type;
     CHP(interp_emit(in, &c));
-    if (in->probe_fn) {
+    /* a zero-length G38.3/G38.5 moves nothing: no machine to ask, no trip (as rs274) */
+    if (in->probe_fn && memcmp(from, end, sizeof from)) {
         char why[256] = "";
         if (in->probe_fn(in->probe_ctx, &c, &r, why, sizeof why))
             return interp_fail(in, INTERP_ERR_PROBE, col, "%s: %s", name, why);

@@ -152,6 +152,6 @@ double probe_model_find(const struct probe_model *m, const double a[3], const do
     double s0, s1;
     box_clip(m, a, b, &s0, &s1);
     if (contact)   /* from outside: where the line enters the block */
-        return s0 <= s1 && s0 <= 1 ? fmax(s0, 0) : -1;
+        return s0 <= s1 && s0 <= 1 && s1 >= 0 ? fmax(s0, 0) : -1;
     return s1 < 1 ? fmax(s1, 0) : -1;   /* from inside: where it leaves */
 }

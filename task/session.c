@@ -248,6 +248,10 @@ void session_tick(struct session *s)
                         "e-stop%s%s", s->r->first_fault[0] ? "; cause: " : "",
                         s->r->first_fault);
     }
+    if (s->running && !s->stopping && runner_stream_stalled(s->r)) {
+        s->stopping = true;      /* at rest where the program stopped on an error (G38.2 */
+        runner_abort(s->r);      /* without a trip): end the run there; run_outcome says why */
+    }
     if (s->running) {
         runner_settings_apply(s->r);
         if (st == MOTION_DONE || st == MOTION_FAULT || (st == MOTION_IDLE && s->stopping))

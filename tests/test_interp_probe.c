@@ -53,6 +53,9 @@ START_TEST(box_find)
     ck_assert_double_eq_tol(probe_model_find(&m, in, side, false), 0.5, 1e-12); /* leaves */
     const double miss[3] = { 0, 0, -10 }, miss2[3] = { 5, 60, -10 };
     ck_assert_double_eq_tol(probe_model_find(&m, miss, miss2, true), -1, 1e-15);
+    /* the block lies behind the move, on its line: not reached */
+    const double away_from[3] = { 20, 30, 20 }, away_to[3] = { 20, 30, 40 };
+    ck_assert_double_eq_tol(probe_model_find(&m, away_from, away_to, true), -1, 1e-15);
     const double far[3] = { 20, 30, -20 };
     ck_assert_double_eq_tol(probe_model_find(&m, in, far, false), -1, 1e-15);    /* stays in */
     ck_assert(probe_model_contact(&m, in));
