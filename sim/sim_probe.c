@@ -12,11 +12,12 @@
  *                                    platform's pose from the kinematics, kins.pose-fb-*)
  *   sim-probe.tripped    bit   out   the probe touches the workpiece (motion.probe-input)
  *   sim-probe.stuck      bit   in    test hook: the probe reads tripped wherever it is
+ *   sim-probe.missing    bit   in    test hook: the workpiece is not there (never tripped)
  */
 struct sim_probe {
     double *pos[3];          /* in: mm */
     bool *tripped;           /* out */
-    bool *stuck;             /* in */
+    bool *stuck, *missing;   /* in */
     struct probe_model model;
 };
 
@@ -25,7 +26,7 @@ static void sim_probe_update(void *arg, long period_ns)
     struct sim_probe *s = arg;
     (void)period_ns;
     double p[3] = { *s->pos[0], *s->pos[1], *s->pos[2] };
-    *s->tripped = *s->stuck || probe_model_contact(&s->model, p);
+    *s->tripped = *s->stuck || (!*s->missing && probe_model_contact(&s->model, p));
 }
 
 static int sim_probe_load(struct hal *h, int argc, char **argv)
@@ -47,7 +48,8 @@ static int sim_probe_load(struct hal *h, int argc, char **argv)
         (rc = hal_pin_float_newf(h, HAL_IN, &s->pos[1], "sim-probe.y")) ||
         (rc = hal_pin_float_newf(h, HAL_IN, &s->pos[2], "sim-probe.z")) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &s->tripped, "sim-probe.tripped")) ||
-        (rc = hal_pin_bit_newf(h, HAL_IN, &s->stuck, "sim-probe.stuck")))
+        (rc = hal_pin_bit_newf(h, HAL_IN, &s->stuck, "sim-probe.stuck")) ||
+        (rc = hal_pin_bit_newf(h, HAL_IN, &s->missing, "sim-probe.missing")))
         return rc;
     return hal_export_functf(h, sim_probe_update, s, "sim-probe.update");
 }

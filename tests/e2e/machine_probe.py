@@ -80,6 +80,22 @@ def main():
         check("the program went on from where the machine stopped (not Z600, not a back-off)",
               abs(mp[2] - stop_z) < 1e-6, (mp, stop_z))
 
+        # MDI: the line's probe answers the next lines
+        c.ok("mdi.execute", line="G0 X0 Y0 Z645")
+        c.wait()
+        c.ok("mdi.execute", line="G38.2 Z600 F300")
+        st = c.wait()
+        pr = st["probe"]
+        check("MDI G38.2 trips on the block and stops there", pr["moves"] == 1 and
+              pr["tripped"] and 634.95 < pr["trip"][2] < 635.005 and
+              abs(st["machine_pose"]["commanded"][2] - pr["stop"][2]) < 1e-9, (pr, st["machine_pose"]))
+        c.ok("mdi.execute", line="G1 X[#5070 * 4] Y[#5063 - 630] F600")
+        st = c.wait()
+        mp, pp = st["machine_pose"]["commanded"], st["pose"]["commanded"]
+        check("... and the next MDI line reads #5070 and #5063 (X4, Y = #5063 - 630)",
+              abs(pp[0] - 4) < 1e-9 and abs(pp[1] - (pr["trip"][2] - (mp[2] - pp[2]) - 630))
+              < 1e-6 and abs(mp[2] - pr["stop"][2]) < 1e-9, (pp, pr))
+
         # a probe that reads tripped before the move starts: G38.2 refuses, nothing moves
         c.ok("mdi.execute", line="G0 X0 Y0 Z645")
         c.wait()
@@ -95,6 +111,22 @@ def main():
             st["machine_pose"]["commanded"], [0, 0, 645, 0, 0, 0])) < 1e-9,
               st["machine_pose"]["commanded"])
         c.ok("hal.set", name="sim-probe.stuck", value=False)
+
+        # the block is not on the machine (the check's model still has it): G38.2 runs to its
+        # end and the program stops there with an error naming the line
+        c.ok("hal.set", name="sim-probe.missing", value=True)
+        c.notes.clear()
+        program(c, tmp, "missing.ngc", "G21 G90 F600\nG38.2 Z630\nG0 X5\nM2\n")
+        c.ok("program.run")
+        st = c.wait(120)
+        msgs = c.messages()
+        check("G38.2 without a trip on the machine: an error naming the line",
+              any("missing.ngc:2" in m and "without the probe touching anything" in m
+                  for m in msgs), msgs)
+        mp = st["machine_pose"]["commanded"]
+        check("... after the whole move, and the program went no further", abs(mp[2] - 630) <
+              1e-6 and abs(mp[0]) < 1e-9 and st["probe"]["tripped"] is False, (mp, st["probe"]))
+        c.ok("hal.set", name="sim-probe.missing", value=False)
         ms.stop(p, c)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
