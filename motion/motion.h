@@ -166,8 +166,10 @@ struct motion_probe_result {
                                   * end of the move without a trip), mm, deg */
     double stop[KINS_POSE_DIM];  /* path pose where the machine came to rest */
 };
-/* How many probe moves have been answered since the machine started (any thread), and the
- * last one's result in out (NULL: none wanted). */
+/* How many probe moves have been answered since the program started (any thread), and the
+ * last one's result in out (NULL: none wanted). The result holds from the moment the count
+ * moves until the next probe move starts, which in a program is after the interpreter has
+ * read it (a status reader at that instant may see the next move's result being filled). */
 unsigned motion_probe_result(const struct motion *m, struct motion_probe_result *out);
 
 /* The spindle and coolant as the program commands them at the point the path has reached. */
