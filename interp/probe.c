@@ -77,11 +77,7 @@ static int probe_checks(struct interp *in, int type, int col, const double from[
     if (in->tcp_on)
         return interp_fail(in, INTERP_ERR_MODAL, col, "%s cannot be used under tool centre "
                            "point control (G43.4): cancel it with G49 first", name);
-    if (in->inverse_time)
-        return interp_fail(in, INTERP_ERR_MODAL, col, "%s cannot be used in inverse time mode "
-                           "(G93): a probe move runs at the feed rate; give G94 and an F word",
-                           name);
-    CHP(interp_need_feed(in, name));
+    CHP(interp_need_feed(in, name));     /* under G93: F in the block, the whole move's time */
     if (!(type & 1) && !memcmp(from, end, 6 * sizeof *from))
         return interp_fail(in, INTERP_ERR_WORD, col, "%s: the probe move has zero length: the "
                            "end point is where the probe already is", name);
@@ -118,6 +114,8 @@ int interp_probe(struct interp *in, int g)
     memcpy(c.end, end, sizeof c.end);
     memcpy(c.probe_stop, r.stop, sizeof c.probe_stop);
     c.feed_mm_min = in->feed_mm_min;
+    if (in->inverse_time)                /* the whole move, to end, would take this long */
+        c.inverse_time_min = 1.0 / in->f_word;
     c.ivalue = type;
     CHP(interp_emit(in, &c));
     /* a zero-length G38.3/G38.5 moves nothing: no machine to ask, no trip (as rs274) */

@@ -332,6 +332,17 @@ static int add_probe(struct motion *m, struct motion_plan *p, const struct canon
     struct canon_cmd line = *c;
     line.type = CANON_FEED;
     memcpy(line.end, c->probe_stop, sizeof line.end);
+    if (c->inverse_time_min > 0) {
+        /* G93: the whole move to end takes that long, wherever the probe stops it */
+        double xyz = 0, abc = 0;
+        for (int i = 0; i < 3; i++) {
+            xyz += (c->end[i] - from[i]) * (c->end[i] - from[i]);
+            abc += (c->end[i + 3] - from[i + 3]) * (c->end[i + 3] - from[i + 3]);
+        }
+        double len = sqrt(xyz) >= EPS_LEN ? sqrt(xyz) : sqrt(abc);
+        line.feed_mm_min = len / c->inverse_time_min;
+        line.inverse_time_min = 0;
+    }
     if (add_stop(p, c, from, SEG_DWELL, 0) < 0)
         return -1;
     size_t n0 = p->nseg;

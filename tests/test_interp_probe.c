@@ -140,6 +140,7 @@ START_TEST(model_plane_program)
     ck_assert_pose(pr->end, 1, 2, -18, 0, 0, 0, 1e-12);         /* the programmed end */
     ck_assert_pose(pr->probe_stop, 1, 2, -3, 0, 0, 0, 1e-12);   /* where the model trips */
     ck_assert_int_eq(pr->ivalue, 0);
+    ck_assert_double_eq(pr->inverse_time_min, 0);
     ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 1, 3, 7, 0, 0, 0, 1e-12); /* #5063 = -5 */
     ck_assert_pose(nth(&p, CANON_FEED, 1)->end, 1.5, 3, 7, 0, 0, 0, 1e-12);
     canon_prog_free(&p);
@@ -148,6 +149,11 @@ START_TEST(model_plane_program)
     ck_assert_int_eq(rc, INTERP_ERR_PROBE);
     ck_assert_int_eq(e.line, 3);
     ck_assert_str_eq(e.message, "G38.2: the move ended without the probe touching anything");
+    canon_prog_free(&p);
+    /* G93: the probe move carries the whole move's time, 1/F minutes */
+    rc = run_model(&m, "G21 F100\nG0 Z10\nG93 G38.2 Z-10 F4\nM2\n", &p, &e);
+    ck_assert_msg(rc == INTERP_OK, "%s", e.message);
+    ck_assert_double_eq_tol(nth(&p, CANON_PROBE, 0)->inverse_time_min, 0.25, 1e-15);
     canon_prog_free(&p);
     /* G38.3: no error; #5070 = 0 and the program goes on from the end */
     rc = run_model(&m, "G21 F100\nG0 Z10\nG38.3 Z0\nG1 X[#5070 + 1]\nM2\n", &p, &e);

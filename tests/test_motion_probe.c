@@ -155,6 +155,34 @@ START_TEST(test_already_tripped)
 }
 END_TEST
 
+/* G93: the whole move to its end takes 1/F minutes, wherever the planner is told it stops
+ * (the interpreter's model stopped it halfway): 20 mm in 0.6 s is 33.3 mm/s. */
+START_TEST(test_inverse_time)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, -10, 0, 0, 0 },
+                 half[6] = { 0, 0, 0, 0, 0, 0 };
+    memcpy(p.start, top, sizeof top);
+    add_probe(&p, 5, bottom, 0, 1);
+    p.cmds[0].inverse_time_min = 0.01;
+    memcpy(p.cmds[0].probe_stop, half, sizeof half);
+    tm_add(&p, CANON_PROGRAM_END, 6, NULL, 0, 0);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct surface s = { -100, 0 };
+    struct tm_stats st;
+    tm_run(mc.m, DT, 100000, &st, probe_hook, &s);
+    ck_assert_msg(fabs(st.max_v_mm_s - 20 / 0.6) < 0.05, "%g mm/s", st.max_v_mm_s);
+    ck_assert_double_eq_tol(st.last.pose[2], 0, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* G38.4 from inside the material: stops once the probe leaves it (above z = 5). */
 START_TEST(test_away)
 {
@@ -258,6 +286,7 @@ static Suite *probe_suite(void)
     tcase_add_test(tc, test_no_trip_goes_on);
     tcase_add_test(tc, test_already_tripped);
     tcase_add_test(tc, test_away);
+    tcase_add_test(tc, test_inverse_time);
     tcase_add_test(tc, test_stream_goes_on_from_stop);
     suite_add_tcase(s, tc);
     return s;
