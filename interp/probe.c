@@ -56,12 +56,14 @@ static int model_answer(struct interp *in, int type, int col, const double from[
                         const double end[6], struct interp_probe_result *r)
 {
     int away = (type & 2) != 0;
-    double s = probe_model_find(&in->probe_model, from, end, !away);
-    if (s == 0 && !(type & 1))
+    bool already = probe_model_contact(&in->probe_model, from) != away;
+    if (already && !(type & 1))
         return interp_fail(in, INTERP_ERR_PROBE, col, "%s: the probe %s where the move starts "
                            "(the probe model, [PROBE] in the INI)", probe_name(type), away
                            ? "is already clear of the workpiece" : "already touches the "
                            "workpiece");
+    /* (s = 0 without `already`: on the surface, leaving it at once) */
+    double s = already ? 0 : probe_model_find(&in->probe_model, from, end, !away);
     r->tripped = s >= 0;
     for (int i = 0; i < 6; i++)
         r->trip[i] = s >= 0 ? from[i] + s * (end[i] - from[i]) : end[i];

@@ -158,6 +158,7 @@ double motion_input_result(const struct motion *m, unsigned *seq);
  * becomes true; away: becomes false), decelerating within the path's and legs'
  * acceleration limits, as a pause does. */
 void motion_set_probe_input(struct motion *m, bool on);
+/* (Until it is first called, as in `hexcnc check`, probe moves run as plain feeds.) */
 struct motion_probe_result {
     int already;             /* G38.2/G38.4: the input was already as sought where the move
                               * starts (LinuxCNC's error); nothing moved */

@@ -230,6 +230,8 @@ struct motion {
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     /* G38 probing (motion_probe.c), servo thread only but the result and its counter */
     bool probe_in;           /* motion.probe-input this period */
+    bool probe_wired;        /* someone gives the input (the HAL component, each period):
+                              * without, probe moves are plain feeds (hexcnc check) */
     size_t probe_seg;        /* probe segment being watched (+1), 0 = none */
     int probe_halt;          /* enum motion_probe_phase of the move at probe_seg */
     struct motion_probe_result probe_res; /* the last probe move's result ... */

@@ -20,8 +20,10 @@
 
 void motion_set_probe_input(struct motion *m, bool on)
 {
-    if (m)
+    if (m) {
         m->probe_in = on;
+        m->probe_wired = true;
+    }
 }
 
 unsigned motion_probe_result(const struct motion *m, struct motion_probe_result *out)
@@ -49,6 +51,8 @@ bool motion_probe_watch(struct motion *m)
 {
     if (m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED)
         return true;
+    if (!m->probe_wired)
+        return false;
     /* the stop before a probe move counts as its start: nothing moves before the input is
      * first looked at */
     size_t k = m->cs;
@@ -81,7 +85,8 @@ void motion_probe_arm(struct motion *m)
 {
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
-    if (!sg->probe || m->probe_seg == m->cs + 1 || m->probe_halt != PROBE_WATCHING)
+    if (!m->probe_wired || !sg->probe || m->probe_seg == m->cs + 1 ||
+        m->probe_halt != PROBE_WATCHING)
         return;
     /* the path came onto the move within this period, without a look at the input at its
      * start: look now, and if it is already as sought, back to the start (at rest there) */

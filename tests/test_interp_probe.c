@@ -187,6 +187,13 @@ START_TEST(model_box_away)
     ck_assert_int_eq(nth(&p, CANON_PROBE, 0)->ivalue, 2);
     ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 11, 1, -10, 0, 0, 0, 1e-9);
     canon_prog_free(&p);
+    /* onto the block's top (Z0) and back up: on its surface the probe touches, so G38.4 is
+     * not "already clear"; it leaves at once, where it starts */
+    rc = run_model(&m, "G21 F10\nG0 X20 Y30 Z5\nG38.2 Z-5\nG38.4 Z5\n"
+                   "G1 X[#5063 + 1] Y[#5070 * 2]\nM2\n", &p, &e);
+    ck_assert_msg(rc == INTERP_OK, "%s", e.message);
+    ck_assert_pose(nth(&p, CANON_FEED, 0)->end, 1, 2, 0, 0, 0, 0, 1e-12);
+    canon_prog_free(&p);
     /* G38.4 from outside: already clear */
     rc = run_model(&m, "G21 F10\nG38.4 X5\nM2\n", &p, &e);
     ck_assert_int_eq(rc, INTERP_ERR_PROBE);

@@ -183,6 +183,33 @@ START_TEST(test_inverse_time)
 }
 END_TEST
 
+/* Without anyone giving the probe input (hexcnc check's servo pass), a probe move is a
+ * plain feed: a G38.4, whose input would read false, runs to its end and reports nothing. */
+START_TEST(test_unwired)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    const double low[6] = { 0, 0, 0, 0, 0, 0 }, high[6] = { 0, 0, 5, 0, 0, 0 },
+                 side[6] = { 3, 0, 5, 0, 0, 0 };
+    memcpy(p.start, low, sizeof low);
+    add_probe(&p, 5, high, 1200, 2);
+    tm_add(&p, CANON_FEED, 6, side, 1200, 0);
+    tm_add(&p, CANON_PROGRAM_END, 7, NULL, 0, 0);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 100000, &st, NULL, NULL);
+    ck_assert_uint_eq(motion_probe_result(mc.m, NULL), 0);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    ck_assert_pose(st.last.pose, 3, 0, 5, 0, 0, 0, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* G38.4 from inside the material: stops once the probe leaves it (above z = 5). */
 START_TEST(test_away)
 {
@@ -286,6 +313,7 @@ static Suite *probe_suite(void)
     tcase_add_test(tc, test_no_trip_goes_on);
     tcase_add_test(tc, test_already_tripped);
     tcase_add_test(tc, test_away);
+    tcase_add_test(tc, test_unwired);
     tcase_add_test(tc, test_inverse_time);
     tcase_add_test(tc, test_stream_goes_on_from_stop);
     suite_add_tcase(s, tc);
