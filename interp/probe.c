@@ -51,13 +51,14 @@ static void rs274_answer(const double from[6], const double end[6],
 }
 
 /* The probe model's answer: where along the move the contact changes as the type seeks
- * (towards: touches; away: leaves). The interpreter's model stops where it trips. */
+ * (towards: touches; away: leaves). The interpreter's model stops where it trips. With a
+ * machine to ask (strict 0) it is only the plan's guess: the machine's answer counts. */
 static int model_answer(struct interp *in, int type, int col, const double from[6],
-                        const double end[6], struct interp_probe_result *r)
+                        const double end[6], bool strict, struct interp_probe_result *r)
 {
     int away = (type & 2) != 0;
     bool already = probe_model_contact(&in->probe_model, from) != away;
-    if (already && !(type & 1))
+    if (already && !(type & 1) && strict)
         return interp_fail(in, INTERP_ERR_PROBE, col, "%s: the probe %s where the move starts "
                            "(the probe model, [PROBE] in the INI)", probe_name(type), away
                            ? "is already clear of the workpiece" : "already touches the "
@@ -108,7 +109,7 @@ int interp_probe(struct interp *in, int g)
     CHP(probe_checks(in, type, col, from, end));
     struct interp_probe_result r;
     if (in->probe_model.kind != PROBE_MODEL_NONE)
-        CHP(model_answer(in, type, col, from, end, &r));
+        CHP(model_answer(in, type, col, from, end, !in->probe_fn, &r));
     else
         rs274_answer(from, end, &r);
     struct canon_cmd c;

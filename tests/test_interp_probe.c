@@ -236,6 +236,10 @@ START_TEST(machine_answer)
     struct fake_machine f = { 0, 0 };
     struct interp *in = interp_create();
     interp_set_probe_fn(in, fake_probe, &f);
+    /* a model that has the probe in the material from the start: the machine's answer
+     * counts, not the model's refusal */
+    struct probe_model deep = plane_z(100);
+    interp_set_probe_model(in, &deep);
     struct canon_prog p;
     /* G55 X offset 5: #5061 is in program coordinates; the next move starts at the stop */
     int rc = run_on(in, "G21 F100\nG10 L2 P2 X5\nG55\nG0 X-5 Y0 Z10\nG38.2 Z-10 A20\n"
