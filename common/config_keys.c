@@ -27,6 +27,8 @@ const struct config_section config_sections[] = {
     { "JOINT_#", CONFIG_STRICT, "one leg: length limits, speed limits, following error, "
       "step generator" },
     { "RS274NGC", CONFIG_STRICT, "interpreter settings (docs/gcode.md)" },
+    { "PROBE", CONFIG_STRICT, "the workpiece G38 probing touches in `hexcnc interp -i` and "
+      "`hexcnc check` (docs/gcode.md)" },
     { "EMCIO", CONFIG_OPEN, "LinuxCNC's I/O controller; hexcnc reads TOOL_TABLE only" },
     { "HAL", CONFIG_STRICT, "HAL files run when the machine starts (docs/hal.md)" },
     { "TASK", CONFIG_STRICT, "`hexcnc run` (docs/running.md)" },
@@ -269,6 +271,19 @@ const struct config_key config_keys[] = {
       "to the INI) where `o<name> call` finds name.ngc, after the program's folder" },
     { "RS274NGC", "LOOP_LIMIT", INT, "", "> 0", 0, 0, "10000000", "loop iterations (while, "
       "do, repeat) one program may run before it is refused as a loop that never ends" },
+    /* [PROBE] */
+    { "PROBE", "MODEL", ENUM, "", "NONE|PLANE|BOX", 0, 0, "NONE", "the workpiece G38.2..G38.5 "
+      "probe in `hexcnc interp -i` and `hexcnc check`: NONE (as LinuxCNC's rs274: no trip, "
+      "0.254 mm short of the end), PLANE (material below PLANE_POINT, PLANE_NORMAL) or BOX "
+      "(BOX_MIN..BOX_MAX)" },
+    { "PROBE", "PLANE_POINT", NUMS, "mm", "", 3, 0, "", "MODEL = PLANE: a point x y z of the "
+      "surface, machine coordinates" },
+    { "PROBE", "PLANE_NORMAL", NUMS, "", "", 3, 0, "", "MODEL = PLANE: the surface's normal x "
+      "y z, pointing out of the material (any length but 0)" },
+    { "PROBE", "BOX_MIN", NUMS, "mm", "", 3, 0, "", "MODEL = BOX: the block's corner with the "
+      "smallest x y z, machine coordinates" },
+    { "PROBE", "BOX_MAX", NUMS, "mm", "", 3, 0, "", "MODEL = BOX: the block's corner with the "
+      "largest x y z, machine coordinates" },
     { "EMCIO", "TOOL_TABLE", PATH, "", "", 0, 0, "", "tool table, when [RS274NGC] has none "
       "(LinuxCNC's place for it)" },
 

@@ -15,11 +15,11 @@ static const struct { int code, group; } g_table[] = {
     {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},  {901, 4},  {910, 3},
     {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},  {940, 5},  {980, 10},
     {990, 10}, {1410, 0}, {1420, 0}, {51, 1},   {520, 0},  {50, 1},   {52, 1},   {53, 0},
-    {950, 5},
+    {950, 5},  {382, 1},  {383, 1},  {384, 1},  {385, 1},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {55, 61, 331, 382, 383, 384, 385, 840, 860, 870, 880};
+static const int g_unsupported[] = {55, 61, 331, 840, 860, 870, 880};
 
 /* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
  * or "not yet". */

@@ -17,6 +17,7 @@ static const char *const canon_names[CANON_TYPE_COUNT] = {
     [CANON_PROGRAM_END] = "PROGRAM_END", [CANON_OFFSETS] = "OFFSETS",
     [CANON_SETTING] = "SETTING",        [CANON_DIGITAL_OUT] = "DIGITAL_OUT",
     [CANON_ANALOG_OUT] = "ANALOG_OUT",   [CANON_WAIT_INPUT] = "WAIT_INPUT",
+    [CANON_PROBE] = "PROBE",
 };
 
 const char *canon_type_name(enum canon_type t)

@@ -45,6 +45,11 @@ enum canon_type {
     CANON_WAIT_INPUT,      /* M66: wait (at rest) on input ivalue (analog: E, else P) in
                             * wait_mode (0 read at once, 1 rise, 2 fall, 3 high, 4 low) for
                             * at most value seconds; its result is #5399 */
+    CANON_PROBE,           /* G38.2..G38.5: straight feed towards end that stops where the
+                            * probe input changes; ivalue = LinuxCNC's probe type (0 G38.2,
+                            * 1 G38.3, 2 G38.4, 3 G38.5: bit 0 no error without a trip, bit 1
+                            * away from the workpiece: trip on loss of contact). The move
+                            * starts and ends at rest; the next command starts at probe_stop */
     CANON_TYPE_COUNT
 };
 
@@ -115,6 +120,9 @@ struct canon_cmd {
     int analog;            /* WAIT_INPUT: an analog input (E), else digital (P) */
     int wait_mode;         /* WAIT_INPUT: L, 0..4 */
     double offset[6];      /* OFFSETS: total offset in force (work + G92 + tool), mm/deg */
+    double probe_stop[6];  /* PROBE: where the interpreter takes the move to end, machine
+                            * frame: where its probe model trips, else 0.254 mm short of end
+                            * (rs274's back-off) or at end; the machine answers its own */
     struct canon_arc arc;  /* ARC only */
     const char *text;      /* COMMENT text (owned by the interpreter) */
     const struct canon_setting *setting; /* SETTING only: valid during the sink call (the

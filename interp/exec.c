@@ -548,7 +548,8 @@ static int exec_motion(struct interp *in)
     CHP(interp_polar_words(in));
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
-        if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800)
+        if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800 ||
+            (b->g[1] >= 382 && b->g[1] <= 385))
             in->cycle_mode = in->cycle_il_on = 0;
     }
     if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 || b->g[8] == 431 ||
@@ -573,6 +574,12 @@ static int exec_motion(struct interp *in)
             return 0;
         CHP(interp_need_feed(in, m == 20 ? "G2" : "G3"));
         return interp_arc(in, m);
+    }
+    if (m >= 382 && m <= 385) {
+        if (!axis && b->g[1] >= 0)
+            return interp_fail(in, INTERP_ERR_WORD, b->gcol[1], "G38.%d needs axis words: the "
+                               "point to probe towards", m - 380);
+        return axis ? interp_probe(in, m) : 0;
     }
     if (m == 50 || m == 51) {
         in->motion = prev_motion;   /* G5 and G5.1 leave the motion mode as it was (rs274) */

@@ -28,6 +28,7 @@ static const char *const status_text[INTERP_STATUS_COUNT] = {
     [INTERP_ERR_CONFIG] = "bad interpreter setting in the INI file",
     [INTERP_ERR_CANCELLED] = "stopped by the operator",
     [INTERP_ERR_CCOMP] = "G41/G42 cutter compensation error",
+    [INTERP_ERR_PROBE] = "a probe move did not find what it sought",
 };
 
 /* The fixed text of a status (the message of a run is in struct interp_error). */

@@ -29,6 +29,8 @@ enum interp_status {
     INTERP_ERR_CONFIG,        /* a bad interpreter setting in the machine's INI file */
     INTERP_ERR_CANCELLED,     /* the cancel flag was set (Ctrl-C) while the program was read */
     INTERP_ERR_CCOMP,         /* G41/G42 cutter compensation refused the path or the code */
+    INTERP_ERR_PROBE,         /* G38.2/G38.4 without a trip, a probe tripped at the start, or
+                               * probing the machine cannot do */
     INTERP_STATUS_COUNT
 };
 const char *interp_strerror(int status);
@@ -107,6 +109,26 @@ const struct interp_error *interp_last_error(const struct interp *in);
  * fn may block until the machine has reached the wait. NULL (the default): 0, as rs274. */
 typedef double (*interp_input_fn)(void *ctx, const struct canon_cmd *wait);
 void interp_set_input_fn(struct interp *in, interp_input_fn fn, void *ctx);
+/* G38.2..G38.5: after the sink got the CANON_PROBE command, fn gives the machine's answer in
+ * r (it may block until the move has ended): 0, or non-zero with why (a machinist's words:
+ * "the probe is already tripped") and the program stops with an error at the probe's line.
+ * NULL (the default): the probe model of interp_set_probe_model answers, and without one
+ * the interpreter answers as LinuxCNC's rs274 does (no trip; the move ends 0.254 mm short
+ * of its end point). */
+struct interp_probe_result {
+    int tripped;              /* the probe changed state during the move: #5070 = 1 */
+    double trip[6];           /* machine pose where it did (else where the move ended):
+                               * #5061..#5066, in program coordinates */
+    double stop[6];           /* machine pose the machine came to rest at: the program goes
+                               * on from here */
+};
+typedef int (*interp_probe_fn)(void *ctx, const struct canon_cmd *probe,
+                               struct interp_probe_result *r, char *why, size_t whylen);
+void interp_set_probe_fn(struct interp *in, interp_probe_fn fn, void *ctx);
+/* The simulated workpiece `hexcnc interp` and `check` probe ([PROBE] in the INI, read by
+ * interp_setup); copied. NULL or PROBE_MODEL_NONE: none. */
+struct probe_model;
+void interp_set_probe_model(struct interp *in, const struct probe_model *m);
 /* G141/G142, for displays: fn gets each block's programmed contour point (machine frame, mm
  * and deg) before the compensation offsets it; first is 1 for a run's first block, whose
  * contour starts at from. NULL (the default): nothing is called. */

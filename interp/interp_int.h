@@ -7,6 +7,7 @@
 #include "interp/ccomp.h"
 #include "interp/comp5.h"
 #include "interp/interp.h"
+#include "interp/probe_model.h"
 #include "kins/kins.h"
 
 #define INTERP_NPARAMS 5603      /* #1 .. #5602, as LinuxCNC */
@@ -168,6 +169,9 @@ struct interp {
     int text_mapped;             /* the program text is a file mapping (interp_run_file) */
     interp_input_fn input_fn;    /* M66's answer (NULL: 0) */
     void *input_ctx;
+    interp_probe_fn probe_fn;    /* G38's answer from the machine (NULL: probe_model) */
+    void *probe_ctx;
+    struct probe_model probe_model; /* the workpiece interp and check probe */
     interp_contour_fn contour_fn; /* G141/G142's programmed points, for displays (NULL: none) */
     interp_ini_fn ini_get;       /* #<_ini[SECTION]KEY> (NULL: no INI) */
     void *ini_ctx;
@@ -349,6 +353,7 @@ int interp_feed_mode_value(const struct interp *in);
 int interp_need_spindle(struct interp *in, const char *what, int col);
 /* Checks a feed move has a feed (F in force, or F in the block under G93). */
 int interp_need_feed(struct interp *in, const char *what);
+int interp_probe(struct interp *in, int g);   /* G38.2..G38.5 (g x10), probe.c */
 
 /* rotation.c: the active system's rotation about Z (G10 L2 R). */
 void interp_rotate_xy(double *x, double *y, double deg);

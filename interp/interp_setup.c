@@ -1,5 +1,5 @@
 /* interp_setup.c: reads [RS274NGC] FEED_UNITS, TOOL_TABLE, PARAMETER_FILE, SUBROUTINE_PATH and
- * LOOP_LIMIT and applies them. */
+ * LOOP_LIMIT, and the probe model of [PROBE], and applies them. */
 #include "interp/interp_setup.h"
 
 #include <stdio.h>
@@ -71,6 +71,8 @@ int interp_settings_read(struct interp_settings *s, interp_setup_get_fn get, voi
                             "whole number of loop iterations above 0 is expected", lim);
         s->loop_limit = v;
     }
+    if (st == INTERP_OK && probe_model_read(&s->probe, get, ctx, err, errlen) != 0)
+        st = INTERP_ERR_CONFIG;
     return st;
 }
 
@@ -83,6 +85,7 @@ int interp_settings_apply(struct interp *in, const struct interp_settings *s,
         return errbuf_set(err, errlen, INTERP_ERR_NOMEM, "out of memory");
     if (s->loop_limit > 0)
         interp_set_loop_limit(in, s->loop_limit);
+    interp_set_probe_model(in, &s->probe);
     if (tt && s->tool_table[0]) {
         char msg[600];
         if (tooltable_load(tt, s->tool_table, msg, sizeof msg) != TOOLTABLE_OK)

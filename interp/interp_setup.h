@@ -5,6 +5,8 @@
 
 #include <stddef.h>
 
+#include "interp/probe_model.h"
+
 struct interp;
 struct tooltable;
 
@@ -18,6 +20,7 @@ struct interp_settings {
     char param_file[1024];         /* [RS274NGC] PARAMETER_FILE; "" = none */
     char subroutine_path[4096];    /* [RS274NGC] SUBROUTINE_PATH, folders made absolute */
     long loop_limit;               /* [RS274NGC] LOOP_LIMIT: loop iterations in one program */
+    struct probe_model probe;      /* [PROBE]: the workpiece G38 probes in interp and check */
 };
 
 /* Flags of interp_settings_apply() and interp_setup(). */

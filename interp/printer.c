@@ -296,6 +296,14 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
         to_program(&v, c->end, e);
         put_call(p, c->type == CANON_TRAVERSE ? "STRAIGHT_TRAVERSE" : "STRAIGHT_FEED", e, 6,
                  p->digits);
+    } else if (c->type == CANON_PROBE) {   /* rs274: the probe is switched on around it */
+        double e[6];
+        to_program(&v, c->end, e);
+        puts_(p, "TURN_PROBE_ON()\n");
+        line_start(p, c);
+        put_call(p, "STRAIGHT_PROBE", e, 6, p->digits);
+        line_start(p, c);
+        puts_(p, "TURN_PROBE_OFF()\n");
     } else if (c->type == CANON_ARC) {
         put_arc(p, &v, c);
     } else {

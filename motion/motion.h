@@ -154,6 +154,26 @@ void motion_set_inputs(struct motion *m, const bool *din, int nd, const double *
  * M66 waits have been answered since the program started (any thread). */
 double motion_input_result(const struct motion *m, unsigned *seq);
 
+/* G38.2..G38.5: the probe input (motion.probe-input), this period. During a probe move the
+ * executor stops on the path where it changes as the move seeks (towards the workpiece:
+ * becomes true; away: becomes false), decelerating within the path's and legs'
+ * acceleration limits, as a pause does. */
+void motion_set_probe_input(struct motion *m, bool on);
+/* (Until it is first called, as in `hexcnc check`, probe moves run as plain feeds.) */
+struct motion_probe_result {
+    int already;             /* G38.2/G38.4: the input was already as sought where the move
+                              * starts (LinuxCNC's error); nothing moved */
+    int tripped;             /* the input changed during the move */
+    double trip[KINS_POSE_DIM];  /* path pose commanded the period the change was seen (the
+                                  * end of the move without a trip), mm, deg */
+    double stop[KINS_POSE_DIM];  /* path pose where the machine came to rest */
+};
+/* How many probe moves have been answered since the program started (any thread), and the
+ * last one's result in out (NULL: none wanted). The result holds from the moment the count
+ * moves until the next probe move starts, which in a program is after the interpreter has
+ * read it (a status reader at that instant may see the next move's result being filled). */
+unsigned motion_probe_result(const struct motion *m, struct motion_probe_result *out);
+
 /* The spindle and coolant as the program commands them at the point the path has reached. */
 struct motion_spindle {
     int dir;                 /* 1 (M3), -1 (M4), 0 (stopped) */
@@ -210,6 +230,7 @@ struct motion_out {
                                         * speed, 2 for a tool change, 3 for an input (M66) */
     struct motion_tool tool;           /* tool change requests, the tool in the spindle */
     struct motion_outputs outputs;     /* M62..M68 in force (kept from program to program) */
+    int probe_input;                   /* motion.probe-input as motion saw it (G38) */
     size_t settings_done;              /* CANON_SETTING commands of the program the machine has
                                         * passed since motion_start, in program order: the
                                         * path reached their place (never decreases) */
@@ -286,6 +307,9 @@ void motion_stream_detach(struct motion *m);
 /* Sync: the window so far is planned to a stop at its end (an M66 wait there) and handed
  * over; what comes next starts a new window at rest there. */
 int motion_stream_sync(struct motion_stream *s);
+/* After a sync on a probe move: the next window starts at rest at pose (where the machine
+ * stopped on the probe, not the move's end); call before adding what follows. */
+void motion_stream_restart_at(struct motion_stream *s, const double pose[KINS_POSE_DIM]);
 /* Whether the executor is about to run out of planned path (a simulated clock waits). */
 bool motion_stream_starving(const struct motion *m);
 

@@ -118,6 +118,8 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
             tol = motion_blend_tolerance(cfg, c);
         if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
             memcpy(at, c->end, sizeof at);
+        else if (c->type == CANON_PROBE)   /* the next move starts where the probe stops */
+            memcpy(at, c->probe_stop, sizeof at);
     }
 }
 

@@ -320,6 +320,43 @@ static int add_stop(struct motion_plan *p, const struct canon_cmd *c, const doub
     return 0;
 }
 
+static void set_speed(const struct motion *m, struct motion_seg *sg, const struct canon_cmd *c,
+                      double blend_tol_mm);
+
+/* G38.2..G38.5: a straight feed from rest to rest towards probe_stop (where the planner is
+ * told the move ends: the whole move on the machine, which stops earlier on a trip), which
+ * the executor watches the probe input on (motion_probe.c). */
+static int add_probe(struct motion *m, struct motion_plan *p, const struct canon_cmd *c,
+                     const double *from)
+{
+    struct canon_cmd line = *c;
+    line.type = CANON_FEED;
+    memcpy(line.end, c->probe_stop, sizeof line.end);
+    if (c->inverse_time_min > 0) {
+        /* G93: the whole move to end takes that long, wherever the probe stops it */
+        double xyz = 0, abc = 0;
+        for (int i = 0; i < 3; i++) {
+            xyz += (c->end[i] - from[i]) * (c->end[i] - from[i]);
+            abc += (c->end[i + 3] - from[i + 3]) * (c->end[i + 3] - from[i + 3]);
+        }
+        double len = sqrt(xyz) >= EPS_LEN ? sqrt(xyz) : sqrt(abc);
+        line.feed_mm_min = len / c->inverse_time_min;
+        line.inverse_time_min = 0;
+    }
+    if (add_stop(p, c, from, SEG_DWELL, 0) < 0)
+        return -1;
+    size_t n0 = p->nseg;
+    if (add_line(p, &line, from) < 0)
+        return -1;
+    if (p->nseg > n0) {
+        struct motion_seg *sg = &p->segs[p->nseg - 1];
+        set_speed(m, sg, &line, 0);
+        sg->probe = 1;
+        sg->probe_type = c->ivalue;
+    }
+    return add_stop(p, c, c->probe_stop, SEG_DWELL, 0);
+}
+
 /* The programmed speed of a move (feed, G93 inverse time, or rapid) and its path mode. */
 static void set_speed(const struct motion *m, struct motion_seg *sg, const struct canon_cmd *c,
                       double blend_tol_mm)
@@ -420,7 +457,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         if (motion_cancelled(m, c->file, c->line, err, errlen))
             return MOTION_ERR_CANCELLED;
         int rc = 0;
-        if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC) {
+        if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC ||
+            c->type == CANON_PROBE) {
             rc = tcp_switch(m, c, at, &at_tcp, &at_len, err, errlen);
             if (rc == -2)
                 return MOTION_ERR_PROGRAM;
@@ -432,6 +470,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         }
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
+        case CANON_PROBE: rc = add_probe(m, p, c, at); break;
         case CANON_ARC:
             rc = add_arc(p, c, at, err, errlen);
             if (rc == 0 && abc && abc[i].blend)
@@ -515,6 +554,8 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             blend = motion_blend_tolerance(&m->cfg, c);
         if (c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC)
             memcpy(at, c->end, sizeof at);
+        else if (c->type == CANON_PROBE)
+            memcpy(at, c->probe_stop, sizeof at);
         if (c->type == CANON_PROGRAM_END)
             break;
     }

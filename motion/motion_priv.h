@@ -65,6 +65,10 @@ struct motion_seg {
     int wait_input;          /* SEG_WAIT: for an input (M66): input, its kind and mode */
     int input, input_analog, input_mode;
     double timeout_s;        /* M66 Q */
+    int probe;               /* SEG_LINE of G38.2..G38.5: the executor watches the probe input
+                              * (motion_probe.c) and stops where it changes */
+    int probe_type;          /* LinuxCNC's probe type: bit 0 no error without a trip, bit 1
+                              * seek loss of contact */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
      * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
@@ -224,6 +228,14 @@ struct motion {
     struct motion_outputs outputs; /* M62..M68 in force */
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
+    /* G38 probing (motion_probe.c), servo thread only but the result and its counter */
+    bool probe_in;           /* motion.probe-input this period */
+    bool probe_wired;        /* someone gives the input (the HAL component, each period):
+                              * without, probe moves are plain feeds (hexcnc check) */
+    size_t probe_seg;        /* probe segment being watched (+1), 0 = none */
+    int probe_halt;          /* enum motion_probe_phase of the move at probe_seg */
+    struct motion_probe_result probe_res; /* the last probe move's result ... */
+    _Atomic unsigned probe_seq;  /* ... published by counting probe moves answered */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];
@@ -272,6 +284,27 @@ static inline void motion_phases(double v0, double v1, double vp, double a, doub
 /* motion_stream.c, for motion.c's attach: the stream's executor and its start pose. */
 void motion_stream_bind(struct motion_stream *s, struct motion *m);
 const double *motion_stream_start(const struct motion_stream *s);
+
+/* Where a probe move is (motion_probe.c). */
+enum motion_probe_phase {
+    PROBE_WATCHING,          /* on the move (or none yet), the input not yet as sought */
+    PROBE_HALTING,           /* it changed: decelerating on the path */
+    PROBE_PARKED,            /* at rest there, result published: the rest of the chunk is
+                              * dropped; the next part starts here */
+    PROBE_DONE,              /* the move ended without a change, result published */
+};
+/* Forgets the probe move (a new program or chunk: segment numbers start again). */
+void motion_probe_reset(struct motion *m);
+/* G38 probing (motion_probe.c), called by the executor (motion_step.c). Before the clock
+ * advances: watches the probe input on a probe segment; true while a trip asks the path
+ * to come to rest (the feed override's target is then 0). */
+bool motion_probe_watch(struct motion *m);
+/* After the clock advanced: a probe move the path came onto this period is looked at from
+ * its start (an input already as sought stops it there, before it moves). */
+void motion_probe_arm(struct motion *m);
+/* After the pose of the period is evaluated: publishes the result once the probe move has
+ * come to rest (tripped) or reached its end (no trip). */
+void motion_probe_settle(struct motion *m);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -186,6 +186,7 @@ static void enter_chunk(struct motion *m, struct motion_chunk *c, struct motion_
     m->waited_at_seg = 0;
     m->chunk = n;
     m->run = &n->plan;
+    motion_probe_reset(m);
     if (c)
         atomic_store_explicit(&c->retired, 1, memory_order_release);
 }
@@ -242,6 +243,28 @@ static int resting(const struct motion_plan *p, size_t ci, const struct motion_s
     return ci + 1 == sg->k0 + sg->nk && p->kt[ci + 1] > p->kt[ci];
 }
 
+/* At rest where a probe tripped: the rest of the chunk is dropped; on into the next part
+ * once the planner, which starts it here, has it (a whole program ends here). */
+static void probe_parked(struct motion *m)
+{
+    struct motion_chunk *c = m->chunk, *n = c ? atomic_load(&c->next) : NULL;
+    m->rate = 0;
+    if (m->state == MOTION_PAUSING)
+        m->state = MOTION_PAUSED;
+    if (m->state == MOTION_STOPPING) {
+        m->state = MOTION_IDLE;
+        m->loaded = 0;
+    } else if (!c) {
+        m->state = MOTION_DONE;    /* a whole program (an MDI line) ends where it stopped */
+    } else if (n && n != MOTION_TAIL_TAKEN && m->state == MOTION_RUNNING) {
+        pass_marks_to(m, c->plan.nseg);
+        pass_ios_to(m, c->plan.nseg);
+        enter_chunk(m, c, n, n->plan.nknot ? n->plan.kt[n->k_enter] : 0);
+        if (n->plan.nseg == 0 && n->last)
+            m->state = MOTION_DONE;
+    }
+}
+
 /* Advances the plan clock by one period. */
 static void advance(struct motion *m, double dt)
 {
@@ -249,6 +272,11 @@ static void advance(struct motion *m, double dt)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap;
     m->elapsed_s += dt;
+    if (m->probe_halt == PROBE_PARKED) {
+        probe_parked(m);
+        return;
+    }
+    bool probe_halt = motion_probe_watch(m);
     if (m->waiting) {  /* held for the spindle: pause and abort end the wait at rest */
         if (m->state == MOTION_RUNNING)
             follow_knots(m);
@@ -264,13 +292,13 @@ static void advance(struct motion *m, double dt)
         }
     }
     if (resting(p, m->ci, sg)) {
-        if (m->state == MOTION_RUNNING)
+        if (m->state == MOTION_RUNNING && !probe_halt)
             m->tau_s += dt;             /* a rest lasts its time whatever the override */
         else
             m->rate = 0;
     } else {
         double ovr = sg->kind == SEG_LINE && sg->feed == 0 ? m->rapid_cmd : m->override_cmd;
-        double target = m->state == MOTION_RUNNING ? ovr : 0;
+        double target = m->state == MOTION_RUNNING && !probe_halt ? ovr : 0;
         plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
         double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
         m->tau_s += 0.5 * (m->rate + rn) * dt;
@@ -278,6 +306,7 @@ static void advance(struct motion *m, double dt)
     }
     follow_knots(m);
     p = m->run;                  /* a streamed program may have gone on into the next chunk */
+    motion_probe_arm(m);
     if (m->step_until_seg && m->cs >= m->step_until_seg && m->state == MOTION_RUNNING) {
         m->step_until_seg = 0;   /* the block is done: pause on the path */
         m->state = MOTION_PAUSING;
@@ -518,6 +547,8 @@ static void stream_watch(struct motion *m)
         struct motion_chunk *c = m->chunk;
         if (!c)
             wait = MOTION_TAIL_TAKEN;
+        else if (m->probe_halt == PROBE_PARKED)  /* stopped on the probe: read on */
+            wait = !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
         else if (c->sync)    /* after the M66 wait: the interpreter reads on */
             wait = m->tau_s >= c->plan.total_time_s && !m->waiting &&
                    !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
@@ -549,7 +580,9 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         advance(m, period_s);  /* must see its own spindle command out */
         pass_marks(m);
         pass_ios(m);
-        int st = m->run->nseg ? evaluate(m) : KINS_OK;  /* (a streamed end holds no move) */
+        /* (a streamed end holds no move; at rest on a probe's trip the pose holds) */
+        int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m) : KINS_OK;
+        motion_probe_settle(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
                      "(%s); machine stopped", m->file ? m->file : "program", m->line,
@@ -600,5 +633,6 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->waiting = m->waiting;
     out->tool = m->tool;
     out->outputs = m->outputs;
+    out->probe_input = m->probe_in;
     return ret;
 }

@@ -58,7 +58,13 @@ struct motion_stream {
 
 static bool is_move(enum canon_type t)
 {
-    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC;
+    return t == CANON_TRAVERSE || t == CANON_FEED || t == CANON_ARC || t == CANON_PROBE;
+}
+
+/* Where a move leaves the path: a probe move where the planner is told it stops. */
+static const double *move_end(const struct canon_cmd *c)
+{
+    return c->type == CANON_PROBE ? c->probe_stop : c->end;
 }
 
 int motion_stream_create(struct motion *m, const double start[KINS_POSE_DIM],
@@ -171,9 +177,9 @@ static void move_size(const struct canon_cmd *c, const double *from, double *mm,
 {
     double d2 = 0, a = 0;
     for (int k = 0; k < 3; k++)
-        d2 += (c->end[k] - from[k]) * (c->end[k] - from[k]);
+        d2 += (move_end(c)[k] - from[k]) * (move_end(c)[k] - from[k]);
     for (int k = 3; k < 6; k++)
-        a = fmax(a, fabs(c->end[k] - from[k]));
+        a = fmax(a, fabs(move_end(c)[k] - from[k]));
     *mm = sqrt(d2);
     *deg = a;
 }
@@ -190,7 +196,7 @@ static size_t choose_cut(const struct motion_stream *s)
     for (size_t i = 0; i < s->n; i++) {
         memcpy(&from[i * KINS_POSE_DIM], at, sizeof at);
         if (is_move(s->win[i].type))
-            memcpy(at, s->win[i].end, sizeof at);
+            memcpy(at, move_end(&s->win[i]), sizeof at);
     }
     double mm = 0, deg = 0;
     size_t cut = SIZE_MAX, moves_after = 0, second_last = SIZE_MAX;
@@ -222,7 +228,7 @@ static void carry_state(struct motion_stream *s, size_t end)
     for (size_t i = 0; i < end; i++) {
         const struct canon_cmd *c = &s->win[i];
         if (is_move(c->type)) {
-            memcpy(s->start, c->end, sizeof s->start);
+            memcpy(s->start, move_end(c), sizeof s->start);
             s->start_tcp = c->tcp;
             s->start_len_mm = c->tool_len_mm;
         } else if (c->type == CANON_PATH_MODE)
@@ -422,6 +428,13 @@ int motion_stream_sync(struct motion_stream *s)
         return s->status;
     int st = motion_merge_flush(&s->merge, take, s);
     return st ? st : plan_window(s, true, true);
+}
+
+void motion_stream_restart_at(struct motion_stream *s, const double pose[KINS_POSE_DIM])
+{
+    memcpy(s->start, pose, sizeof s->start);
+    s->start_tcp = 0;             /* (G38 is refused under G43.4) */
+    s->start_len_mm = 0;
 }
 
 const char *motion_stream_error(const struct motion_stream *s)

@@ -1,6 +1,7 @@
 # sim/: simulated machine parts. The stepgen is a built-in HAL component.
-LIB_SRCS += sim/stepgen_core.c sim/stepgen.c sim/sim_home.c sim/sim_spindle.c sim/sim_toolchanger.c
-HAL_COMPS += stepgen sim_home sim_spindle sim_toolchanger
+LIB_SRCS += sim/stepgen_core.c sim/stepgen.c sim/sim_home.c sim/sim_spindle.c sim/sim_toolchanger.c \
+            sim/sim_probe.c
+HAL_COMPS += stepgen sim_home sim_spindle sim_toolchanger sim_probe
 TESTS += test_stepgen test_stepgen_hal
 # Simulated Modbus drives (libmodbus servers) and their tests.
 LIB_SRCS += sim/modbus_sim.c sim/modbus_sim_model.c sim/modbus_sim_hal.c

@@ -292,6 +292,18 @@ int runner_new_interp(struct runner *r, const double start[KINS_POSE_DIM], struc
 }
 
 /* Interprets the whole program into prog, starting from the machine's present pose. */
+/* A whole program is planned before the machine moves: it cannot go on from where a probe
+ * stops, which only the machine knows. */
+static int probe_refused(void *ctx, const struct canon_cmd *c, struct interp_probe_result *r,
+                         char *why, size_t whylen)
+{
+    (void)ctx, (void)c, (void)r;
+    snprintf(why, whylen, "`hexcnc run` plans the whole program before the machine moves, so "
+             "it cannot go on from where a probe stops: run programs that probe in the "
+             "machine session (hexcnc machine)");
+    return -1;
+}
+
 static int runner_interpret(struct runner *r, const char *path, struct canon_prog *prog,
                             char *err, size_t errlen)
 {
@@ -304,6 +316,7 @@ static int runner_interpret(struct runner *r, const char *path, struct canon_pro
     int st = runner_new_interp(r, start, &r->interp, &tt, err, errlen);
     if (st)
         return st;
+    interp_set_probe_fn(r->interp, probe_refused, NULL);
     if (interp_run_file(r->interp, path, canon_prog_sink, prog) != INTERP_OK) {
         char msg[600];
         const struct interp_error *e = interp_last_error(r->interp);
@@ -380,6 +393,10 @@ int runner_cut_step(struct runner_cut *cut, const struct canon_cmd *c, struct ca
     case CANON_ARC:
         memcpy(cut->at, c->end, sizeof cut->at);
         cut->last_comp = c->compensated;
+        return RUNNER_CUT_DROP;
+    case CANON_PROBE:    /* skipped: the interpreter reads on with its own answer */
+        memcpy(cut->at, c->probe_stop, sizeof cut->at);
+        cut->last_comp = 0;
         return RUNNER_CUT_DROP;
     case CANON_DWELL:
     case CANON_PAUSE:

@@ -205,6 +205,9 @@ void runner_stream_close(struct runner *r);
 bool runner_stream_checked(struct runner *r, const char *path);
 /* The planner thread's error, once it has stopped on one (RUNNER_OK otherwise). */
 int runner_stream_outcome(const struct runner *r, char *err, size_t errlen);
+/* Whether the machine waits at rest for a part of the program the producer will never
+ * plan: it stopped on an error after a sync (a probe that found nothing, G38.2). */
+bool runner_stream_stalled(const struct runner *r);
 /* Whether the machine is about to run out of planned path while the planner still works
  * (a simulated clock waits for it). */
 bool runner_stream_starving(const struct runner *r);

@@ -30,6 +30,7 @@ struct stream_sink {
     _Atomic int *first_ready;        /* run pass: set once the first chunk is out */
     size_t settings;
     unsigned waits;                  /* M66 waits sent to the machine */
+    unsigned probes;                 /* G38 probe moves sent to the machine */
     int status;                      /* RUNNER_ERR_* of the first error */
     char err[800];
 };
@@ -94,6 +95,13 @@ static int take(struct stream_sink *k, const struct canon_cmd *c)
         sleep_ms(1);
     if (atomic_load(k->stop))
         return sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+    struct canon_cmd whole;
+    if (k->run && c->type == CANON_PROBE) {
+        /* the machine is planned the whole move: it stops where the probe trips */
+        whole = *c;
+        memcpy(whole.probe_stop, c->end, sizeof whole.probe_stop);
+        c = &whole;
+    }
     if (motion_stream_add(k->ms, c) != MOTION_OK)
         return sink_fail(k, RUNNER_ERR_PLAN, "%s", motion_stream_error(k->ms));
     if (k->first_ready && !atomic_load(k->first_ready) && motion_stream_backlog(k->ms) > 0)
@@ -127,6 +135,46 @@ static double input_answer(void *ctx, const struct canon_cmd *w)
         }
         sleep_ms(1);
     }
+}
+
+/* G38 on a run: the window so far, the probe move last, goes to the machine, planned to a
+ * stop at the move's end; the machine stops earlier where the probe input changes. The
+ * interpreter reads on with where it tripped and where the machine came to rest, and the
+ * next window starts there (LinuxCNC's probe is a "queue buster" too). The verification
+ * pass, and a probe before the line a run starts from, keep the interpreter's own answer. */
+static int probe_answer(void *ctx, const struct canon_cmd *c, struct interp_probe_result *r,
+                        char *why, size_t whylen)
+{
+    struct stream_sink *k = ctx;
+    if (!k->run || k->status || !k->cut.started)
+        return 0;
+    if (motion_stream_sync(k->ms) != MOTION_OK) {
+        sink_fail(k, RUNNER_ERR_PLAN, "%s", motion_stream_error(k->ms));
+        snprintf(why, whylen, "%s", motion_stream_error(k->ms));
+        return -1;
+    }
+    atomic_store(k->first_ready, 1);
+    k->probes++;
+    struct motion_probe_result res;
+    while (motion_probe_result(k->r->motion, &res) < k->probes) {
+        if (atomic_load(k->stop)) {
+            sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+            snprintf(why, whylen, "the program was stopped");
+            return -1;
+        }
+        sleep_ms(1);
+    }
+    motion_stream_restart_at(k->ms, res.stop);
+    if (res.already) {
+        snprintf(why, whylen, "the probe is already %s where the move starts "
+                 "(motion.probe-input is %s)", c->ivalue & 2 ? "clear of the workpiece"
+                 : "tripped", c->ivalue & 2 ? "false" : "true");
+        return -1;
+    }
+    r->tripped = res.tripped;
+    memcpy(r->trip, res.trip, sizeof r->trip);
+    memcpy(r->stop, res.stop, sizeof r->stop);
+    return 0;
 }
 
 static int sink(void *ctx, const struct canon_cmd *c)
@@ -336,6 +384,7 @@ int runner_stream_start(struct runner *r, const char *path, int from_line, char 
     rs->sink.first_ready = &rs->first_ready;
     runner_cut_init(&rs->sink.cut, from_line, id.start);
     interp_set_input_fn(r->interp, input_answer, &rs->sink);
+    interp_set_probe_fn(r->interp, probe_answer, &rs->sink);
     if (pthread_create(&rs->thread, NULL, producer, r) != 0) {
         st = errbuf_set(err, errlen, RUNNER_ERR_NOMEM, "cannot start the planner's thread");
         goto fail;
@@ -365,6 +414,14 @@ int runner_stream_outcome(const struct runner *r, char *err, size_t errlen)
         rs->sink.status == RUNNER_ERR_ABORTED)
         return RUNNER_OK;
     return errbuf_set(err, errlen, rs->sink.status, "%s", rs->sink.err);
+}
+
+bool runner_stream_stalled(const struct runner *r)
+{
+    char err[8];
+    return r->stream && atomic_load(&r->stream->done) &&
+           runner_stream_outcome(r, err, sizeof err) != RUNNER_OK &&
+           motion_stream_starving(r->motion);
 }
 
 bool runner_stream_starving(const struct runner *r)

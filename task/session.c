@@ -232,6 +232,8 @@ static void run_outcome(struct session *s, enum motion_state st)
     double answer = motion_input_result(s->m, &waits);
     if (s->run_is_mdi && waits > 0)  /* an MDI line's M66: the next lines read its answer */
         interp_set_param(s->mdi, 5399, answer);
+    if (s->run_is_mdi)
+        session_mdi_probe_done(s);
     if (!s->run_is_mdi)
         mdi_renew(s);
 }
@@ -247,6 +249,10 @@ void session_tick(struct session *s)
         session_message(s, "error", "task", "the e-stop chain opened: the machine is in "
                         "e-stop%s%s", s->r->first_fault[0] ? "; cause: " : "",
                         s->r->first_fault);
+    }
+    if (s->running && !s->stopping && runner_stream_stalled(s->r)) {
+        s->stopping = true;      /* at rest where the program stopped on an error (G38.2 */
+        runner_abort(s->r);      /* without a trip): end the run there; run_outcome says why */
     }
     if (s->running) {
         runner_settings_apply(s->r);
@@ -295,6 +301,7 @@ int session_create(const struct session_opts *opts, struct session **out, char *
     if (!s)
         return errbuf_set(err, errlen, 1, "out of memory");
     s->lfd = -1;
+    s->mdi_probe = -1;
     s->quiet = opts->quiet;
     s->feed_ovr = s->rapid_ovr = s->spindle_ovr = 1;
     s->optional_stop = true;

@@ -56,6 +56,7 @@ struct session {
     enum session_mode mode;
     bool running;                /* a program or MDI line is under way */
     bool run_is_mdi;
+    int mdi_probe;               /* the running MDI line's G38 probe type (0..3), else -1 */
     bool stopping;               /* program.abort asked */
     char program[1024];          /* open program ("" when none) */
     long program_lines;
@@ -137,6 +138,9 @@ void session_tick(struct session *s);
 /* Whether anything moves or waits (the simulated clock then runs flat out). */
 bool session_busy(const struct session *s);
 /* Posts a message to subscribers (and stderr unless quiet). sev: info, warning, error. */
+/* After an MDI line with a G38 probe move (session_prog.c): the machine's answer into the
+ * MDI interpreter's #5061..#5066 and #5070, or the error of a probe that found nothing. */
+void session_mdi_probe_done(struct session *s);
 void session_message(struct session *s, const char *sev, const char *source,
                      const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 

@@ -61,6 +61,12 @@ int session_mdi(struct session *s, const char *line, char *err, size_t len)
                     "program)");
     }
     s->mode = SESS_MDI;
+    s->mdi_probe = -1;
+    for (size_t i = 0; i < prog.count; i++)   /* the machine runs the whole probe move: it */
+        if (prog.cmds[i].type == CANON_PROBE) {   /* stops where the probe trips */
+            memcpy(prog.cmds[i].probe_stop, prog.cmds[i].end, sizeof prog.cmds[i].end);
+            s->mdi_probe = prog.cmds[i].ivalue;
+        }
     char msg[600];
     int st = runner_load_canon(s->r, &prog, msg, sizeof msg);
     canon_prog_free(&prog);
@@ -79,6 +85,32 @@ int session_mdi(struct session *s, const char *line, char *err, size_t len)
         }
     }
     return 0;
+}
+
+void session_mdi_probe_done(struct session *s)
+{
+    int type = s->mdi_probe;
+    struct motion_probe_result r;
+    s->mdi_probe = -1;
+    if (type < 0 || motion_probe_result(s->m, &r) == 0)
+        return;                  /* no probe, or stopped before the move ended */
+    static const char *const names[] = { "G38.2", "G38.3", "G38.4", "G38.5" };
+    if (r.already) {
+        session_message(s, "error", "task", "MDI:1: %s: the probe is already %s where the "
+                        "move starts (motion.probe-input is %s)", names[type], type & 2 ?
+                        "clear of the workpiece" : "tripped", type & 2 ? "false" : "true");
+        return;
+    }
+    if (!r.tripped && !(type & 1))
+        session_message(s, "error", "task", "MDI:1: %s: the move ended without the probe %s",
+                        names[type], type & 2 ? "losing contact" : "touching anything");
+    struct interp_view v;        /* #5061..#5066 in the coordinates the line ran in */
+    interp_get_view(s->mdi, &v);
+    for (int i = 0; i < KINS_POSE_DIM; i++) {
+        double p = r.trip[i] - v.g5x_mm[i] - v.g92_mm[i] - v.tool_mm[i];
+        interp_set_param(s->mdi, 5061 + i, i < 3 && v.inch ? p / 25.4 : p);
+    }
+    interp_set_param(s->mdi, 5070, r.tripped);
 }
 
 /* A program path from the API: relative ones from [DISPLAY] PROGRAM_PREFIX or the INI's

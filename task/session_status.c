@@ -81,6 +81,17 @@ static json_t *mcodes(const struct interp_view *v)
     return a;
 }
 
+/* G38: the probe input now and the machine's last probe move (machine coordinates). */
+static json_t *probe_status(struct session *s, const struct motion_out *o)
+{
+    struct motion_probe_result r;
+    unsigned n = motion_probe_result(s->m, &r);
+    return json_pack("{s:b, s:i, s:b, s:o, s:o}", "input", o->probe_input != 0, "moves",
+                     (int)n, "tripped",
+                     n && r.tripped, "trip", n ? vec(r.trip, KINS_POSE_DIM) : json_null(),
+                     "stop", n ? vec(r.stop, KINS_POSE_DIM) : json_null());
+}
+
 json_t *session_status(struct session *s)
 {
     struct motion_out o;
@@ -159,5 +170,6 @@ json_t *session_status(struct session *s)
         "overrides", "feed", s->feed_ovr, "rapid", s->rapid_ovr, "spindle", s->spindle_ovr,
         "switches", "optional_stop", s->optional_stop, "block_delete", s->block_delete,
         "error", s->last_error[0] ? s->last_error : NULL);
+    json_object_set_new(j, "probe", probe_status(s, &o));
     return j;
 }

@@ -173,6 +173,8 @@ static int sink(void *ctx, const struct canon_cmd *cmd)
         put(p, cmd->end, KIND_RAPID, cmd->line);
     else if (cmd->type == CANON_FEED)
         put(p, cmd->end, kind, cmd->line);
+    else if (cmd->type == CANON_PROBE)   /* G38: to where the interpreter takes it to stop */
+        put(p, cmd->probe_stop, KIND_FEED, cmd->line);
     else if (cmd->type == CANON_ARC)
         put_arc(p, cmd, kind);
     return 0;

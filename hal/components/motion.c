@@ -64,6 +64,7 @@ struct motion_comp {
     double *aout[MOTION_MAX_AIO];            /* out: motion.analog-out-NN (M67, M68) */
     bool *din[MOTION_MAX_DIO];               /* in: motion.digital-in-NN (M66 P) */
     double *ain[MOTION_MAX_AIO];             /* in: motion.analog-in-NN (M66 E) */
+    bool *probe_in;                          /* in: motion.probe-input (G38.2..G38.5) */
     /* the tool changer's handshake, LinuxCNC's iocontrol pins */
     int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
     bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
@@ -226,6 +227,7 @@ static void motion_comp_update(void *arg, long period_ns)
     for (int i = 0; i < c->naio; i++)
         ain[i] = *c->ain[i];
     motion_set_inputs(c->m, din, c->ndio, ain, c->naio);
+    motion_set_probe_input(c->m, *c->probe_in);
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
@@ -324,6 +326,7 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
         st = hal_pin_bit_newf(h, HAL_IN, &c->din[i], "motion.digital-in-%02d", i);
     for (int i = 0; st == HAL_OK && i < c->naio; i++)
         st = hal_pin_float_newf(h, HAL_IN, &c->ain[i], "motion.analog-in-%02d", i);
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->probe_in, "motion.probe-input");
     if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");

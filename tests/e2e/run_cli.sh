@@ -41,6 +41,13 @@ check "malformed program exits 1" [ $? -eq 1 ]
 check "malformed program names file:line" has "$tmp/err" "bad.ngc:2"
 check "malformed program: no motion" has "$tmp/err" "did not move"
 
+# 3b. G38 probing: `hexcnc run` plans the whole program first, so it refuses, naming the line.
+printf 'G21 G90 F300\nG1 X1 Y0 Z640\nG38.2 Z600\nM2\n' >"$tmp/probe.ngc"
+"$bin" run "$ini" "$tmp/probe.ngc" >"$tmp/out" 2>"$tmp/err"
+check "G38 in hexcnc run exits 1" [ $? -eq 1 ]
+check "G38 in hexcnc run names file:line and the session" has "$tmp/err" "probe.ngc:3:1: error: G38.2: .hexcnc run. plans the whole program"
+check "G38 in hexcnc run: no motion" has "$tmp/err" "did not move"
+
 # 4. A point out of reach is refused before motion, naming its line.
 printf 'G1 X0 Y0 Z645 F2\nG1 X10\nG1 X600\nM2\n' >"$tmp/far.ngc"
 "$bin" run "$ini" "$tmp/far.ngc" >"$tmp/out" 2>"$tmp/err"
