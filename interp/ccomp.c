@@ -335,18 +335,23 @@ static int line_corner(struct interp *in, int move, const double p[3], const dou
     return 0;
 }
 
+void ccomp_take_position(struct interp *in)
+{
+    double cur[6];
+    int ax[3];
+    interp_prog_pos(in, cur);
+    ccomp_axes(in, ax);
+    for (int i = 0; i < 3; i++)
+        in->cc.cur[i] = cur[ax[i]];
+}
+
 int ccomp_straight(struct interp *in, int move, const double end6[6])
 {
     struct ccomp *cc = &in->cc;
     double p[3], ex, ey;
     ccomp_prog_point(in, p);
     if (cc->first) {
-        double cur[6];
-        int ax[3];
-        interp_prog_pos(in, cur);
-        ccomp_axes(in, ax);
-        for (int i = 0; i < 3; i++)
-            cc->cur[i] = cur[ax[i]];
+        ccomp_take_position(in);
         CHP(straight_first(in, move, p, end6));
     } else if (p[0] == cc->prog[0] && p[1] == cc->prog[1]) {
         /* no motion in the plane: the tool stays beside the programmed point */

@@ -183,12 +183,7 @@ int ccomp_arc(struct interp *in, int move, const double s[2], const double e[2],
     double p[3];
     ccomp_prog_point(in, p);
     if (cc->first) {
-        double cur[6];
-        int ax[3];
-        interp_prog_pos(in, cur);
-        ccomp_axes(in, ax);
-        for (int i = 0; i < 3; i++)
-            cc->cur[i] = cur[ax[i]];
+        ccomp_take_position(in);
         CHP(arc_first(in, turns, e, c, s, p[2], end6));
     } else {
         CHP(arc_next(in, move, turns, e, c, p[2], end6));

@@ -31,5 +31,7 @@ void ccomp_set_endpoint(struct interp *in, double x, double y);
 int ccomp_move_endpoint_and_flush(struct interp *in, double x, double y);
 /* The block's programmed point in plane order (program units, offsets removed). */
 void ccomp_prog_point(struct interp *in, double p[3]);
+/* The entry move starts where the program stands: that point, in plane order, into cc.cur. */
+void ccomp_take_position(struct interp *in);
 
 #endif

@@ -356,6 +356,8 @@ int interp_need_feed(struct interp *in, const char *what);
 int interp_probe(struct interp *in, int g);   /* G38.2..G38.5 (g x10), probe.c */
 
 /* rotation.c: the active system's rotation about Z (G10 L2 R). */
+/* Machine pose to program coordinates: offsets and rotation removed, inches under G20. */
+void interp_machine_to_program(const struct interp *in, const double m[6], double out[6]);
 void interp_rotate_xy(double *x, double *y, double deg);
 /* Program X Y (program units) to machine X Y (mm), offsets and rotation applied. */
 void interp_xy_to_machine(const struct interp *in, double px, double py, double m[2]);

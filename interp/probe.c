@@ -90,23 +90,6 @@ static int probe_checks(struct interp *in, int type, int col, const double from[
     return 0;
 }
 
-/* The machine pose p in program coordinates (offsets removed, program units). */
-static void to_program(const struct interp *in, const double p[6], double out[6])
-{
-    for (int i = 0; i < 6; i++)
-        out[i] = p[i] - in->g5x[i] - in->g92[i] - in->tool[i];
-    if (in->rot_deg != 0.0) {          /* G10 L2 R: X Y in the turned frame */
-        double x = p[AX_X] - in->g5x[AX_X] - in->tool[AX_X];
-        double y = p[AX_Y] - in->g5x[AX_Y] - in->tool[AX_Y];
-        interp_rotate_xy(&x, &y, -in->rot_deg);
-        out[AX_X] = x - in->g92[AX_X];
-        out[AX_Y] = y - in->g92[AX_Y];
-    }
-    if (in->inch)
-        for (int i = 0; i < 3; i++)
-            out[i] /= MM_PER_INCH;
-}
-
 /* G38.2..G38.5 (g x10) with the block's axis words: the probe move, then its answer. */
 int interp_probe(struct interp *in, int g)
 {
@@ -143,7 +126,7 @@ int interp_probe(struct interp *in, int g)
         return interp_fail(in, INTERP_ERR_PROBE, col, "%s: the move ended without the probe %s",
                            name, type & 2 ? "losing contact" : "touching anything");
     double prog[6];
-    to_program(in, r.trip, prog);
+    interp_machine_to_program(in, r.trip, prog);
     for (int i = 0; i < 6; i++)
         in->params[5061 + i] = prog[i];
     in->params[5070] = r.tripped;

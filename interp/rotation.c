@@ -45,6 +45,20 @@ void interp_rotated_pos(const struct interp *in, double q[2])
     interp_rotate_xy(&q[0], &q[1], -in->rot_deg);
 }
 
+/* Machine pose to program coordinates, offsets and the rotation removed, inch programs in
+ * inches (G38's #5061.. from the pose where the probe stopped). */
+void interp_machine_to_program(const struct interp *in, const double m[6], double out[6])
+{
+    struct interp_view v;
+    memset(&v, 0, sizeof v);
+    memcpy(v.g5x_mm, in->g5x, sizeof v.g5x_mm);
+    memcpy(v.g92_mm, in->g92, sizeof v.g92_mm);
+    memcpy(v.tool_mm, in->tool, sizeof v.tool_mm);
+    v.xy_rotation_deg = in->rot_deg;
+    v.inch = in->inch;
+    interp_view_to_program(&v, m, out);
+}
+
 /* Machine pose to program coordinates of a view (printers, displays): offsets and the
  * rotation removed, inch programs in inches. */
 void interp_view_to_program(const struct interp_view *v, const double m[6], double out[6])
