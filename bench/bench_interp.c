@@ -11,6 +11,7 @@
 
 #include "interp/interp.h"
 #include "interp/printer.h"
+#include "bench/bench_interp_util.h"
 
 #define BLOCKS 200000
 
@@ -91,31 +92,6 @@ static int generate_comp(const char *path, long *blocks)
     return fclose(f);
 }
 
-/* CPU seconds of this process: the machine is shared, so wall time would measure the load
- * of others as much as this code. */
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
-/* CPU seconds (user + system) used by the finished children so far. */
-static double children_s(void)
-{
-    struct rusage u;
-    getrusage(RUSAGE_CHILDREN, &u);
-    return (double)(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-           (double)(u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
-}
-
-/* Counts feed moves, so the work cannot be optimised away. */
-static int null_sink(void *ctx, const struct canon_cmd *c)
-{
-    (*(long *)ctx) += c->type == CANON_FEED;
-    return 0;
-}
-
 /* Drops the printed text. */
 static int null_write(void *ctx, const char *buf, size_t len)
 {
@@ -149,22 +125,6 @@ static double time_library(const char *path, int print, long *moves)
             best = dt;
         free(pr);
         interp_destroy(in);
-    }
-    return best;
-}
-
-/* CPU time of a shell command and its children (best of `runs`); < 0 if it fails. */
-static double time_command(const char *cmd, int runs)
-{
-    double best = -1;
-    for (int r = 0; r < runs; r++) {
-        double t0 = children_s();
-        int st = system(cmd);
-        double dt = children_s() - t0;
-        if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
-            return -1;
-        if (best < 0 || dt < best)
-            best = dt;
     }
     return best;
 }
