@@ -19,7 +19,7 @@ static const struct { int code, group; } g_table[] = {
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
-static const int g_unsupported[] = {55, 61, 331, 840, 860, 870, 880};
+static const int g_unsupported[] = {55, 61, 840, 860, 870, 880};
 
 /* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
  * or "not yet". */
@@ -27,6 +27,8 @@ static const int g_unsupported[] = {55, 61, 331, 840, 860, 870, 880};
 static const struct { int code; const char *what; } g_lathe[] = {
     {70, "lathe diameter mode" LATHE}, {80, "lathe radius mode" LATHE},
     {330, "spindle-synchronised motion (threading): this machine has no spindle position "
+     "feedback to follow"},
+    {331, "rigid tapping, spindle-synchronised motion: this machine has no spindle position "
      "feedback to follow"},
     {700, "a lathe finishing cycle" LATHE}, {710, "a lathe roughing cycle" LATHE},
     {711, "a lathe roughing cycle" LATHE}, {720, "a lathe roughing cycle" LATHE},
