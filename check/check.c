@@ -1,4 +1,5 @@
 /* check.c: the check of one program: interpret, scan the reach, plan, run on the servo clock. */
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -82,18 +83,32 @@ int check_add_warning(struct check_result *r, const struct check_problem *p)
     return add_to(&r->warnings, &r->nwarnings, &r->capwarnings, p);
 }
 
-/* The line number in a "file:line: ..." message from motion, 0 when there is none. */
-static int message_line(const char *msg, const struct canon_prog *prog, char *file, size_t len)
+/* The file and line a motion message names ("file:line: ..."), line 0 when it names none. */
+static int message_line(const char *msg, char *file, size_t len)
 {
-    for (size_t k = 0; k < prog->count; k++) {
-        const char *f = prog->cmds[k].file;
-        size_t n = f ? strlen(f) : 0;
-        if (n && strncmp(msg, f, n) == 0 && msg[n] == ':') {
-            snprintf(file, len, "%s", f);
-            return atoi(msg + n + 1);
+    for (const char *c = strchr(msg, ':'); c; c = strchr(c + 1, ':')) {
+        const char *d = c + 1;
+        while (isdigit((unsigned char)*d))
+            d++;
+        if (c > msg && d > c + 1 && *d == ':') {
+            snprintf(file, len, "%.*s", (int)(c - msg), msg);
+            return atoi(c + 1);
         }
     }
     return 0;
+}
+
+int check_add_plan_problem(struct check_result *r, const char *msg, int stopped, double time_s)
+{
+    struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = stopped ? time_s : -1,
+                               .count = 1 };
+    p.line = message_line(msg, p.file, sizeof p.file);
+    if (stopped)
+        snprintf(p.message, sizeof p.message, "motion stopped before the end of the program: "
+                 "%.300s", msg[0] ? msg : "it did not finish in twice the planned time");
+    else
+        snprintf(p.message, sizeof p.message, "%s", msg);
+    return check_add_problem(r, &p);
 }
 
 /* Fills the result's header fields from the machine. */
@@ -122,28 +137,16 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
     int reach = check_scan_reach(mc, prog, r);
     char msg[400];
     if (motion_load(mc->motion, prog, msg, sizeof msg) != MOTION_OK) {
-        if (reach == 0) {      /* the planner found what the reach pass did not: report it */
-            struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = -1,
-                                       .count = 1 };
-            p.line = message_line(msg, prog, p.file, sizeof p.file);
-            snprintf(p.message, sizeof p.message, "%s", msg);
-            check_add_problem(r, &p);
-        }
+        if (reach == 0)        /* the planner found what the reach pass did not: report it */
+            check_add_plan_problem(r, msg, 0, -1);
         return CHECK_ERR_VIOLATION;
     }
     if (motion_start(mc->motion) != MOTION_OK)
         return CHECK_ERR_CONFIG;
     int st = check_simulate(mc, prog->start, opts, NULL, r);
     r->simulated = 1;
-    if (st != CHECK_OK) {
-        struct check_problem p = { .kind = CHECK_PLAN, .leg = -1, .time_s = r->machining_time_s,
-                                   .count = 1 };
-        snprintf(msg, sizeof msg, "%s", motion_last_error(mc->motion));
-        p.line = message_line(msg, prog, p.file, sizeof p.file);
-        snprintf(p.message, sizeof p.message, "motion stopped before the end of the program: "
-                 "%.300s", msg[0] ? msg : "it did not finish in twice the planned time");
-        check_add_problem(r, &p);
-    }
+    if (st != CHECK_OK)
+        check_add_plan_problem(r, motion_last_error(mc->motion), 1, r->machining_time_s);
     return r->nproblems ? CHECK_ERR_VIOLATION : CHECK_OK;
 }
 

@@ -77,6 +77,11 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
 int check_program_whole(struct check_machine *mc, const char *path,
                         const struct check_opts *opts, struct check_result *r);
 
+/* A problem of kind CHECK_PLAN from motion's message, with the file and line it names:
+ * the planner's refusal (stopped 0), or motion stopped at time_s before the program's end
+ * (stopped 1; an empty message: it ran past twice the planned time). */
+int check_add_plan_problem(struct check_result *r, const char *msg, int stopped, double time_s);
+
 /* The result's header fields (configuration, tolerances, schedule) from the machine. */
 void check_result_header(struct check_machine *mc, const struct check_opts *o,
                          struct check_result *r);

@@ -14,7 +14,6 @@
 
 #define AHEAD_CHUNKS 4       /* planned windows the producer may have ahead of the servo pass
                               * (each about 2048 moves): the memory bound */
-#define MAX_FILES 64         /* distinct program files whose names locate a planner message */
 
 /* The producer's side: what it reads, what it found. Its check_result holds the reach
  * problems (the servo pass fills the caller's); they are merged at the end. */
@@ -29,9 +28,6 @@ struct producer {
                                       * reach pass goes on to the end) */
     int interp_status;               /* CHECK_OK, or the interpreter's error (in pb) */
     struct check_problem pb;
-    int nomem;
-    const char *files[MAX_FILES];    /* program files seen (their names live in the interp) */
-    int nfiles;
     _Atomic int ready;               /* the first window is planned, or the producer ended */
     _Atomic int done;                /* the producer has ended */
 };
@@ -42,23 +38,11 @@ static void pause_us(long us)
     nanosleep(&ts, NULL);
 }
 
-static void note_file(struct producer *p, const char *f)
-{
-    if (!f)
-        return;
-    for (int i = p->nfiles - 1; i >= 0; i--)
-        if (p->files[i] == f)
-            return;
-    if (p->nfiles < MAX_FILES)
-        p->files[p->nfiles++] = f;
-}
-
 /* The interpreter's commands: reach pass, then the planner (while it has not failed), with
  * at most AHEAD_CHUNKS windows ahead of the servo pass. */
 static int sink(void *ctx, const struct canon_cmd *c)
 {
     struct producer *p = ctx;
-    note_file(p, c->file);
     size_t before = p->found.nproblems;
     check_reach_cmd(p->mc, &p->reach, c, &p->found);
     if (p->found.nproblems > before && !p->plan_status)
@@ -120,19 +104,6 @@ static double feed_planned(void *ctx)
     return si.plan.time_s;
 }
 
-/* The line of a "file:line: ..." planner message, and its file. */
-static int message_line(const struct producer *p, const char *msg, char *file, size_t len)
-{
-    for (int i = 0; i < p->nfiles; i++) {
-        size_t n = strlen(p->files[i]);
-        if (n && strncmp(msg, p->files[i], n) == 0 && msg[n] == ':') {
-            snprintf(file, len, "%s", p->files[i]);
-            return atoi(msg + n + 1);
-        }
-    }
-    return 0;
-}
-
 /* Problems in the order a reader expects (the reach pass's first, as check_canon gives them):
  * found's, then r's, into r. */
 static int merge_found(struct check_result *r, struct check_result *found)
@@ -166,23 +137,7 @@ static void plan_failure(struct producer *p, struct check_result *r)
         merge_found(r, &p->found);
         return;
     }
-    struct check_problem pr = { .kind = CHECK_PLAN, .leg = -1, .time_s = -1, .count = 1 };
-    const char *msg = motion_stream_error(p->ms);
-    pr.line = message_line(p, msg, pr.file, sizeof pr.file);
-    snprintf(pr.message, sizeof pr.message, "%s", msg);
-    check_add_problem(r, &pr);
-}
-
-/* Motion did not reach the program's end although everything was planned. */
-static int unfinished(const struct producer *p, struct check_result *r)
-{
-    struct check_problem pr = { .kind = CHECK_PLAN, .leg = -1, .time_s = r->machining_time_s,
-                                .count = 1 };
-    const char *msg = motion_last_error(p->mc->motion);
-    pr.line = message_line(p, msg, pr.file, sizeof pr.file);
-    snprintf(pr.message, sizeof pr.message, "motion stopped before the end of the program: "
-             "%.300s", msg[0] ? msg : "it did not finish in twice the planned time");
-    return check_add_problem(r, &pr);
+    check_add_plan_problem(r, motion_stream_error(p->ms), 0, -1);
 }
 
 int check_program(struct check_machine *mc, const char *path, const struct check_opts *opts,
@@ -242,7 +197,8 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         r->simulated = 1;
         st = merge_found(r, &p->found);
         if (!st && sim != CHECK_OK)
-            st = unfinished(p, r);
+            st = check_add_plan_problem(r, motion_last_error(mc->motion), 1,
+                                        r->machining_time_s);
         if (!st)
             st = r->nproblems ? CHECK_ERR_VIOLATION : CHECK_OK;
     }
