@@ -258,7 +258,7 @@ static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
 
 /* The scheduled measures of one period: the deviation at every line change, the condition
  * number at a line change the pose has moved on from (dense code changes line every few
- * tenths of a millimetre, and a singular value decomposition costs ten servo periods), and
+ * tenths of a millimetre, and a condition number costs several servo periods), and
  * both on their schedule. */
 static void measures(struct sim *s, const struct motion_out *out)
 {

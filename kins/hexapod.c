@@ -68,6 +68,18 @@ static inline bool hexapod_ws_plain(const struct hexapod *h, const double *pose,
     return !h->ws_extra && up;
 }
 
+/* The joints of legs already evaluated with their unit vectors, and the workspace's status
+ * at that pose (inverse_rates and inverse_near: the full check reuses the legs). */
+static inline int joints_checked(struct kins *k, const double *pose, const struct hexapod_rot *o,
+                                 const struct hexapod_legs *lg, double *joints)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    int st = hexapod_lengths_of(k, lg, joints);
+    if (st == KINS_OK && !hexapod_ws_plain(h, pose, o, lg))
+        st = hexapod_workspace(h, pose, o, lg, NULL, 0);
+    return st;
+}
+
 /* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i; then the workspace's other
  * limits (hexapod_workspace.c). */
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
@@ -133,9 +145,7 @@ static int hexapod_inverse_near(struct kins *k, const double pose[KINS_POSE_DIM]
     }
     hexapod_rot_from_sc(&o, sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]);
     hexapod_legs_eval(h, t, &o, &lg);
-    int st = hexapod_lengths_of(k, &lg, joints);
-    if (st == KINS_OK && !hexapod_ws_plain(h, pose, &o, &lg))
-        st = hexapod_ws_full(h, pose);
+    int st = joints_checked(k, pose, &o, &lg, joints);
     struct hexapod_rot on;
     struct hexapod_legs ln;
     double tn[3];
@@ -219,9 +229,7 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
     if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
         return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
-    int st = hexapod_lengths_of(k, &lg, joints);
-    if (st == KINS_OK && !hexapod_ws_plain(h, pose, &o, &lg))
-        st = hexapod_workspace(h, pose, &o, &lg, NULL, 0);
+    int st = joints_checked(k, pose, &o, &lg, joints);
     if (st != KINS_OK)
         return st;
     for (int j = 0; j < KINS_POSE_DIM; j++)
