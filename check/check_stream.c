@@ -18,6 +18,7 @@
 /* The producer's side: what it reads, what it found. Its check_result holds the reach
  * problems (the servo pass fills the caller's); they are merged at the end. */
 struct producer {
+    pthread_t thread;
     struct check_machine *mc;
     struct interp *in;
     const char *path;
@@ -30,6 +31,8 @@ struct producer {
     struct check_problem pb;
     _Atomic int ready;               /* the first window is planned, or the producer ended */
     _Atomic int done;                /* the producer has ended */
+    _Atomic int stop;                /* the servo pass has ended: plan no more (the reach
+                                      * pass goes on), and wait for no chunk to be left */
 };
 
 static void pause_us(long us)
@@ -48,10 +51,13 @@ static int sink(void *ctx, const struct canon_cmd *c)
     if (p->found.nproblems > before && !p->plan_status)
         p->plan_status = MOTION_ERR_UNREACHABLE;  /* the planner would refuse it too: the
                                                    * reach pass's words are the clearer */
-    if (p->plan_status)
+    if (p->plan_status || atomic_load(&p->stop))
         return 0;
     while (motion_stream_backlog(p->ms) >= AHEAD_CHUNKS)
-        pause_us(200);
+        if (atomic_load(&p->stop))
+            return 0;
+        else
+            pause_us(200);
     if (motion_stream_add(p->ms, c) != MOTION_OK)
         p->plan_status = MOTION_ERR_PROGRAM;
     else if (!atomic_load(&p->ready) && motion_stream_backlog(p->ms) > 0)
@@ -71,7 +77,8 @@ static void *produce(void *arg)
         p->pb.line = e->line, p->pb.column = e->column;
         interp_error_format(e, p->pb.message, sizeof p->pb.message);
         p->interp_status = CHECK_ERR_VIOLATION;
-    } else if (!p->plan_status && motion_stream_finish(p->ms) != MOTION_OK) {
+    } else if (!p->plan_status && !atomic_load(&p->stop) &&
+               motion_stream_finish(p->ms) != MOTION_OK) {
         p->plan_status = MOTION_ERR_PROGRAM;
     }
     atomic_store(&p->ready, 1);
@@ -165,27 +172,33 @@ int check_program(struct check_machine *mc, const char *path, const struct check
     }
     check_reach_begin(&p->reach, mc->kins->home, 0, 0);
     char err[400];
+    const char *why = NULL;
+    int e;
     if (motion_stream_create(mc->motion, mc->kins->home, NULL, &p->ms, err, sizeof err) !=
-            MOTION_OK ||
-        motion_stream_attach(mc->motion, p->ms, NULL) != MOTION_OK) {
-        motion_stream_destroy(p->ms);
-        free(p);
-        return CHECK_ERR_NOMEM;
+        MOTION_OK)
+        why = err;
+    else if (motion_stream_attach(mc->motion, p->ms, NULL) != MOTION_OK)
+        why = motion_last_error(mc->motion);
+    else if ((e = pthread_create(&p->thread, NULL, produce, p)) != 0) {
+        snprintf(err, sizeof err, "the planner's thread cannot start: %s", strerror(e));
+        why = err;
     }
-    pthread_t th;
-    if (pthread_create(&th, NULL, produce, p) != 0) {
+    if (why) {                           /* the check cannot run: say why */
+        check_add_plan_problem(r, why, 0, -1);
         motion_stream_detach(mc->motion);
         motion_stream_destroy(p->ms);
         free(p);
-        return CHECK_ERR_NOMEM;
+        return CHECK_ERR_CONFIG;
     }
     while (!atomic_load(&p->ready))
         pause_us(100);
     struct check_feed feed = { feed_wait, feed_planned, p };
     int sim = CHECK_OK;
-    if (!p->plan_status && !p->interp_status && motion_start(mc->motion) == MOTION_OK)
-        sim = check_simulate(mc, mc->kins->home, opts, &feed, r);
-    pthread_join(th, NULL);
+    if (!p->plan_status && !p->interp_status)
+        sim = motion_start(mc->motion) == MOTION_OK
+                  ? check_simulate(mc, mc->kins->home, opts, &feed, r) : CHECK_ERR_CONFIG;
+    atomic_store(&p->stop, 1);          /* (a servo pass cut short leaves chunks unread) */
+    pthread_join(p->thread, NULL);
     if (p->plan_status || p->interp_status) {
         plan_failure(p, r);
         st = CHECK_ERR_VIOLATION;
