@@ -112,6 +112,18 @@ static int take(struct stream_sink *k, const struct canon_cmd *c)
 /* M66 on a run: the window so far goes to the machine to a stop at the wait; the
  * interpreter reads on with the machine's answer once it has it (LinuxCNC's M66 is a
  * "queue buster" too). The verification pass reads 0, as rs274 does. */
+/* A millisecond more for the machine's answer to an M66 or a G38; false (the run then
+ * fails as stopped) once the operator has stopped the program. */
+static bool wait_for_machine(struct stream_sink *k)
+{
+    if (atomic_load(k->stop)) {
+        sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+        return false;
+    }
+    sleep_ms(1);
+    return true;
+}
+
 static double input_answer(void *ctx, const struct canon_cmd *w)
 {
     struct stream_sink *k = ctx;
@@ -129,11 +141,8 @@ static double input_answer(void *ctx, const struct canon_cmd *w)
         double v = motion_input_result(k->r->motion, &seq);
         if (seq >= k->waits)
             return v;
-        if (atomic_load(k->stop)) {
-            sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+        if (!wait_for_machine(k))
             return 0;
-        }
-        sleep_ms(1);
     }
 }
 
@@ -156,14 +165,11 @@ static int probe_answer(void *ctx, const struct canon_cmd *c, struct interp_prob
     atomic_store(k->first_ready, 1);
     k->probes++;
     struct motion_probe_result res;
-    while (motion_probe_result(k->r->motion, &res) < k->probes) {
-        if (atomic_load(k->stop)) {
-            sink_fail(k, RUNNER_ERR_ABORTED, "%s", "the program was stopped");
+    while (motion_probe_result(k->r->motion, &res) < k->probes)
+        if (!wait_for_machine(k)) {
             snprintf(why, whylen, "the program was stopped");
             return -1;
         }
-        sleep_ms(1);
-    }
     motion_stream_restart_at(k->ms, res.stop);
     if (res.already) {
         snprintf(why, whylen, "the probe is already %s where the move starts "
