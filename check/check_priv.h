@@ -32,6 +32,11 @@ struct check_machine {
     size_t ninterps;
 };
 
+/* A line change takes the condition number once the pose is this far from where it was
+ * last taken (the planner's knot spacing): check_sim.c measures, check_report.c says so. */
+#define CHECK_COND_STEP_MM 1.0
+#define CHECK_COND_STEP_DEG 0.5
+
 /* Whether a canonical command moves the machine. */
 static inline int check_is_motion(enum canon_type t)
 {

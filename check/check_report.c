@@ -3,6 +3,7 @@
 #include <stdio.h>
 
 #include "check/check.h"
+#include "check/check_priv.h"
 
 /* Prints a JSON string with the characters JSON requires escaped. */
 static void json_str(FILE *f, const char *s)
@@ -151,8 +152,10 @@ void check_print_table(const struct check_result *r, FILE *f)
         if (r->tip_measured)
             fprintf(f, "tool tip        %.4g um max from its path (line %d)\n",
                     r->max_tip_deviation_mm * 1e3, r->max_tip_deviation_line);
-        schedule(when, sizeof when, r->condition_every_s,
-                 " 1 mm or 0.5 deg on from the last");
+        char moved[64];
+        snprintf(moved, sizeof moved, " %g mm or %g deg on from the last", CHECK_COND_STEP_MM,
+                 CHECK_COND_STEP_DEG);
+        schedule(when, sizeof when, r->condition_every_s, moved);
         fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
                 r->max_condition, r->max_condition_line, r->condition_limit, when);
         fputs("leg   min mm     max mm     range mm         peak mm/s  limit   "

@@ -9,8 +9,6 @@
 
 #define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
 #define MAX_PERIODS_FACTOR 2 /* the run stops at twice the planned time (a stuck planner) */
-#define COND_STEP_MM 1.0     /* a line change takes the condition number once the pose is */
-#define COND_STEP_DEG 0.5    /* this far from where it was last taken (the planner's knots) */
 
 /* State of the pass between periods. */
 struct sim {
@@ -244,7 +242,7 @@ static void singularity(struct sim *s, const struct motion_out *out)
     check_add_problem(r, &p);
 }
 
-/* Whether the pose has moved COND_STEP_MM or COND_STEP_DEG from where the condition number
+/* Whether the pose has moved CHECK_COND_STEP_MM or _DEG from where the condition number
  * was last taken. */
 static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
 {
@@ -253,7 +251,7 @@ static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
         d2 += (pose[i] - s->cond_pose[i]) * (pose[i] - s->cond_pose[i]);
     for (int i = 3; i < KINS_POSE_DIM; i++)
         da = fmax(da, fabs(pose[i] - s->cond_pose[i]));
-    return d2 >= COND_STEP_MM * COND_STEP_MM || da >= COND_STEP_DEG;
+    return d2 >= CHECK_COND_STEP_MM * CHECK_COND_STEP_MM || da >= CHECK_COND_STEP_DEG;
 }
 
 /* The scheduled measures of one period: the deviation at every line change, the condition
