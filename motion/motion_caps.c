@@ -8,6 +8,7 @@
 #define FD_H 0.05              /* finite-difference step along the path, mm (deg) */
 #define LEG_ACC_SPLIT 0.6      /* share of a leg's acceleration for the path acceleration term */
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
+#define FINE_SLACK 1e-9        /* relative: knots this much wider than fine_h are as close */
 
 /* Samples segment sg at s; returns the inverse kinematics status at s itself. */
 static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
@@ -348,7 +349,11 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
                      struct motion_sample *S, double *hard, double *cap, double *acc, char *err,
                      size_t errlen)
 {
-    double h = sg->fine_h > 0 ? fmin(hs, sg->fine_h) : hs;  /* the error terms' spacing */
+    /* The error terms' spacing: the knots' own, unless they lie further apart than the
+     * checks are made for (a move capped at MAX_INTERVALS). Evenly spread knots come out an
+     * ulp or so wider than fine_h (len i / n against len / n): that is the knots' spacing,
+     * not a reason to sample every interval again in between. */
+    double h = sg->fine_h > 0 && hs > sg->fine_h * (1 + FINE_SLACK) ? sg->fine_h : hs;
     int st = reach_check(m, sg, S, h, sample_at(m, sg, s, S), err, errlen);
     if (st)
         return st;
