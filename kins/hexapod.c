@@ -69,7 +69,7 @@ static inline bool hexapod_ws_plain(const struct hexapod *h, const double *pose,
 }
 
 /* The joints of legs already evaluated with their unit vectors, and the workspace's status
- * at that pose (inverse_rates and inverse_near: the full check reuses the legs). */
+ * at that pose (inverse_rates and inverse_path: the full check reuses the legs). */
 static inline int joints_checked(struct kins *k, const double *pose, const struct hexapod_rot *o,
                                  const struct hexapod_legs *lg, double *joints)
 {
@@ -97,64 +97,65 @@ static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], dou
     return hexapod_ws_full(h, pose);
 }
 
-/* sin and cos of a small angle d (rad): the series to the term that no longer counts below
- * 1e-2 rad (the next is 1e-22 relative), else the library's. */
-static void small_sincos(double d, double *s, double *c)
+/* a x b into o. */
+static inline void cross3(const double a[3], const double b[3], double o[3])
 {
-    if (fabs(d) >= 1e-2) {
-        sincos(d, s, c);
-        return;
-    }
-    double d2 = d * d;
-    *s = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42)));
-    *c = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30 * (1 - d2 / 56)));
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* The orientation of a pose near one whose sines and cosines are known (sa ca ...): by the
- * angle-sum formulas with the small differences, three sines and cosines fewer. */
-static void rot_near(const double pose[KINS_POSE_DIM], const double near[KINS_POSE_DIM],
-                     const double sc0[6], double t[3], struct hexapod_rot *o)
-{
-    double sc[6];
-    for (int i = 0; i < 3; i++) {
-        double sd, cd, s0 = sc0[2 * i], c0 = sc0[2 * i + 1];
-        small_sincos((near[KINS_A + i] - pose[KINS_A + i]) * HEXAPOD_RAD_PER_DEG, &sd, &cd);
-        sc[2 * i] = s0 * cd + c0 * sd;
-        sc[2 * i + 1] = c0 * cd - s0 * sd;
-        t[i] = near[KINS_X + i];
-    }
-    hexapod_rot_from_sc(o, sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]);
-}
-
-/* The planner's finite differences: the pose as hexapod_inverse does it, its neighbours'
- * legs from the same sines and cosines. */
-static int hexapod_inverse_near(struct kins *k, const double pose[KINS_POSE_DIM],
-                                const double pm[KINS_POSE_DIM], const double pp[KINS_POSE_DIM],
-                                double *joints, double *joints_m, double *joints_p)
+/* The planner's samples: the legs at a pose and their first and second derivatives along a
+ * path whose pose changes by dp and d2p per unit of path, exact (one evaluation instead of
+ * differencing three). With R = Rz(C) Ry(B) Rx(A), R' = [w]x R, where the angular velocity
+ * w = e_a A' + e_b B' + z C' (hexapod_rot's axes) and its rate
+ *     w' = e_a A'' + e_b B'' + z C'' + B' C' (z x e_b) + A' (C' z + B' e_b) x e_a
+ * (e_b = Rz y turns with C, e_a = Rz Ry x with B and C). A leg v = t + R p - b then has
+ *     v' = t' + w x Rp,   v'' = t'' + w' x Rp + w x (w x Rp),
+ *     L' = u . v',        L'' = (|v'|^2 - L'^2) / L + u . v''. */
+static int hexapod_inverse_path(struct kins *k, const double pose[KINS_POSE_DIM],
+                                const double dp[KINS_POSE_DIM], const double d2p[KINS_POSE_DIM],
+                                double *joints, double *dL, double *d2L)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3], sc[6];
+    double t[3];
     struct hexapod_rot o;
     struct hexapod_legs lg;
     for (int j = 0; j < KINS_POSE_DIM; j++)
-        if (!isfinite(pose[j]) || !isfinite(pm[j]) || !isfinite(pp[j]))
+        if (!isfinite(dp[j]) || !isfinite(d2p[j]))
             return KINS_ERR_ARG;
-    for (int i = 0; i < 3; i++) {
-        sincos(pose[KINS_A + i] * HEXAPOD_RAD_PER_DEG, &sc[2 * i], &sc[2 * i + 1]);
-        t[i] = pose[KINS_X + i];
-    }
-    hexapod_rot_from_sc(&o, sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]);
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
     hexapod_legs_eval(h, t, &o, &lg);
     int st = joints_checked(k, pose, &o, &lg, joints);
-    struct hexapod_rot on;
-    struct hexapod_legs ln;
-    double tn[3];
-    rot_near(pose, pm, sc, tn, &on);
-    hexapod_legs_eval(h, tn, &on, &ln);
-    hexapod_lengths_of(k, &ln, joints_m);
-    rot_near(pose, pp, sc, tn, &on);
-    hexapod_legs_eval(h, tn, &on, &ln);
-    hexapod_lengths_of(k, &ln, joints_p);
+    const double z[3] = { 0, 0, 1 };
+    double a1 = dp[KINS_A] * HEXAPOD_RAD_PER_DEG, b1 = dp[KINS_B] * HEXAPOD_RAD_PER_DEG;
+    double c1 = dp[KINS_C] * HEXAPOD_RAD_PER_DEG, a2 = d2p[KINS_A] * HEXAPOD_RAD_PER_DEG;
+    double b2 = d2p[KINS_B] * HEXAPOD_RAD_PER_DEG, c2 = d2p[KINS_C] * HEXAPOD_RAD_PER_DEG;
+    double w[3], wd[3], zeb[3], spin[3], spin_ea[3];
+    cross3(z, o.e_b, zeb);
+    for (int j = 0; j < 3; j++)
+        spin[j] = c1 * z[j] + b1 * o.e_b[j];
+    cross3(spin, o.e_a, spin_ea);
+    for (int j = 0; j < 3; j++) {
+        w[j] = a1 * o.e_a[j] + b1 * o.e_b[j] + c1 * z[j];
+        wd[j] = a2 * o.e_a[j] + b2 * o.e_b[j] + c2 * z[j] + b1 * c1 * zeb[j] + a1 * spin_ea[j];
+    }
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        double wr[3], wwr[3], wdr[3], v1[3], v2[3];
+        cross3(w, lg.rp_mm[i], wr);
+        cross3(w, wr, wwr);
+        cross3(wd, lg.rp_mm[i], wdr);
+        for (int j = 0; j < 3; j++) {
+            v1[j] = dp[KINS_X + j] + wr[j];
+            v2[j] = d2p[KINS_X + j] + wdr[j] + wwr[j];
+        }
+        const double *u = lg.u[i];
+        double l1 = u[0] * v1[0] + u[1] * v1[1] + u[2] * v1[2];
+        double vv = v1[0] * v1[0] + v1[1] * v1[1] + v1[2] * v1[2];
+        dL[i] = l1;
+        d2L[i] = (vv - l1 * l1) / lg.len_mm[i] + u[0] * v2[0] + u[1] * v2[1] + u[2] * v2[2];
+    }
     return st;
 }
 
@@ -375,7 +376,7 @@ const struct kins_ops kins_hexapod_ops = {
     .check = hexapod_check,
     .tool_point = hexapod_tool_point,
     .inverse_rates = hexapod_inverse_rates,
-    .inverse_near = hexapod_inverse_near,
+    .inverse_path = hexapod_inverse_path,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

@@ -102,12 +102,13 @@ struct kins_ops {
     /* Optional: where the tool is (for tool centre point control). NULL: the model has no
      * tool, and G43.4 is refused on it. */
     int (*tool_frame)(struct kins *k, struct kins_tool_frame *out);
-    /* Optional: joints at pose (statuses as inverse) and at two poses pm, pp near it (within
-     * a few hundredths of a mm and degree: the planner's finite differences), written
-     * whatever their reach. NULL: three calls of inverse. */
-    int (*inverse_near)(struct kins *k, const double pose[KINS_POSE_DIM],
-                        const double pm[KINS_POSE_DIM], const double pp[KINS_POSE_DIM],
-                        double *joints, double *joints_m, double *joints_p);
+    /* Optional: joints at pose (statuses as inverse) and their first and second
+     * derivatives along a path whose pose changes by dpose per unit of path and dpose by
+     * d2pose (mm, deg per unit; the planner's samples), exact; written whatever the reach.
+     * NULL: the planner differences three inverse solutions along the path. */
+    int (*inverse_path)(struct kins *k, const double pose[KINS_POSE_DIM],
+                        const double dpose[KINS_POSE_DIM], const double d2pose[KINS_POSE_DIM],
+                        double *joints, double *djoints, double *d2joints);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -164,17 +165,6 @@ static inline int kins_inverse_rates(struct kins *k, const double *pose, const d
         return k->ops->inverse_rates(k, pose, vel, joints, rates);
     int st = k->ops->inverse(k, pose, joints);
     return st == KINS_OK ? k->ops->leg_rates(k, pose, vel, rates) : st;
-}
-/* Joints at a pose and at two poses near it (kins_ops.inverse_near). */
-static inline int kins_inverse_near(struct kins *k, const double *pose, const double *pm,
-                                    const double *pp, double *joints, double *joints_m,
-                                    double *joints_p)
-{
-    if (k->ops->inverse_near)
-        return k->ops->inverse_near(k, pose, pm, pp, joints, joints_m, joints_p);
-    k->ops->inverse(k, pm, joints_m);
-    k->ops->inverse(k, pp, joints_p);
-    return k->ops->inverse(k, pose, joints);
 }
 static inline int kins_tool_point(struct kins *k, const double *pose, double *tip_base_mm,
                                   double *tip_platform_mm)

@@ -10,31 +10,27 @@
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
 #define FINE_SLACK 1e-9        /* relative: knots this much wider than fine_h are as close */
 
-/* Samples segment sg at s; returns the inverse kinematics status at s itself. */
+/* Samples segment sg at s; returns the inverse kinematics status at s itself. The pose and
+ * its derivatives are the path's own; the legs' come from the kinematics' exact ones where
+ * it has them, else (and under G43.4, whose tip-to-platform map is not the kinematics')
+ * by central differences of three inverse solutions FD_H apart. */
 static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
                      struct motion_sample *o)
 {
+    o->tcp = sg->tcp;
+    o->tool_len_mm = sg->tool_len_mm;
+    motion_seg_derivs(&m->plan, sg, s, o->pose, o->dp, o->d2p);
+    if (!sg->tcp && m->kins->ops->inverse_path)
+        return m->kins->ops->inverse_path(m->kins, o->pose, o->dp, o->d2p, o->L, o->dL, o->d2L);
     double h = FD_H, pm[KINS_POSE_DIM], pp[KINS_POSE_DIM];
     double Lm[KINS_MAX_JOINTS], Lp[KINS_MAX_JOINTS];
     if (sg->kind == SEG_ARC)
         h = fmin(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
-    o->tcp = sg->tcp;
-    o->tool_len_mm = sg->tool_len_mm;
-    motion_seg_pose(&m->plan, sg, s, o->pose);
     motion_seg_pose(&m->plan, sg, s - h, pm);
     motion_seg_pose(&m->plan, sg, s + h, pp);
-    int st;
-    if (sg->tcp) {
-        st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
-        motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pm, Lm); /* written even out of range */
-        motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pp, Lp);
-    } else {
-        st = kins_inverse_near(m->kins, o->pose, pm, pp, o->L, Lm, Lp);
-    }
-    for (int i = 0; i < KINS_POSE_DIM; i++) {
-        o->dp[i] = (pp[i] - pm[i]) / (2 * h);
-        o->d2p[i] = (pp[i] - 2 * o->pose[i] + pm[i]) / (h * h);
-    }
+    int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
+    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pm, Lm); /* written even out of range */
+    motion_path_inverse(m, sg->tcp, sg->tool_len_mm, pp, Lp);
     for (int i = 0; i < m->nj; i++) {
         o->dL[i] = (Lp[i] - Lm[i]) / (2 * h);
         o->d2L[i] = (Lp[i] - 2 * o->L[i] + Lm[i]) / (h * h);

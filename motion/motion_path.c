@@ -84,6 +84,39 @@ void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg
     }
 }
 
+/* Pose at s and its first and second derivatives along the path (per unit of s), analytic:
+ * what the planner samples through the kinematics (one sine and cosine for all three). */
+void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                       double pose[KINS_POSE_DIM], double dp[KINS_POSE_DIM],
+                       double d2p[KINS_POSE_DIM])
+{
+    double il = sg->len > 0 ? 1.0 / sg->len : 0.0, u = s * il;
+    for (int i = 0; i < KINS_POSE_DIM; i++) {
+        pose[i] = sg->start[i] + u * (sg->end[i] - sg->start[i]);
+        dp[i] = (sg->end[i] - sg->start[i]) * il;
+        d2p[i] = 0;
+    }
+    if (sg->kind != SEG_ARC)
+        return;
+    const struct motion_arc *a = &p->arcs[sg->arc];
+    double th = a->sweep_rad, ang = th * u, r = a->r0_mm + a->dr_mm * u;
+    double h = a->h0_mm + a->dh_mm * u, c, sn;
+    sincos(ang, &sn, &c);
+    for (int i = 0; i < 3; i++) {
+        double radial = c * a->e1[i] + sn * a->e2[i], along = -sn * a->e1[i] + c * a->e2[i];
+        pose[i] = a->center[i] + r * radial + h * a->n[i];
+        dp[i] = il * (a->dr_mm * radial + r * th * along + a->dh_mm * a->n[i]);
+        d2p[i] = il * il * (2 * a->dr_mm * th * along - r * th * th * radial);
+    }
+    if (a->abc_cubic) {
+        abc_cubic(sg, a, u, 0, pose + 3);
+        abc_cubic(sg, a, u, 1, dp + 3);
+        abc_cubic(sg, a, u, 2, d2p + 3);
+        for (int k = 3; k < 6; k++)
+            dp[k] *= il, d2p[k] *= il * il;
+    }
+}
+
 /* The file name, copied once per distinct name so the plan owns it. */
 static const char *intern_file(struct motion_plan *p, const char *name)
 {

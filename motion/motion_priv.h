@@ -326,6 +326,10 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
 /* d pose / ds at s (mm or deg per unit of s). */
 void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg, double s,
                         double dp[KINS_POSE_DIM]);
+/* Pose at s with its first and second derivatives along the path (per unit of s). */
+void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg, double s,
+                       double pose[KINS_POSE_DIM], double dp[KINS_POSE_DIM],
+                       double d2p[KINS_POSE_DIM]);
 /* abc: NULL, or one entry per command of prog marking G64 blend arcs (motion_blend.h). */
 struct motion_blend_abc;
 int motion_path_build(struct motion *m, const struct canon_prog *prog,

@@ -1,5 +1,5 @@
 /* test_kins_shortcuts.c: the kinematics' fast paths against the plain computations: the
- * condition number from the Gram matrix, the legs of the planner's finite differences. */
+ * condition number from the Gram matrix, the legs' exact derivatives along a path. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -25,41 +25,68 @@ static struct kins *make_tmu(void)
     return k;
 }
 
-/* The planner's finite differences: the legs of two poses near one, from that pose's sines
- * and cosines, equal the plain inverse of each (series and library angles alike). */
-START_TEST(test_inverse_near)
+/* A path through a pose: p(s) = pose + s dp + s^2 d2p / 2 (mm, deg). */
+static void path_at(const double pose[6], const double dp[6], const double d2p[6], double s,
+                    double out[6])
+{
+    for (int i = 0; i < 6; i++)
+        out[i] = pose[i] + s * dp[i] + 0.5 * s * s * d2p[i];
+}
+
+/* The planner's samples: the legs' exact first and second derivatives along a path equal
+ * Richardson-extrapolated central differences of the plain inverse (errors h^4), for a dense
+ * five-axis block, a rotary-only move, a blend arc's bend and A B C cubic, and a pose turned
+ * far in every angle (the axes e_a, e_b then matter). */
+START_TEST(test_inverse_path)
 {
     struct kins *k = make_tmu();
-    const double base[6] = { 12.5, -30.25, 640, 4.5, -6.25, 9 };
-    const double steps[3][6] = {
-        { 0.05, -0.02, 0.01, 0.0042, -0.003, 0.002 },   /* along a dense five-axis block */
-        { 0, 0, 0, 0.05, 0.05, -0.05 },                 /* a rotary-only move's 0.05 deg */
-        { 0.3, 0.1, -0.2, 1.5, -0.9, 2 },               /* past the series: the library's */
+    const double base[4][6] = {
+        { 12.5, -30.25, 640, 4.5, -6.25, 9 }, { 0, 0, 645, 0, 0, 0 },
+        { -40, 25, 650, 2, 3, -4 }, { 30, 20, 630, 14, -11, 35 },
     };
-    for (int c = 0; c < 3; c++) {
-        double pm[6], pp[6], L[6], Lm[6], Lp[6], R[6], Rm[6], Rp[6];
-        for (int i = 0; i < 6; i++)
-            pm[i] = base[i] - steps[c][i], pp[i] = base[i] + steps[c][i];
-        ck_assert_int_eq(kins_inverse_near(k, base, pm, pp, L, Lm, Lp), KINS_OK);
-        ck_assert_int_eq(kins_inverse(k, base, R), KINS_OK);
-        ck_assert_int_eq(kins_inverse(k, pm, Rm), KINS_OK);
-        ck_assert_int_eq(kins_inverse(k, pp, Rp), KINS_OK);
+    const double dp[4][6] = {
+        { 0.8, -0.6, 0.02, 0.0084, -0.006, 0.004 },     /* per mm along a dense block */
+        { 0, 0, 0, 0.6, 0.64, 0.48 },                    /* rotary only: per deg */
+        { 0.6, 0.8, 0, 0.01, -0.02, 0.03 },              /* a blend arc */
+        { -0.3, 0.9, 0.3, 1.5, -2, 2.5 },
+    };
+    const double d2p[4][6] = {
+        { 0 }, { 0 },
+        { -0.48, 0.36, 0, 0.004, 0.002, -0.006 },        /* bend of radius 1.67 mm */
+        { 0.2, 0.1, -0.3, 0.7, 0.5, -0.9 },
+    };
+    for (int c = 0; c < 4; c++) {
+        double L[6], dL[6], d2L[6], R0[6], d1[2][6], d2[2][6];
+        ck_assert_int_eq(k->ops->inverse_path(k, base[c], dp[c], d2p[c], L, dL, d2L), KINS_OK);
+        ck_assert_int_eq(kins_inverse(k, base[c], R0), KINS_OK);
+        for (int e = 0; e < 2; e++) {        /* steps h and h / 2 */
+            double h = e ? 0.01 : 0.02, pm[6], pp[6], Lm[6], Lp[6];
+            path_at(base[c], dp[c], d2p[c], -h, pm);
+            path_at(base[c], dp[c], d2p[c], h, pp);
+            kins_inverse(k, pm, Lm);
+            kins_inverse(k, pp, Lp);
+            for (int i = 0; i < 6; i++) {
+                d1[e][i] = (Lp[i] - Lm[i]) / (2 * h);
+                d2[e][i] = (Lp[i] - 2 * R0[i] + Lm[i]) / (h * h);
+            }
+        }
         for (int i = 0; i < 6; i++) {
-            ck_assert_double_eq_tol(L[i], R[i], 1e-12);
-            ck_assert_double_eq_tol(Lm[i], Rm[i], 1e-11);
-            ck_assert_double_eq_tol(Lp[i], Rp[i], 1e-11);
+            ck_assert_double_eq(L[i], R0[i]);
+            double r1 = (4 * d1[1][i] - d1[0][i]) / 3, r2 = (4 * d2[1][i] - d2[0][i]) / 3;
+            ck_assert_msg(fabs(dL[i] - r1) < 1e-8, "case %d leg %d: dL %.12g, differenced "
+                          "%.12g", c, i, dL[i], r1);
+            ck_assert_msg(fabs(d2L[i] - r2) < 1e-5 * (1 + fabs(r2)), "case %d leg %d: d2L "
+                          "%.12g, differenced %.12g", c, i, d2L[i], r2);
         }
     }
-    /* out of reach: the status is the pose's, the neighbours' legs are written all the same */
-    double far[6] = { 0, 0, 1200, 0, 0, 0 }, fm[6], fp[6], L[6], Lm[6], Lp[6], R[6];
+    /* out of reach: the status is the pose's, the derivatives are written all the same */
+    const double far[6] = { 0, 0, 1200, 0, 0, 0 }, z[6] = { 0 }, up[6] = { 0, 0, 1, 0, 0, 0 };
+    double L[6], dL[6] = { 0 }, d2L[6];
+    ck_assert_int_eq(k->ops->inverse_path(k, far, up, z, L, dL, d2L), KINS_ERR_UNREACHABLE);
     for (int i = 0; i < 6; i++)
-        fm[i] = far[i] - 0.01, fp[i] = far[i] + 0.01;
-    ck_assert_int_eq(kins_inverse_near(k, far, fm, fp, L, Lm, Lp), KINS_ERR_UNREACHABLE);
-    kins_inverse(k, fp, R);
-    for (int i = 0; i < 6; i++)
-        ck_assert_double_eq_tol(Lp[i], R[i], 1e-11);
+        ck_assert(dL[i] > 0.5);              /* every leg lengthens as the platform rises */
     const double bad[6] = { 0, 0, NAN, 0, 0, 0 };
-    ck_assert_int_eq(kins_inverse_near(k, base, bad, base, L, Lm, Lp), KINS_ERR_ARG);
+    ck_assert_int_eq(k->ops->inverse_path(k, base[0], bad, z, L, dL, d2L), KINS_ERR_ARG);
     kins_free(k);
 }
 END_TEST
@@ -117,7 +144,7 @@ int main(void)
     Suite *s = suite_create("kins_shortcuts");
     TCase *tc = tcase_create("shortcuts");
     tcase_add_test(tc, test_condition_number);
-    tcase_add_test(tc, test_inverse_near);
+    tcase_add_test(tc, test_inverse_path);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
