@@ -10,6 +10,11 @@
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
 #define FINE_SLACK 1e-9        /* relative: knots this much wider than fine_h are as close */
 
+/* fmin and fmax as the C library defines them (a NaN argument loses), inline: the caps take
+ * a few dozen per knot, and the library's are calls. */
+static inline double min2(double a, double b) { return a < b ? a : b == b ? b : a; }
+static inline double max2(double a, double b) { return a > b ? a : b == b ? b : a; }
+
 /* Samples segment sg at s; returns the inverse kinematics status at s itself. The pose and
  * its derivatives are the path's own; the legs' come from the kinematics' exact ones where
  * it has them, else (and under G43.4, whose tip-to-platform map is not the kinematics')
@@ -19,13 +24,14 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
 {
     o->tcp = sg->tcp;
     o->tool_len_mm = sg->tool_len_mm;
+    o->q_state = 0;
     motion_seg_derivs(&m->plan, sg, s, o->pose, o->dp, o->d2p);
     if (!sg->tcp && m->kins->ops->inverse_path)
         return m->kins->ops->inverse_path(m->kins, o->pose, o->dp, o->d2p, o->L, o->dL, o->d2L);
     double h = FD_H, pm[KINS_POSE_DIM], pp[KINS_POSE_DIM];
     double Lm[KINS_MAX_JOINTS], Lp[KINS_MAX_JOINTS];
     if (sg->kind == SEG_ARC)
-        h = fmin(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
+        h = min2(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
     motion_seg_pose(&m->plan, sg, s - h, pm);
     motion_seg_pose(&m->plan, sg, s + h, pp);
     int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
@@ -98,16 +104,23 @@ static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S
 }
 
 /* q = J^-1 d2L at a sample: the pose's second derivative along the path as the legs see
- * it (the path's own, d2p, plus the kinematics' bending). -1 when J is singular. */
-static int pose_curvature(struct motion *m, const struct motion_sample *S, double q[6])
+ * it (the path's own, d2p, plus the kinematics' bending), into S->q once per sample. -1
+ * when J is singular. */
+static int pose_curvature(struct motion *m, struct motion_sample *S)
 {
-    if (jacobian_inverse_near(m, S) < 0)
+    if (S->q_state)
+        return S->q_state > 0 ? 0 : -1;
+    if (jacobian_inverse_near(m, S) < 0) {
+        S->q_state = -1;
         return -1;
-    for (int i = 0; i < 6; i++) {
-        q[i] = 0;
-        for (int j = 0; j < 6; j++)
-            q[i] += m->jc_Jinv[i][j] * S->d2L[j];
     }
+    for (int i = 0; i < 6; i++) {
+        double qi = 0;
+        for (int j = 0; j < 6; j++)
+            qi += m->jc_Jinv[i][j] * S->d2L[j];
+        S->q[i] = qi;
+    }
+    S->q_state = 1;
     return 0;
 }
 
@@ -124,7 +137,7 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
     for (int i = 0; i < 3; i++)
         perp2 += (q[i] - shift * S->dp[i]) * (q[i] - shift * S->dp[i]);
     for (int i = 3; i < 6; i++)
-        ang = fmax(ang, fabs(q[i] - shift * S->dp[i]));
+        ang = max2(ang, fabs(q[i] - shift * S->dp[i]));
     *perp_mm = sqrt(perp2);
     *ang_deg = ang;
 }
@@ -142,19 +155,19 @@ static double setpoint_period(const struct motion_config *c)
  * only a timing shift) must stay within KINEMATIC_TOLERANCE: d <= sqrt(8 tol / |q_perp|),
  * v <= d / T. Returns HUGE_VAL when no cap applies, -1 when J is singular. */
 static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
-                          const struct motion_sample *S)
+                          struct motion_sample *S)
 {
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0 || m->nj != 6)
         return HUGE_VAL;
-    double q[6], perp, ang, dmax = HUGE_VAL;
-    if (pose_curvature(m, S, q) < 0)
+    double perp, ang, dmax = HUGE_VAL;
+    if (pose_curvature(m, S) < 0)
         return -1;
-    across_path(sg, S, q, &perp, &ang);
+    across_path(sg, S, S->q, &perp, &ang);
     if (perp > 1e-15)
         dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
-        dmax = fmin(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
+        dmax = min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
     return dmax / setpoint_period(c);
 }
 
@@ -174,20 +187,28 @@ double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
         return HUGE_VAL;
     double qk[6] = {0}, perp = 0, ang = 0, tol = KIN_TOL_SHARE * c->kin_tol_mm;
     if (m->nj == 6) {
-        if (pose_curvature(m, S, qk) < 0)
+        struct motion_sample T;       /* a sample whose q was not taken yet (not the planner's
+                                       * knots: motion_knot_caps takes it) */
+        const struct motion_sample *Q = S;
+        if (!S->q_state) {
+            T = *S;
+            pose_curvature(m, &T);
+            Q = &T;
+        }
+        if (Q->q_state < 0)
             return -1;
         for (int i = 0; i < 6; i++)
-            qk[i] -= S->d2p[i];
+            qk[i] = Q->q[i] - S->d2p[i];
         across_path(sg, S, qk, &perp, &ang);
     }
     double d = HUGE_VAL;
     if (k_mm + perp > 1e-15) {
-        double d0 = sqrt(8 * tol / (k_mm + perp)), x = fmin(1.0, k_mm * d0 / 2);
+        double d0 = sqrt(8 * tol / (k_mm + perp)), x = min2(1.0, k_mm * d0 / 2);
         double f = 2 / (1 + sqrt(1 - x * x));
         d = sqrt(8 * tol / (k_mm * f + perp));
     }
     if (c->kin_tol_deg > 0 && kabc + ang > 1e-30)
-        d = fmin(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
+        d = min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
     return d / setpoint_period(c);
 }
 
@@ -254,11 +275,11 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
         if (d1 > 1e-12) {
-            *vl = fmin(*vl, c->joint[i].max_vel_mm_s / d1);
-            *am = fmin(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
+            *vl = min2(*vl, c->joint[i].max_vel_mm_s / d1);
+            *am = min2(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
-            *vl = fmin(*vl, sqrt((1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2)));
+            *vl = min2(*vl, sqrt((1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2)));
     }
 }
 
@@ -277,7 +298,7 @@ static double leg_acc_at_speed(const struct motion *m, const struct motion_sampl
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, aL = c->joint[i].max_acc_mm_s2;
         if (d1 > 1e-12)
-            am = fmin(am, fmax(LEG_ACC_SPLIT * aL, aL - 1.2 * fabs(S->d2L[i]) * vh * vh) / d1);
+            am = min2(am, max2(LEG_ACC_SPLIT * aL, aL - 1.2 * fabs(S->d2L[i]) * vh * vh) / d1);
     }
     return am;
 }
@@ -292,15 +313,15 @@ static void machine_caps(const struct motion *m, const struct motion_seg *sg,
     *vm = sg->rotary ? HUGE_VAL : c->max_lin_vel_mm_s;
     *am = sg->rotary ? HUGE_VAL : c->max_lin_acc_mm_s2;
     for (int i = 3; i < 6; i++)
-        w = fmax(w, fabs(S->dp[i]));
+        w = max2(w, fabs(S->dp[i]));
     if (w > 1e-12) {
-        *vm = fmin(*vm, c->max_ang_vel_deg_s / w);
-        *am = fmin(*am, c->max_ang_acc_deg_s2 / w);
+        *vm = min2(*vm, c->max_ang_vel_deg_s / w);
+        *am = min2(*am, c->max_ang_acc_deg_s2 / w);
     }
     if (sg->kind == SEG_ARC) {
         const struct motion_arc *a = &m->plan.arcs[sg->arc];
-        double r = fmin(a->r0_mm, a->r0_mm + a->dr_mm);
-        *vm = fmin(*vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
+        double r = min2(a->r0_mm, a->r0_mm + a->dr_mm);
+        *vm = min2(*vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
         *am *= sqrt(1 - ARC_NORMAL_SHARE * ARC_NORMAL_SHARE);
     }
 }
@@ -334,7 +355,7 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
         if (st)
             return st;
         leg_caps(m, &T, h, &v, am);
-        *vl = fmin(*vl, v);
+        *vl = min2(*vl, v);
     }
     return MOTION_OK;
 }
@@ -359,10 +380,10 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
                                 * for the bend (abc'' v^2), half for the path's (abc' a) */
         double w = 0;
         for (int i = 3; i < 6; i++)
-            w = fmax(w, fabs(S->dp[i]));
-        vm = fmin(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
+            w = max2(w, fabs(S->dp[i]));
+        vm = min2(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
         if (w > 1e-12)
-            am = fmin(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
+            am = min2(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
     }
     double am_machine = am;
     leg_caps(m, S, h, &vl, &am);
@@ -377,15 +398,15 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
         return MOTION_ERR_KINS;
     }
     double feed = sg->feed > 0 ? sg->feed : HUGE_VAL;
-    double soft = fmin(feed, vm);
+    double soft = min2(feed, vm);
     if (vl < soft)
         m->plan.info.limited_by_legs++;
-    if (vk < fmin(soft, vl))
+    if (vk < min2(soft, vl))
         m->plan.info.limited_by_kin_tol++;
-    *hard = fmin(fmin(vm, vl), vk);
-    *cap = fmin(*hard, feed);
+    *hard = min2(min2(vm, vl), vk);
+    *cap = min2(*hard, feed);
     if (h >= hs)               /* the legs' share for the path, now the speed is known */
-        am = fmin(am_machine, leg_acc_at_speed(m, S, h, *hard));
+        am = min2(am_machine, leg_acc_at_speed(m, S, h, *hard));
     *acc = am;
     return MOTION_OK;
 }
@@ -408,17 +429,17 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
         dx += (B.dp[i] - A.dp[i]) * (B.dp[i] - A.dp[i]);
     dx = sqrt(dx);
     for (int i = 3; i < 6; i++)
-        da = fmax(da, fabs(B.dp[i] - A.dp[i]));
+        da = max2(da, fabs(B.dp[i] - A.dp[i]));
     if (dx > 1e-12) {
-        v = fmin(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
-        v = fmin(v, 4 * a->blend_tol_mm / (Ts * dx));
+        v = min2(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
+        v = min2(v, 4 * a->blend_tol_mm / (Ts * dx));
     }
     if (da > 1e-12)
-        v = fmin(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
+        v = min2(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
     for (int i = 0; i < m->nj; i++) {
         double dl = fabs(B.dL[i] - A.dL[i]);
         if (dl > 1e-12)
-            v = fmin(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
+            v = min2(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
     }
     return v;
 }
@@ -437,8 +458,8 @@ double motion_junction_share(const struct motion *m, const struct motion_sample 
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     f = v * sqrt(dx) / (c->max_lin_acc_mm_s2 * T);
     for (int i = 3; i < 6; i++)
-        f = fmax(f, v * fabs(B->dp[i] - A->dp[i]) / (c->max_ang_acc_deg_s2 * T));
+        f = max2(f, v * fabs(B->dp[i] - A->dp[i]) / (c->max_ang_acc_deg_s2 * T));
     for (int i = 0; i < m->nj; i++)
-        f = fmax(f, v * fabs(B->dL[i] - A->dL[i]) / (0.5 * c->joint[i].max_acc_mm_s2 * T));
-    return fmin(f, JUMP_SHARE);
+        f = max2(f, v * fabs(B->dL[i] - A->dL[i]) / (0.5 * c->joint[i].max_acc_mm_s2 * T));
+    return min2(f, JUMP_SHARE);
 }

@@ -360,6 +360,9 @@ struct motion_sample {
     double tool_len_mm;
     double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
     double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
+    int q_state;             /* q below: 0 not yet taken, 1 taken, -1 the Jacobian is singular */
+    double q[KINS_POSE_DIM]; /* the pose's curvature as the legs see it, J^-1 d2L (the
+                              * kinematic-error and chord caps both use it: taken once) */
 };
 
 /* Whether the operator asked to stop planning; if so err says where (motion_caps.c). */
