@@ -61,8 +61,10 @@ void check_move_pose(const double from[KINS_POSE_DIM], const struct canon_cmd *c
     struct arc_geom g;
     arc_geom(from, c, &g);
     double a = g.sweep_rad * u, r = g.r0 + u * (g.r1 - g.r0), h = g.h0 + u * (g.h1 - g.h0);
+    double sa, ca;
+    sincos(a, &sa, &ca);       /* one call, the values of sin() and cos() */
     for (int i = 0; i < 3; i++)
-        pose[i] = g.c[i] + r * (cos(a) * g.e1[i] + sin(a) * g.e2[i]) + h * g.n[i];
+        pose[i] = g.c[i] + r * (ca * g.e1[i] + sa * g.e2[i]) + h * g.n[i];
 }
 
 /* Samples needed on a move: by XYZ length (arc length for arcs) and by A B C change. */

@@ -9,8 +9,10 @@
 /* R = Rz(C) Ry(B) Rx(A), row-major. */
 static void rot(const double abc[3], double r[3][3])
 {
-    double ca = cos(abc[0] * DEG), sa = sin(abc[0] * DEG), cb = cos(abc[1] * DEG);
-    double sb = sin(abc[1] * DEG), cc = cos(abc[2] * DEG), sc = sin(abc[2] * DEG);
+    double ca, sa, cb, sb, cc, sc;     /* (sincos: the values of sin() and cos(), one call) */
+    sincos(abc[0] * DEG, &sa, &ca);
+    sincos(abc[1] * DEG, &sb, &cb);
+    sincos(abc[2] * DEG, &sc, &cc);
     r[0][0] = cc * cb, r[0][1] = cc * sb * sa - sc * ca, r[0][2] = cc * sb * ca + sc * sa;
     r[1][0] = sc * cb, r[1][1] = sc * sb * sa + cc * ca, r[1][2] = sc * sb * ca - cc * sa;
     r[2][0] = -sb, r[2][1] = cb * sa, r[2][2] = cb * ca;
@@ -59,8 +61,9 @@ void kins_tcp_to_pose(const struct kins_tool_frame *f, double len_mm,
  * w = C' z + B' Rz(C) y + A' Rz(C) Ry(B) x. */
 static void omega(const double abc[3], const double rate[3], double w[3])
 {
-    double cb = cos(abc[1] * DEG), sb = sin(abc[1] * DEG);
-    double cc = cos(abc[2] * DEG), sc = sin(abc[2] * DEG);
+    double cb, sb, cc, sc;
+    sincos(abc[1] * DEG, &sb, &cb);
+    sincos(abc[2] * DEG, &sc, &cc);
     double a = rate[0] * DEG, b = rate[1] * DEG, c = rate[2] * DEG;
     w[0] = -sc * b + cc * cb * a;
     w[1] = cc * b + sc * cb * a;

@@ -56,7 +56,8 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
         return;
     const struct motion_arc *a = &p->arcs[sg->arc];
     double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, h = a->h0_mm + a->dh_mm * u;
-    double c = cos(ang), sn = sin(ang);
+    double c, sn;
+    sincos(ang, &sn, &c);      /* one call, the values of sin() and cos() (a servo period's) */
     for (int i = 0; i < 3; i++)
         pose[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
     if (a->abc_cubic)
@@ -73,7 +74,8 @@ void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg
     if (sg->kind != SEG_ARC)
         return;
     const struct motion_arc *a = &p->arcs[sg->arc];
-    double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, c = cos(ang), sn = sin(ang);
+    double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, c, sn;
+    sincos(ang, &sn, &c);
     for (int i = 0; i < 3; i++)
         dp[i] = il * (a->dr_mm * (c * a->e1[i] + sn * a->e2[i])
                       + r * a->sweep_rad * (-sn * a->e1[i] + c * a->e2[i]) + a->dh_mm * a->n[i]);
