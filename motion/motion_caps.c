@@ -271,6 +271,8 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
                      double *vl, double *am)
 {
     const struct motion_config *c = &m->cfg;
+    double v2 = HUGE_VAL;      /* the curvature terms' speed, squared: one square root for
+                                * all legs (it is monotonic, so the smallest root is exact) */
     *vl = HUGE_VAL;
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
@@ -279,8 +281,10 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
             *am = min2(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
-            *vl = min2(*vl, sqrt((1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2)));
+            v2 = min2(v2, (1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2));
     }
+    if (v2 < HUGE_VAL)
+        *vl = min2(*vl, sqrt(v2));
 }
 
 /* The path acceleration the legs allow at a knot once its speed is known to stay within vh
@@ -374,7 +378,9 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     int st = reach_check(m, sg, S, h, sample_at(m, sg, s, S), err, errlen);
     if (st)
         return st;
-    double vm, am, vl, kabc = motion_seg_abc_curvature(&m->plan, sg, s);
+    double vm, am, vl, kabc = 0;   /* |d2(A B C)/ds2|: the path's, 0 but on blend arcs */
+    for (int i = 3; i < 6; i++)
+        kabc = max2(kabc, fabs(S->d2p[i]));
     machine_caps(m, sg, S, &vm, &am);
     if (kabc > 1e-12) {        /* A B C bend along a blend arc: half the angular acceleration
                                 * for the bend (abc'' v^2), half for the path's (abc' a) */
@@ -422,14 +428,14 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     const struct motion_config *c = &m->cfg;
     if (a->blend_tol_mm <= 0 || a->rotary != b->rotary || a->kind > SEG_ARC || b->kind > SEG_ARC)
         return 0;
-    const struct motion_sample A = *Ap, B = *Bp;
+    const struct motion_sample *A = Ap, *B = Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
     double dx = 0, da = 0, v = HUGE_VAL;
     for (int i = 0; i < 3; i++)
-        dx += (B.dp[i] - A.dp[i]) * (B.dp[i] - A.dp[i]);
+        dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);
     for (int i = 3; i < 6; i++)
-        da = max2(da, fabs(B.dp[i] - A.dp[i]));
+        da = max2(da, fabs(B->dp[i] - A->dp[i]));
     if (dx > 1e-12) {
         v = min2(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
         v = min2(v, 4 * a->blend_tol_mm / (Ts * dx));
@@ -437,7 +443,7 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     if (da > 1e-12)
         v = min2(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
     for (int i = 0; i < m->nj; i++) {
-        double dl = fabs(B.dL[i] - A.dL[i]);
+        double dl = fabs(B->dL[i] - A->dL[i]);
         if (dl > 1e-12)
             v = min2(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
     }
