@@ -72,8 +72,9 @@ static void child(const char *ini, const char *prog, int whole, int fd)
         st = check_program(mc, prog, NULL, &r);
     }
     double wall = now_s() - t0;
-    int n = snprintf(line, sizeof line, "%d %.6f %.3f %ld %.4f\n", st, wall,
-                     r.machining_time_s, r.periods, r.max_condition);
+    int n = snprintf(line, sizeof line, "%d %.6f %.3f %ld %.4f %.3f %.3f\n", st, wall,
+                     r.machining_time_s, r.periods, r.max_condition, r.servo_cpu_s,
+                     r.plan_cpu_s);
     if (write(fd, line, (size_t)n) != n)
         _exit(1);
     check_result_free(&r);
@@ -107,14 +108,16 @@ static double run(const char *ini, const char *prog, int whole, const char *what
     }
     int st;
     long periods;
-    double wall, machining, cond;
+    double wall, machining, cond, servo_cpu, plan_cpu;
     buf[got] = 0;
-    if (sscanf(buf, "%d %lf %lf %ld %lf", &st, &wall, &machining, &periods, &cond) != 5)
+    if (sscanf(buf, "%d %lf %lf %ld %lf %lf %lf", &st, &wall, &machining, &periods, &cond,
+               &servo_cpu, &plan_cpu) != 7)
         return -1;
     double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
                  (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-    printf("%-34s %9.1f s %8.3f s %8.3f s %8.0fx %8.0fx %8.1f MB\n", what, machining, wall, cpu,
-           machining / wall, machining / cpu, (double)ru.ru_maxrss / 1024.0);
+    printf("%-34s %9.1f s %8.3f s %8.3f s %8.0fx %8.0fx %8.1f MB %8.3f s %8.3f s\n", what,
+           machining, wall, cpu, machining / wall, machining / cpu,
+           (double)ru.ru_maxrss / 1024.0, servo_cpu, plan_cpu);
     return wall;
 }
 
@@ -130,8 +133,10 @@ int main(void)
     printf("\ndense five-axis CAM code: %d blocks of %.1f mm, X Y Z A B C on every block, "
            "G64 P0.01, F2000, TMU machine, 1 kHz servo (%ld cores online)\n", BLOCKS, STEP_MM,
            sysconf(_SC_NPROCESSORS_ONLN));
-    printf("%-34s %11s %10s %10s %9s %9s %11s\n", "check", "machining", "wall", "CPU",
-           "x real", "x CPU", "peak mem");
+    printf("%-34s %11s %10s %10s %9s %9s %11s %10s %10s\n", "check", "machining", "wall",
+           "CPU", "x real", "x CPU", "peak mem", "servo CPU", "plan CPU");
+    printf("(servo CPU: the servo-rate pass's thread; plan CPU: the reach pass and the "
+           "planner, with the interpreter when streamed)\n");
     double s = run(ini, prog, 0, "streamed (hexcnc check)");
     double w = run(ini, prog, 1, "whole program in memory");
     if (s > 0 && w > 0)

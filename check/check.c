@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "check/check_priv.h"
 
@@ -124,6 +125,14 @@ void check_result_header(struct check_machine *mc, const struct check_opts *o,
     snprintf(r->config, sizeof r->config, "%s", mc->ini);
 }
 
+double check_thread_cpu_s(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
+        return 0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* Reach pass, plan, then the servo-rate pass. */
 int check_canon(struct check_machine *mc, const struct canon_prog *prog,
                 const struct check_opts *opts, struct check_result *r)
@@ -134,16 +143,21 @@ int check_canon(struct check_machine *mc, const struct canon_prog *prog,
         opts = &def;
     }
     check_result_header(mc, opts, r);
+    double t0 = check_thread_cpu_s();
     int reach = check_scan_reach(mc, prog, r);
     char msg[400];
-    if (motion_load(mc->motion, prog, msg, sizeof msg) != MOTION_OK) {
+    int loaded = motion_load(mc->motion, prog, msg, sizeof msg);
+    r->plan_cpu_s = check_thread_cpu_s() - t0;
+    if (loaded != MOTION_OK) {
         if (reach == 0)        /* the planner found what the reach pass did not: report it */
             check_add_plan_problem(r, msg, 0, -1);
         return CHECK_ERR_VIOLATION;
     }
     if (motion_start(mc->motion) != MOTION_OK)
         return CHECK_ERR_CONFIG;
+    t0 = check_thread_cpu_s();
     int st = check_simulate(mc, prog->start, opts, NULL, r);
+    r->servo_cpu_s = check_thread_cpu_s() - t0;
     r->simulated = 1;
     if (st != CHECK_OK)
         check_add_plan_problem(r, motion_last_error(mc->motion), 1, r->machining_time_s);

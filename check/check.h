@@ -124,6 +124,10 @@ struct check_result {
     double condition_limit;          /* [KINS] SINGULAR_CONDITION */
     long condition_evals;
     double deviation_every_s, condition_every_s; /* the schedule used */
+    double servo_cpu_s;              /* CPU time of the servo-rate pass's thread, s */
+    double plan_cpu_s;               /* CPU time of the reach pass and the planner, s (a
+                                      * streamed check: their thread's, the interpreter's
+                                      * too) */
 };
 void check_result_init(struct check_result *r);
 void check_result_free(struct check_result *r);

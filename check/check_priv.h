@@ -37,6 +37,9 @@ struct check_machine {
 #define CHECK_COND_STEP_MM 1.0
 #define CHECK_COND_STEP_DEG 0.5
 
+/* CPU time the calling thread has used, s (the check's per-thread figures). */
+double check_thread_cpu_s(void);
+
 /* Whether a canonical command moves the machine. */
 static inline int check_is_motion(enum canon_type t)
 {

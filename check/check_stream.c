@@ -33,6 +33,7 @@ struct producer {
     _Atomic int done;                /* the producer has ended */
     _Atomic int stop;                /* the servo pass has ended: plan no more (the reach
                                       * pass goes on), and wait for no chunk to be left */
+    double cpu_s;                    /* the thread's CPU time, once it has ended */
 };
 
 static void pause_us(long us)
@@ -81,6 +82,7 @@ static void *produce(void *arg)
                motion_stream_finish(p->ms) != MOTION_OK) {
         p->plan_status = MOTION_ERR_PROGRAM;
     }
+    p->cpu_s = check_thread_cpu_s();
     atomic_store(&p->ready, 1);
     atomic_store(&p->done, 1);
     return NULL;
@@ -194,9 +196,11 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         pause_us(100);
     struct check_feed feed = { feed_wait, feed_planned, p };
     int sim = CHECK_OK;
+    double t0 = check_thread_cpu_s();
     if (!p->plan_status && !p->interp_status)
         sim = motion_start(mc->motion) == MOTION_OK
                   ? check_simulate(mc, mc->kins->home, opts, &feed, r) : CHECK_ERR_CONFIG;
+    double servo_cpu_s = check_thread_cpu_s() - t0;
     atomic_store(&p->stop, 1);          /* (a servo pass cut short leaves chunks unread) */
     pthread_join(p->thread, NULL);
     if (p->plan_status || p->interp_status) {
@@ -208,6 +212,8 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         r->planned_time_s = si.plan.time_s;
         r->length_mm = si.plan.length_mm;
         r->simulated = 1;
+        r->servo_cpu_s = servo_cpu_s;
+        r->plan_cpu_s = p->cpu_s;
         st = merge_found(r, &p->found);
         if (!st && sim != CHECK_OK)
             st = check_add_plan_problem(r, motion_last_error(mc->motion), 1,
