@@ -8,6 +8,7 @@
 struct hal;
 struct tooltable;
 struct interp;
+struct check_defer;
 
 /* The machine of one INI: its reader, kinematics, motion and interpreter settings. */
 struct check_machine {
@@ -73,6 +74,8 @@ struct check_feed {
                                       * or 0 when no more will come (the pass stops) */
     double (*planned_s)(void *ctx);  /* the program's planned time once known, else < 0 */
     void *ctx;
+    struct check_defer *defer;       /* the measures' ring, which the planner's thread
+                                      * helps with (check_defer.h), or NULL: the pass's own */
 };
 
 /* Servo-rate pass through motion_step (the program must be loaded, or a stream attached,

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "check/check_defer.h"
 #include "check/check_priv.h"
 #include "check/plot.h"
 
@@ -40,12 +41,16 @@ struct sim {
     int blk_tip_line;
     const char *blk_tip_file;
     long trace_every, trace_count;
+    struct check_defer *dq;            /* the costly measures, applied in order */
 };
+
+static void drain(struct sim *s);
 
 /* Adds a leg limit problem (velocity or acceleration) at the current period. */
 static void leg_limit(struct sim *s, const struct motion_out *out, enum check_kind k, int leg,
                       double value, double limit)
 {
+    drain(s);                          /* the measures before it come first, as they came */
     double t_s = out->time_elapsed_s;
     struct check_problem p = { .kind = k, .line = out->line, .leg = leg, .value = value,
                                .limit = limit, .time_s = t_s, .count = 1 };
@@ -62,6 +67,7 @@ static void leg_limit(struct sim *s, const struct motion_out *out, enum check_ki
 /* A leg beyond its length range at this period. */
 static void leg_out_of_range(struct sim *s, const struct motion_out *out, int i, double L)
 {
+    drain(s);
     const struct check_leg *lg = &s->r->leg[i];
     struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = out->line, .leg = i,
                                .value = L, .time_s = out->time_elapsed_s, .count = 1 };
@@ -123,13 +129,20 @@ static void tip_flush(struct sim *s)
     s->blk_tip_max = 0;
 }
 
+/* The next slot of the ring for a measure of this kind (applying the oldest while it is
+ * full); fill it, then check_defer_commit. */
+static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind kind,
+                                         const struct motion_out *out);
+
 /* The straight feed being followed: its tip line (from the kinematics' tool at its ends, or
  * the programmed tip under G43.4), computed once per move. */
 static void tip_move(struct sim *s, const struct motion_out *out)
 {
     if (out->seg_kind != 1) {
-        if (s->tip_line)
-            tip_flush(s);
+        if (s->tip_line) {
+            slot_for(s, CHECK_DEFER_FLUSH, out);
+            check_defer_commit(s->dq);
+        }
         s->tip_line = 0;
         return;
     }
@@ -137,8 +150,10 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     if (s->tip_line && !memcmp(s->tip_key, out->seg_from, sizeof s->tip_key))
         return;
     s->tip_fresh = 1;
-    if (s->tip_line)
-        tip_flush(s);
+    if (s->tip_line) {
+        slot_for(s, CHECK_DEFER_FLUSH, out);
+        check_defer_commit(s->dq);
+    }
     s->tip_line = 1;
     memcpy(s->tip_key, out->seg_from, sizeof s->tip_key);
     if (out->tcp) {
@@ -151,21 +166,23 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     s->tip_swing = !out->tcp && (out->seg_from[3] != out->seg_to[3] ||
                                  out->seg_from[4] != out->seg_to[4] ||
                                  out->seg_from[5] != out->seg_to[5]);
-    s->blk_tip_line = out->line, s->blk_tip_file = out->file;
+    slot_for(s, CHECK_DEFER_MOVE, out);      /* the warning's line and file */
+    check_defer_commit(s->dq);
 }
 
-/* The tip's deviation d of this period from its move's line, into the figures. */
-static void tip_record(struct sim *s, const struct motion_out *out, double d)
+/* The tip's deviation d at program line `line`, into the figures. */
+static void tip_record(struct sim *s, int line, double d)
 {
     struct check_result *r = s->r;
     if (d > r->max_tip_deviation_mm)
-        r->max_tip_deviation_mm = d, r->max_tip_deviation_line = out->line;
+        r->max_tip_deviation_mm = d, r->max_tip_deviation_line = line;
     if (d > s->blk_tip_max)
         s->blk_tip_max = d;
 }
 
 /* Every period of a straight feed that turns A B C without G43.4: the commanded tip against
- * the line between the tip's positions at the move's ends. */
+ * the line between the tip's positions at the move's ends (applied in order with the
+ * deviations' tips, which measure the same move). */
 static void tip_period(struct sim *s, const struct motion_out *out)
 {
     tip_move(s, out);
@@ -173,73 +190,101 @@ static void tip_period(struct sim *s, const struct motion_out *out)
         return;
     double tip[3];
     tip_of(s, out, out->pose, tip);
-    tip_record(s, out, motion_dist_seg(tip, s->tip_t0, s->tip_t1));
+    struct check_defer_slot *q = slot_for(s, CHECK_DEFER_TIP, out);
+    q->value = motion_dist_seg(tip, s->tip_t0, s->tip_t1);
+    check_defer_commit(s->dq);
 }
 
-/* Kinematic deviation between the previous set point and this one: the legs at mid-chord
- * (where linear leg motion strays furthest) through the forward kinematics, distance from
- * the commanded chord. Returns the distance, mm, or -1 when the forward solve failed. */
-static double deviation(struct sim *s, const struct motion_out *out, double *ang_deg)
+/* Kinematic deviation between the previous set point and this one (check_defer.c computes
+ * it): the legs of both, the poses, and how the tip of the interpolated legs is measured. */
+static void deviation(struct sim *s, const struct motion_out *out)
 {
-    double Lm[KINS_MAX_JOINTS], P[KINS_POSE_DIM], d[3], n2 = 0, u = 0, e2 = 0;
-    for (int i = 0; i < s->nj; i++)
-        Lm[i] = 0.5 * (s->L0[i] + out->joint_pos[i]);
-    if (s->o->cold_forward)    /* the baseline: every solve from the home pose */
-        memcpy(P, s->mc->kins->home, sizeof P);
-    else                       /* warm: the commanded chord's midpoint is within the
-                                * deviation (um) of the answer, so one Newton step does */
-        for (int i = 0; i < KINS_POSE_DIM; i++)
-            P[i] = 0.5 * (s->p0[i] + out->pose[i]);
-    if (kins_forward(s->mc->kins, Lm, P, NULL) != KINS_OK)
-        return -1;
-    s->r->deviation_evals++;
-    for (int i = 0; i < 3; i++)
-        d[i] = out->pose[i] - s->p0[i], n2 += d[i] * d[i];
-    for (int i = 0; i < 3; i++)
-        u += (P[i] - s->p0[i]) * d[i];
-    u = n2 > 1e-24 ? u / n2 : 0.5;
-    for (int i = 0; i < 3; i++)
-        e2 += (P[i] - s->p0[i] - u * d[i]) * (P[i] - s->p0[i] - u * d[i]);
-    *ang_deg = 0;
-    for (int i = 3; i < 6; i++)
-        *ang_deg = fmax(*ang_deg, fabs(P[i] - s->p0[i] - u * (out->pose[i] - s->p0[i])));
-    if (s->have_tf) {   /* the tip of the interpolated legs: from its move's line, or (arcs,
-                         * rapids) from the chord between the tips of the two set points */
-        double tm[3], t0[3], t1[3];
-        tip_of(s, out, P, tm);
-        if (s->tip_line && !s->tip_fresh) {
-            tip_record(s, out, motion_dist_seg(tm, s->tip_t0, s->tip_t1));
-        } else if (out->seg_kind) {
-            tip_of(s, out, s->p0, t0);
-            tip_of(s, out, out->pose, t1);
-            tip_record(s, out, motion_dist_seg(tm, t0, t1));
-        }
+    struct check_defer_slot *q = slot_for(s, CHECK_DEFER_DEVIATION, out);
+    memcpy(q->p0, s->p0, sizeof q->p0);
+    memcpy(q->L0, s->L0, sizeof q->L0);
+    memcpy(q->L1, out->joint_pos, sizeof q->L1);
+    q->tool_len_mm = out->tcp ? out->tool_len_mm : s->tf.length_mm;
+    q->tip_mode = CHECK_TIP_NONE;
+    if (s->have_tf && s->tip_line && !s->tip_fresh) {
+        q->tip_mode = CHECK_TIP_LINE;        /* from its move's line, or (arcs, rapids) from */
+        memcpy(q->t0, s->tip_t0, sizeof q->t0);   /* the chord between the set points' tips */
+        memcpy(q->t1, s->tip_t1, sizeof q->t1);
+    } else if (s->have_tf && out->seg_kind) {
+        q->tip_mode = CHECK_TIP_CHORD;
     }
-    return sqrt(e2);
+    check_defer_commit(s->dq);
 }
 
-/* Condition number of the pose against [KINS] SINGULAR_CONDITION. */
-static void singularity(struct sim *s, const struct motion_out *out)
+/* A deviation's result, in order. */
+static void deviation_result(struct sim *s, const struct check_defer_slot *q)
 {
-    struct kins_check ck;
     struct check_result *r = s->r;
-    if (kins_check_pose(s->mc->kins, out->pose, &ck) != KINS_OK)
+    if (!q->ok)
+        return;
+    r->deviation_evals++;
+    if (q->value > r->max_deviation_mm)
+        r->max_deviation_mm = q->value, r->max_deviation_line = q->line;
+    if (q->value2 > r->max_deviation_deg)
+        r->max_deviation_deg = q->value2;
+    if (s->o->trace)
+        check_trace_deviation(s->o->trace, q->dist_mm, q->time_s, q->value);
+    if (q->tip_mode != CHECK_TIP_NONE)
+        tip_record(s, q->line, q->tip);
+}
+
+/* A condition number's result against [KINS] SINGULAR_CONDITION, in order. */
+static void singularity(struct sim *s, const struct check_defer_slot *q)
+{
+    struct check_result *r = s->r;
+    if (!q->ok)
         return;
     r->condition_evals++;
-    if (ck.condition > r->max_condition)
-        r->max_condition = ck.condition, r->max_condition_line = out->line;
-    if (!(ck.condition > r->condition_limit))
+    if (q->value > r->max_condition)
+        r->max_condition = q->value, r->max_condition_line = q->line;
+    if (!(q->value > r->condition_limit))
         return;
-    struct check_problem p = { .kind = CHECK_SINGULAR, .line = out->line, .leg = -1,
-                               .value = ck.condition, .limit = r->condition_limit,
-                               .time_s = out->time_elapsed_s, .count = 1 };
-    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
+    const double *P = q->pose;
+    struct check_problem p = { .kind = CHECK_SINGULAR, .line = q->line, .leg = -1,
+                               .value = q->value, .limit = r->condition_limit,
+                               .time_s = q->time_s, .count = 1 };
+    snprintf(p.file, sizeof p.file, "%s", q->file ? q->file : "");
     snprintf(p.message, sizeof p.message, "the machine comes close to a singular pose at X%.3f "
              "Y%.3f Z%.3f A%.3f B%.3f C%.3f: condition number %.1f above %.1f ([KINS] "
-             "SINGULAR_CONDITION); it loses stiffness and accuracy there", out->pose[0],
-             out->pose[1], out->pose[2], out->pose[3], out->pose[4], out->pose[5], ck.condition,
-             r->condition_limit);
+             "SINGULAR_CONDITION); it loses stiffness and accuracy there", P[0], P[1], P[2],
+             P[3], P[4], P[5], q->value, r->condition_limit);
     check_add_problem(r, &p);
+}
+
+/* Applies one slot's result. */
+static void apply(struct sim *s, const struct check_defer_slot *q)
+{
+    switch (q->kind) {
+    case CHECK_DEFER_DEVIATION: deviation_result(s, q); break;
+    case CHECK_DEFER_CONDITION: singularity(s, q); break;
+    case CHECK_DEFER_TIP: tip_record(s, q->line, q->value); break;
+    case CHECK_DEFER_FLUSH: tip_flush(s); break;
+    case CHECK_DEFER_MOVE: s->blk_tip_line = q->line, s->blk_tip_file = q->file; break;
+    }
+}
+
+static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind kind,
+                                         const struct motion_out *out)
+{
+    struct check_defer_slot *q;
+    while (!(q = check_defer_push(s->dq, kind)))
+        apply(s, check_defer_next(s->dq, 1));
+    q->line = out->line, q->file = out->file;
+    q->time_s = out->time_elapsed_s, q->dist_mm = out->distance_done_mm;
+    memcpy(q->pose, out->pose, sizeof q->pose);
+    return q;
+}
+
+/* Every measure taken so far, applied (waiting for those being computed). */
+static void drain(struct sim *s)
+{
+    const struct check_defer_slot *q;
+    while ((q = check_defer_next(s->dq, 1)))
+        apply(s, q);
 }
 
 /* Whether the pose has moved CHECK_COND_STEP_MM or _DEG from where the condition number
@@ -257,27 +302,25 @@ static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
 /* The scheduled measures of one period: the deviation at every line change, the condition
  * number at a line change the pose has moved on from (dense code changes line every few
  * tenths of a millimetre, and a condition number costs several servo periods), and
- * both on their schedule. */
+ * both on their schedule. Taken here, computed by whichever thread has time (the
+ * planner's, when it waits for this pass), applied in order. */
 static void measures(struct sim *s, const struct motion_out *out)
 {
-    struct check_result *r = s->r;
     double t = out->time_elapsed_s;
     int changed = out->line != s->line || out->file != s->file;
     if ((changed && cond_moved(s, out->pose)) || t >= s->next_cond_s) {
-        singularity(s, out);
+        slot_for(s, CHECK_DEFER_CONDITION, out);
+        check_defer_commit(s->dq);
         memcpy(s->cond_pose, out->pose, sizeof s->cond_pose);
         s->next_cond_s = t + s->o->condition_every_s;
     }
     if (changed || t >= s->next_dev_s) {
-        double ang = 0, dev = deviation(s, out, &ang);
-        if (dev > r->max_deviation_mm)
-            r->max_deviation_mm = dev, r->max_deviation_line = out->line;
-        if (ang > r->max_deviation_deg)
-            r->max_deviation_deg = ang;
-        if (s->o->trace && dev >= 0)
-            check_trace_deviation(s->o->trace, out->distance_done_mm, t, dev);
+        deviation(s, out);
         s->next_dev_s = t + s->o->deviation_every_s;
     }
+    const struct check_defer_slot *q;
+    while ((q = check_defer_next(s->dq, 0)))     /* what is ready, without waiting */
+        apply(s, q);
 }
 
 /* Per-leg limits from the kinematics and the motion configuration. */
@@ -317,6 +360,11 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
                      .T = mc->mcfg.servo_period_s, .inv_T = 1 / mc->mcfg.servo_period_s };
     s.have_tf = kins_get_tool_frame(mc->kins, &s.tf) == KINS_OK;
     r->tip_measured = s.have_tf;
+    struct check_defer *own = NULL;
+    s.dq = feed && feed->defer ? feed->defer
+         : (own = check_defer_new(mc->kins, s.have_tf ? &s.tf : NULL, o->cold_forward));
+    if (!s.dq)
+        return CHECK_ERR_NOMEM;
     struct motion_out out;
     double planned_s = -1;
     if (!feed) {
@@ -326,8 +374,10 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     }
     r->njoints = s.nj;
     leg_limits(&s);
-    if (kins_inverse(mc->kins, start, s.L0) != KINS_OK)   /* motion starts here */
+    if (kins_inverse(mc->kins, start, s.L0) != KINS_OK) {  /* motion starts here */
+        check_defer_free(own);
         return CHECK_ERR_KINS;
+    }
     memcpy(s.p0, start, sizeof s.p0);
     for (int i = 0; i < KINS_POSE_DIM; i++)   /* the first line change takes it */
         s.cond_pose[i] = HUGE_VAL;
@@ -363,8 +413,12 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
             motion_resume(mc->motion);
     }
     motion_set_rates(mc->motion, true);
-    if (s.tip_line)
-        tip_flush(&s);
+    if (s.tip_line) {
+        slot_for(&s, CHECK_DEFER_FLUSH, &out);
+        check_defer_commit(s.dq);
+    }
+    drain(&s);
+    check_defer_free(own);
     r->machining_time_s = out.time_elapsed_s;
     r->length_mm = out.distance_total_mm;
     return st == MOTION_OK && out.state == MOTION_DONE ? CHECK_OK : CHECK_ERR_CONFIG;

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "check/check_defer.h"
 #include "check/check_priv.h"
 #include "interp/interp.h"
 
@@ -34,12 +35,22 @@ struct producer {
     _Atomic int stop;                /* the servo pass has ended: plan no more (the reach
                                       * pass goes on), and wait for no chunk to be left */
     double cpu_s;                    /* the thread's CPU time, once it has ended */
+    struct check_defer *defer;       /* the servo pass's measures, which this thread computes
+                                      * while it waits for the pass (check_defer.h) */
 };
+
 
 static void pause_us(long us)
 {
     struct timespec ts = { 0, us * 1000 };
     nanosleep(&ts, NULL);
+}
+
+/* While the planner waits for the servo pass: a measure of the pass's, else a short sleep. */
+static void help_or_pause(struct producer *p, long us)
+{
+    if (!check_defer_work(p->defer))
+        pause_us(us);
 }
 
 /* The interpreter's commands: reach pass, then the planner (while it has not failed), with
@@ -58,7 +69,7 @@ static int sink(void *ctx, const struct canon_cmd *c)
         if (atomic_load(&p->stop))
             return 0;
         else
-            pause_us(200);
+            help_or_pause(p, 200);
     if (motion_stream_add(p->ms, c) != MOTION_OK)
         p->plan_status = MOTION_ERR_PROGRAM;
     else if (!atomic_load(&p->ready) && motion_stream_backlog(p->ms) > 0)
@@ -82,9 +93,11 @@ static void *produce(void *arg)
                motion_stream_finish(p->ms) != MOTION_OK) {
         p->plan_status = MOTION_ERR_PROGRAM;
     }
-    p->cpu_s = check_thread_cpu_s();
     atomic_store(&p->ready, 1);
     atomic_store(&p->done, 1);
+    while (!atomic_load(&p->stop))      /* the pass runs on through the last chunks */
+        help_or_pause(p, 100);
+    p->cpu_s = check_thread_cpu_s();
     return NULL;
 }
 
@@ -166,9 +179,16 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         return CHECK_ERR_NOMEM;
     p->mc = mc, p->path = path;
     check_result_init(&p->found);
+    struct kins_tool_frame tf;
+    int have_tf = kins_get_tool_frame(mc->kins, &tf) == KINS_OK;
+    if (!(p->defer = check_defer_new(mc->kins, have_tf ? &tf : NULL, opts->cold_forward))) {
+        free(p);
+        return CHECK_ERR_NOMEM;
+    }
     int st = check_machine_interp_new(mc, &p->in, &p->pb);
     if (st) {
         check_add_problem(r, &p->pb);
+        check_defer_free(p->defer);
         free(p);
         return st;
     }
@@ -189,12 +209,13 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         check_add_plan_problem(r, why, 0, -1);
         motion_stream_detach(mc->motion);
         motion_stream_destroy(p->ms);
+        check_defer_free(p->defer);
         free(p);
         return CHECK_ERR_CONFIG;
     }
     while (!atomic_load(&p->ready))
         pause_us(100);
-    struct check_feed feed = { feed_wait, feed_planned, p };
+    struct check_feed feed = { feed_wait, feed_planned, p, p->defer };
     int sim = CHECK_OK;
     double t0 = check_thread_cpu_s();
     if (!p->plan_status && !p->interp_status)
@@ -224,6 +245,7 @@ int check_program(struct check_machine *mc, const char *path, const struct check
     motion_stream_detach(mc->motion);
     motion_stream_destroy(p->ms);
     check_result_free(&p->found);
+    check_defer_free(p->defer);
     free(p);
     return st;
 }

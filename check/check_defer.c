@@ -1,0 +1,172 @@
+/* check_defer.c: the servo-rate pass's costly measures (deviation, condition number) computed
+ * by whichever thread has time, their results applied in order by the pass itself. */
+#include <math.h>
+#include <sched.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check/check_defer.h"
+
+/*
+ * The servo-rate pass (check_sim.c) writes each measure into the next slot of a ring, with
+ * everything it needs (legs, poses, the tip's line), and goes on stepping motion. A slot is
+ * computed by whoever claims it first, by advancing `claim`: the planner's thread when it
+ * waits for the pass to use up its chunks (check_stream.c), else the pass itself once the
+ * ring is full. The results are pure functions of the slot, so it does not matter which
+ * thread computes them; the pass applies them (figures, problems, warnings) in the order the
+ * measures were taken, as it did when it computed them on the spot.
+ *
+ *     slots:  ... [applied] [apply ... done or being computed ... claim ... waiting ... head)
+ *
+ * Only the pass writes head and apply; both threads advance claim by compare-and-swap, and a
+ * slot's `state` says when its results are there (release / acquire).
+ */
+
+struct check_defer *check_defer_new(struct kins *k, const struct kins_tool_frame *tf,
+                                    int cold_forward)
+{
+    struct check_defer *d = calloc(1, sizeof *d);
+    if (!d)
+        return NULL;
+    d->kins = k;
+    d->have_tf = tf != NULL;
+    if (tf)
+        d->tf = *tf;
+    d->cold_forward = cold_forward;
+    return d;
+}
+
+void check_defer_free(struct check_defer *d)
+{
+    free(d);
+}
+
+/* The tool tip in the workpiece's frame at a platform pose, with a tool len_mm long. */
+static void tip_at(const struct check_defer *d, double len_mm, const double pose[6],
+                   double tip[3])
+{
+    double prog[KINS_POSE_DIM];
+    kins_tcp_from_pose(&d->tf, len_mm, pose, prog);
+    memcpy(tip, prog, 3 * sizeof *tip);
+}
+
+/* Kinematic deviation between two set points: the legs at mid-chord (where linear leg motion
+ * strays furthest) through the forward kinematics, distance from the commanded chord; the
+ * tip of those legs against its move's line or the chord between the set points' tips. */
+static void deviation(const struct check_defer *d, struct check_defer_slot *s)
+{
+    double Lm[KINS_MAX_JOINTS], P[KINS_POSE_DIM], dv[3], n2 = 0, u = 0, e2 = 0, ang = 0;
+    const double *p0 = s->p0, *p1 = s->pose;
+    for (int i = 0; i < d->kins->njoints; i++)
+        Lm[i] = 0.5 * (s->L0[i] + s->L1[i]);
+    if (d->cold_forward)       /* the baseline: every solve from the home pose */
+        memcpy(P, d->kins->home, sizeof P);
+    else                       /* warm: the commanded chord's midpoint is within the
+                                * deviation (um) of the answer, so one Newton step does */
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            P[i] = 0.5 * (p0[i] + p1[i]);
+    s->ok = kins_forward(d->kins, Lm, P, NULL) == KINS_OK;
+    if (!s->ok)
+        return;
+    for (int i = 0; i < 3; i++)
+        dv[i] = p1[i] - p0[i], n2 += dv[i] * dv[i];
+    for (int i = 0; i < 3; i++)
+        u += (P[i] - p0[i]) * dv[i];
+    u = n2 > 1e-24 ? u / n2 : 0.5;
+    for (int i = 0; i < 3; i++)
+        e2 += (P[i] - p0[i] - u * dv[i]) * (P[i] - p0[i] - u * dv[i]);
+    for (int i = 3; i < 6; i++)
+        ang = fmax(ang, fabs(P[i] - p0[i] - u * (p1[i] - p0[i])));
+    s->value = sqrt(e2);
+    s->value2 = ang;
+    if (s->tip_mode == CHECK_TIP_NONE)
+        return;
+    double tm[3], t0[3], t1[3];
+    tip_at(d, s->tool_len_mm, P, tm);
+    if (s->tip_mode == CHECK_TIP_LINE) {
+        s->tip = motion_dist_seg(tm, s->t0, s->t1);
+    } else {
+        tip_at(d, s->tool_len_mm, p0, t0);
+        tip_at(d, s->tool_len_mm, p1, t1);
+        s->tip = motion_dist_seg(tm, t0, t1);
+    }
+}
+
+/* Computes slot s (a measure; the other kinds come with their values). */
+static void compute(const struct check_defer *d, struct check_defer_slot *s)
+{
+    if (s->kind == CHECK_DEFER_DEVIATION) {
+        deviation(d, s);
+    } else if (s->kind == CHECK_DEFER_CONDITION) {
+        struct kins_check ck;
+        s->ok = kins_check_pose(d->kins, s->pose, &ck) == KINS_OK;
+        s->value = s->ok ? ck.condition : 0;
+    }
+    atomic_store_explicit(&s->state, CHECK_DEFER_DONE, memory_order_release);
+}
+
+/* Claims the slot at `claim` if it lies before head; its index into *i. */
+static int claim_one(struct check_defer *d, size_t *i)
+{
+    size_t c = atomic_load_explicit(&d->claim, memory_order_relaxed);
+    while (c < atomic_load_explicit(&d->head, memory_order_acquire))
+        if (atomic_compare_exchange_weak(&d->claim, &c, c + 1)) {
+            *i = c;
+            return 1;
+        }
+    return 0;
+}
+
+int check_defer_work(struct check_defer *d)
+{
+    size_t i;
+    if (!d || !claim_one(d, &i))
+        return 0;
+    struct check_defer_slot *s = &d->slot[i % CHECK_DEFER_SLOTS];
+    if (atomic_load_explicit(&s->state, memory_order_acquire) != CHECK_DEFER_DONE)
+        compute(d, s);
+    return 1;
+}
+
+struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defer_kind kind)
+{
+    if (d->head_local - d->apply >= CHECK_DEFER_SLOTS)
+        return NULL;                     /* full: the pass applies the oldest first */
+    struct check_defer_slot *s = &d->slot[d->head_local % CHECK_DEFER_SLOTS];
+    s->kind = kind;
+    atomic_store_explicit(&s->state, kind == CHECK_DEFER_DEVIATION ||
+                          kind == CHECK_DEFER_CONDITION ? CHECK_DEFER_WAITING
+                          : CHECK_DEFER_DONE, memory_order_relaxed);
+    return s;
+}
+
+void check_defer_commit(struct check_defer *d)
+{
+    d->head_local++;
+    atomic_store_explicit(&d->head, d->head_local, memory_order_release);
+}
+
+struct check_defer_slot *check_defer_next(struct check_defer *d, int wait)
+{
+    if (d->apply == d->head_local)
+        return NULL;
+    struct check_defer_slot *s = &d->slot[d->apply % CHECK_DEFER_SLOTS];
+    for (;;) {
+        int state = atomic_load_explicit(&s->state, memory_order_acquire);
+        if (atomic_load_explicit(&d->claim, memory_order_acquire) <= d->apply) {
+            /* nobody has taken it: a measure waits for the helper unless the pass must
+             * go on; a value is taken at once (claim never passes a slot untaken) */
+            if (state != CHECK_DEFER_DONE && !wait)
+                return NULL;
+            check_defer_work(d);
+            continue;
+        }
+        if (state == CHECK_DEFER_DONE)
+            break;
+        if (!wait)
+            return NULL;
+        sched_yield();                   /* the helper is computing it: a microsecond */
+    }
+    d->apply++;
+    return s;
+}

@@ -1,0 +1,70 @@
+/* check_defer.h: the servo-rate pass's costly measures, computed by whichever thread has time
+ * and applied in order by the pass (check_defer.c). Inside check/ only. */
+#ifndef HEXCNC_CHECK_DEFER_H
+#define HEXCNC_CHECK_DEFER_H
+
+#include <stdatomic.h>
+#include <stddef.h>
+
+#include "check/check_priv.h"
+
+#define CHECK_DEFER_SLOTS 16384      /* measures in flight (6 MB): what the pass takes while
+                                      * the planner plans a window (about 10 ms) */
+
+enum check_defer_kind {
+    CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
+    CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed */
+    CHECK_DEFER_TIP,                 /* a tip deviation the pass has already (value) */
+    CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning */
+    CHECK_DEFER_MOVE,                /* a straight move's start: its line and file */
+};
+enum check_defer_state { CHECK_DEFER_WAITING, CHECK_DEFER_DONE };
+/* How a deviation measures the tip of the interpolated legs. */
+enum check_defer_tip { CHECK_TIP_NONE, CHECK_TIP_LINE /* against t0 t1 */,
+                       CHECK_TIP_CHORD /* against the chord between the set points' tips */ };
+
+/* One measure: what the pass took (written before commit, read-only after) and the result
+ * (written by the thread that computes it, before `state` becomes DONE). */
+struct check_defer_slot {
+    _Atomic int state;               /* enum check_defer_state */
+    enum check_defer_kind kind;
+    int line;                        /* the period's program line and file, machine time */
+    const char *file;
+    double time_s, dist_mm;
+    double pose[KINS_POSE_DIM];      /* this period's commanded pose */
+    double p0[KINS_POSE_DIM];        /* deviation: the last period's, and both set points */
+    double L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS];
+    enum check_defer_tip tip_mode;
+    double tool_len_mm;              /* the tool of the period, for the tip */
+    double t0[3], t1[3];             /* CHECK_TIP_LINE: the move's tip line */
+    int ok;                          /* result: the solve succeeded */
+    double value;                    /* deviation (mm), condition number, or TIP's value */
+    double value2;                   /* deviation: the orientation's, deg */
+    double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
+};
+
+struct check_defer {
+    struct kins *kins;               /* what the measures are computed with (read-only) */
+    struct kins_tool_frame tf;
+    int have_tf, cold_forward;
+    _Atomic size_t head;             /* slots committed (the pass writes) */
+    _Atomic size_t claim;            /* slots taken for computing (both, compare-and-swap) */
+    size_t head_local, apply;        /* the pass's own: committed, applied */
+    struct check_defer_slot slot[CHECK_DEFER_SLOTS];
+};
+
+/* A ring for measures with kinematics k and tool tf (NULL: none); NULL when out of memory. */
+struct check_defer *check_defer_new(struct kins *k, const struct kins_tool_frame *tf,
+                                    int cold_forward);
+void check_defer_free(struct check_defer *d);
+/* The helper's side: computes the oldest measure nobody has taken; 1 if there was one. */
+int check_defer_work(struct check_defer *d);
+/* The pass's side. The next slot to fill, of this kind, or NULL when the ring is full (apply
+ * first); then check_defer_commit publishes it. */
+struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defer_kind kind);
+void check_defer_commit(struct check_defer *d);
+/* The oldest slot not yet applied, once its result is there (wait: computing it, or waiting
+ * for the helper that is); NULL when none is ready without waiting, or none is left. */
+struct check_defer_slot *check_defer_next(struct check_defer *d, int wait);
+
+#endif
