@@ -92,7 +92,7 @@ static void deviation(const struct check_defer *d, struct check_defer_slot *s)
     }
 }
 
-/* Computes slot s (a measure; the other kinds come with their values). */
+/* Computes slot s (a measure; the other kinds need nothing computed). */
 static void compute(const struct check_defer *d, struct check_defer_slot *s)
 {
     if (s->kind == CHECK_DEFER_DEVIATION) {
@@ -101,6 +101,10 @@ static void compute(const struct check_defer *d, struct check_defer_slot *s)
         struct kins_check ck;
         s->ok = kins_check_pose(d->kins, s->pose, &ck) == KINS_OK;
         s->value = s->ok ? ck.condition : 0;
+    } else if (s->kind == CHECK_DEFER_TIP) {
+        double tip[3];
+        tip_at(d, s->tool_len_mm, s->pose, tip);
+        s->value = motion_dist_seg(tip, s->t0, s->t1);
     }
     atomic_store_explicit(&s->state, CHECK_DEFER_DONE, memory_order_release);
 }
@@ -135,8 +139,8 @@ struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defe
     struct check_defer_slot *s = &d->slot[d->head_local % CHECK_DEFER_SLOTS];
     s->kind = kind;
     atomic_store_explicit(&s->state, kind == CHECK_DEFER_DEVIATION ||
-                          kind == CHECK_DEFER_CONDITION ? CHECK_DEFER_WAITING
-                          : CHECK_DEFER_DONE, memory_order_relaxed);
+                          kind == CHECK_DEFER_CONDITION || kind == CHECK_DEFER_TIP
+                          ? CHECK_DEFER_WAITING : CHECK_DEFER_DONE, memory_order_relaxed);
     return s;
 }
 

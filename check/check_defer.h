@@ -14,7 +14,8 @@
 enum check_defer_kind {
     CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
     CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed */
-    CHECK_DEFER_TIP,                 /* a tip deviation the pass has already (value) */
+    CHECK_DEFER_TIP,                 /* the commanded tip against its move's line t0 t1:
+                                      * computed */
     CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning */
     CHECK_DEFER_MOVE,                /* a straight move's start: its line and file */
 };
@@ -36,9 +37,9 @@ struct check_defer_slot {
     double L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS];
     enum check_defer_tip tip_mode;
     double tool_len_mm;              /* the tool of the period, for the tip */
-    double t0[3], t1[3];             /* CHECK_TIP_LINE: the move's tip line */
+    double t0[3], t1[3];             /* CHECK_TIP_LINE and TIP: the move's tip line */
     int ok;                          /* result: the solve succeeded */
-    double value;                    /* deviation (mm), condition number, or TIP's value */
+    double value;                    /* deviation (mm), condition number, tip's (mm) */
     double value2;                   /* deviation: the orientation's, deg */
     double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
 };

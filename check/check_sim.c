@@ -188,10 +188,10 @@ static void tip_period(struct sim *s, const struct motion_out *out)
     tip_move(s, out);
     if (!s->tip_line || !s->tip_swing)
         return;
-    double tip[3];
-    tip_of(s, out, out->pose, tip);
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_TIP, out);
-    q->value = motion_dist_seg(tip, s->tip_t0, s->tip_t1);
+    q->tool_len_mm = out->tcp ? out->tool_len_mm : s->tf.length_mm;
+    memcpy(q->t0, s->tip_t0, sizeof q->t0);
+    memcpy(q->t1, s->tip_t1, sizeof q->t1);
     check_defer_commit(s->dq);
 }
 
