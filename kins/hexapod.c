@@ -159,6 +159,22 @@ static int hexapod_inverse_path(struct kins *k, const double pose[KINS_POSE_DIM]
     return st;
 }
 
+/* The Jacobian d(leg length)/d(X Y Z A B C) of legs evaluated at the pose (mm/mm, mm/deg):
+ * hexapod_jac_row, as the leg rates use it. */
+static int hexapod_jacobian(struct kins *k, const double pose[KINS_POSE_DIM], double *jac)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    double t[3], joints[HEXAPOD_LEGS];
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, &o, &lg);
+    for (int i = 0; i < HEXAPOD_LEGS; i++)
+        hexapod_jac_row(&o, &lg, i, HEXAPOD_RAD_PER_DEG, &jac[i * KINS_POSE_DIM]);
+    return joints_checked(k, pose, &o, &lg, joints);
+}
+
 /* Why a pose is outside the workspace: a leg's length first, then the other limits. */
 static int hexapod_describe(struct kins *k, const double pose[KINS_POSE_DIM], char *msg,
                             size_t len)
@@ -377,6 +393,7 @@ const struct kins_ops kins_hexapod_ops = {
     .tool_point = hexapod_tool_point,
     .inverse_rates = hexapod_inverse_rates,
     .inverse_path = hexapod_inverse_path,
+    .jacobian = hexapod_jacobian,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

@@ -109,6 +109,10 @@ struct kins_ops {
     int (*inverse_path)(struct kins *k, const double pose[KINS_POSE_DIM],
                         const double dpose[KINS_POSE_DIM], const double d2pose[KINS_POSE_DIM],
                         double *joints, double *djoints, double *d2joints);
+    /* Optional: the Jacobian d joint_i / d pose_j at pose, row-major njoints x 6 (mm/mm,
+     * mm/deg), analytic. Statuses as inverse (written whatever the reach). NULL: the planner
+     * differences the inverse. */
+    int (*jacobian)(struct kins *k, const double pose[KINS_POSE_DIM], double *jac);
 };
 
 /* Base of every instance; concrete models embed it first. */

@@ -76,9 +76,11 @@ int motion_invert6(double a[6][6], double inv[6][6])
     return 0;
 }
 
-/* The inverse of the Jacobian dL/dpose (mm/mm, mm/deg) at S's pose, by finite differences
- * of the inverse kinematics, or the cached one when S lies within 2 mm and 1 deg of where it
- * was taken (it changes by well under 1 % there). -1 when the Jacobian is singular. */
+/* The inverse of the Jacobian dL/dpose (mm/mm, mm/deg) at S's pose: the kinematics' own
+ * (analytic) where it has one, else (and under G43.4, whose tip-to-platform map is not the
+ * kinematics') by finite differences of the inverse kinematics; or the cached one when S
+ * lies within 2 mm and 1 deg of where it was taken (it changes by well under 1 % there). -1
+ * when the Jacobian is singular. */
 static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S)
 {
     int near = m->jc_valid && m->jc_tcp == S->tcp && m->jc_len_mm == S->tool_len_mm;
@@ -87,12 +89,16 @@ static int jacobian_inverse_near(struct motion *m, const struct motion_sample *S
     if (near)
         return 0;
     double J[6][6], L1[KINS_MAX_JOINTS], p1[KINS_POSE_DIM], d = 1e-4;
-    for (int j = 0; j < 6; j++) {
-        memcpy(p1, S->pose, sizeof p1);
-        p1[j] += d;
-        motion_path_inverse(m, S->tcp, S->tool_len_mm, p1, L1);
-        for (int i = 0; i < 6; i++)
-            J[i][j] = (L1[i] - S->L[i]) / d;
+    if (!S->tcp && m->kins->ops->jacobian) {
+        m->kins->ops->jacobian(m->kins, S->pose, &J[0][0]);
+    } else {
+        for (int j = 0; j < 6; j++) {
+            memcpy(p1, S->pose, sizeof p1);
+            p1[j] += d;
+            motion_path_inverse(m, S->tcp, S->tool_len_mm, p1, L1);
+            for (int i = 0; i < 6; i++)
+                J[i][j] = (L1[i] - S->L[i]) / d;
+        }
     }
     if (motion_invert6(J, m->jc_Jinv) < 0)
         return -1;

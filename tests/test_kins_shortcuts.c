@@ -91,6 +91,31 @@ START_TEST(test_inverse_path)
 }
 END_TEST
 
+/* The analytic Jacobian the planner asks for equals central differences of the inverse. */
+START_TEST(test_jacobian)
+{
+    struct kins *k = make_tmu();
+    const double pose[6] = { 30, 20, 630, 14, -11, 35 };
+    double J[36], Lm[6], Lp[6], p[6];
+    ck_assert_int_eq(k->ops->jacobian(k, pose, J), KINS_OK);
+    for (int j = 0; j < 6; j++) {
+        double h = 1e-4;
+        memcpy(p, pose, sizeof p);
+        p[j] = pose[j] - h;
+        kins_inverse(k, p, Lm);
+        p[j] = pose[j] + h;
+        kins_inverse(k, p, Lp);
+        for (int i = 0; i < 6; i++)
+            ck_assert_msg(fabs(J[i * 6 + j] - (Lp[i] - Lm[i]) / (2 * h)) < 1e-7, "leg %d, "
+                          "pose %d: %.12g against %.12g", i, j, J[i * 6 + j],
+                          (Lp[i] - Lm[i]) / (2 * h));
+    }
+    const double far[6] = { 0, 0, 1200, 0, 0, 0 };
+    ck_assert_int_eq(k->ops->jacobian(k, far, J), KINS_ERR_UNREACHABLE);
+    kins_free(k);
+}
+END_TEST
+
 /* A 6 x 6 with known singular values: U diag(s) V^T with U, V rotations in two planes. */
 static void known_matrix(const double s[6], double m[36])
 {
@@ -145,6 +170,7 @@ int main(void)
     TCase *tc = tcase_create("shortcuts");
     tcase_add_test(tc, test_condition_number);
     tcase_add_test(tc, test_inverse_path);
+    tcase_add_test(tc, test_jacobian);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
