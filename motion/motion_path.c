@@ -57,7 +57,7 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
     const struct motion_arc *a = &p->arcs[sg->arc];
     double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, h = a->h0_mm + a->dh_mm * u;
     double c, sn;
-    sincos(ang, &sn, &c);      /* one call, the values of sin() and cos() (a servo period's) */
+    sincos(ang, &sn, &c);      /* one call, the same values as sin() and cos() */
     for (int i = 0; i < 3; i++)
         pose[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
     if (a->abc_cubic)
