@@ -148,6 +148,11 @@ const struct config_key config_keys[] = {
       "corner cut when blending" },
     { "TRAJ", "SETPOINT_PERIOD", INT, "ns", ">= 0", 0, 0, "servo period", "period at which "
       "drives take set points, for the kinematic-error bound" },
+    { "TRAJ", "MAX_LINEAR_JERK", NUM, "mm/s^3", "> 0", 0, 0, "none (trapezoidal)", "path "
+      "jerk limit, X Y Z: with MAX_ANGULAR_JERK and every [JOINT_#] MAX_JERK, motion is "
+      "jerk-limited (docs/motion.md); all or none" },
+    { "TRAJ", "MAX_ANGULAR_JERK", NUM, "deg/s^3", "> 0", 0, 0, "none (trapezoidal)", "jerk "
+      "limit of each of A B C; all or none, with MAX_LINEAR_JERK" },
     { "TRAJ", "NO_FORCE_HOMING", BOOL, "", "", 0, 0, "0", "1: programs and MDI may run "
       "before the legs are homed (the session, docs/machine.md)" },
     { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },
@@ -176,6 +181,8 @@ const struct config_key config_keys[] = {
     { "JOINT_#", "MAX_VELOCITY", NUM, "mm/s", "> 0", 0, REQ, "", "leg speed limit" },
     { "JOINT_#", "MAX_ACCELERATION", NUM, "mm/s^2", "> 0", 0, REQ, "", "leg acceleration "
       "limit" },
+    { "JOINT_#", "MAX_JERK", NUM, "mm/s^3", "> 0", 0, 0, "none (trapezoidal)", "leg jerk "
+      "limit; all or none, with [TRAJ] MAX_LINEAR_JERK" },
     { "JOINT_#", "FERROR", NUM, "mm", "> 0", 0, REQ, "", "following-error limit at "
       "MAX_VELOCITY" },
     { "JOINT_#", "MIN_FERROR", NUM, "mm", "> 0", 0, 0, "0.1", "following-error limit at "

@@ -67,6 +67,10 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     m->pose_known = 1;
     m->run = &m->plan;
     m->pb_at[0] = m->pb_at[1] = SIZE_MAX;
+    if ((st = motion_jerk_init(m, err, errlen)) != MOTION_OK) {
+        free(m);
+        return st;
+    }
     *out = m;
     return MOTION_OK;
 }
@@ -78,6 +82,7 @@ void motion_destroy(struct motion *m)
         return;
     motion_plan_free(&m->plan);
     motion_plan_free(&m->names);
+    motion_jerk_free(m);
     free(m);
 }
 

@@ -63,6 +63,7 @@ const char *motion_state_name(enum motion_state s);
 struct motion_joint_config {
     double max_vel_mm_s;     /* MAX_VELOCITY, mm/s (deg/s for a rotary joint of trivial kins) */
     double max_acc_mm_s2;    /* MAX_ACCELERATION, mm/s^2 */
+    double max_jerk_mm_s3;   /* MAX_JERK, mm/s^3; 0: none (jerk limiting off) */
     double ferror_mm;        /* FERROR: following-error limit at MAX_VELOCITY, mm */
     double min_ferror_mm;    /* MIN_FERROR: following-error limit at standstill, mm */
     /* Homing ([JOINT_n] HOME_*, docs/machine.md). search_vel 0: no switch (absolute). */
@@ -87,6 +88,10 @@ struct motion_config {
     double max_lin_acc_mm_s2;       /* [TRAJ] MAX_LINEAR_ACCELERATION, mm/s^2 */
     double max_ang_vel_deg_s;       /* [TRAJ] MAX_ANGULAR_VELOCITY, deg/s, per rotary axis */
     double max_ang_acc_deg_s2;      /* [TRAJ] MAX_ANGULAR_ACCELERATION, deg/s^2 */
+    double max_lin_jerk_mm_s3;      /* [TRAJ] MAX_LINEAR_JERK, mm/s^3; 0: none. Jerk limiting
+                                     * is on when this, max_ang_jerk_deg_s3 and every joint's
+                                     * max_jerk_mm_s3 are set, off when none is */
+    double max_ang_jerk_deg_s3;     /* [TRAJ] MAX_ANGULAR_JERK, deg/s^3; 0: none */
     double default_lin_vel_mm_s;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY, mm/s: feed of a move
                                      * programmed before any F word (canon feed 0) */
     double kin_tol_mm;              /* [TRAJ] KINEMATIC_TOLERANCE, mm: largest deviation of the
@@ -111,6 +116,12 @@ void motion_config_default(struct motion_config *c);
  * [SECTION]KEY when a value is not a positive number. */
 int motion_config_read(struct motion_config *c, const struct kins_config *cfg, int njoints,
                        char *err, size_t errlen);
+
+/* Jerk limiting (motion_jerk.c): the length of the moving average the legs' and the pose's
+ * set points go through, s (0: jerk limiting off). With it no leg's jerk, measured by
+ * differencing the set points period by period, exceeds MAX_JERK wherever the unfiltered
+ * motion keeps its acceleration limits. */
+double motion_jerk_window_s(const struct motion_config *c);
 
 struct motion;
 

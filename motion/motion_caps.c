@@ -132,10 +132,11 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
     *ang_deg = ang;
 }
 
-/* The set-point period: drives move their legs linearly over it. */
+/* The set-point period: drives move their legs linearly over it (with jerk limits, the
+ * chord that cuts a curve as much as the chords and the moving average together). */
 static double setpoint_period(const struct motion_config *c)
 {
-    return c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+    return motion_chord_period(c);
 }
 
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
@@ -403,6 +404,9 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     const struct motion_sample A = *Ap, B = *Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
     double dx = 0, da = 0, v = HUGE_VAL;
+    /* a jump of the direction by dx at speed v: a set-point chord across it cuts the corner
+     * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8 */
+    Ts += motion_jerk_window_s(c) / 2;
     for (int i = 0; i < 3; i++)
         dx += (B.dp[i] - A.dp[i]) * (B.dp[i] - A.dp[i]);
     dx = sqrt(dx);

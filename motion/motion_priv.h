@@ -267,6 +267,7 @@ struct motion {
     unsigned note_seq;
     int line;
     const char *file;
+    struct motion_jerk *jerk; /* jerk limiting's moving average (motion_jerk.c), or NULL */
 };
 
 /* Durations of the three phases of an interval of length ds: accelerate from v0 to vp,
@@ -305,6 +306,28 @@ void motion_probe_arm(struct motion *m);
 /* After the pose of the period is evaluated: publishes the result once the probe move has
  * come to rest (tripped) or reached its end (no trip). */
 void motion_probe_settle(struct motion *m);
+
+/* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
+#define MOTION_JERK_MAX_S 1.0
+/* Allocates the moving average when the configuration limits jerk (m->jerk stays NULL when
+ * it does not); MOTION_ERR_NOMEM with a message. */
+int motion_jerk_init(struct motion *m, char *err, size_t errlen);
+void motion_jerk_free(struct motion *m);
+/* After the executor evaluated the period: its pose, legs and rates go into the average and
+ * the motion's values become the average's (the move, line and file of the window's middle). */
+void motion_jerk_follow(struct motion *m);
+/* The evaluation failed: the motion's values go back to the last output. */
+void motion_jerk_restore(struct motion *m);
+/* A period without program motion (manual, idle, paused, done, fault): the average holds
+ * the motion's present values and starts from them when the program moves again. */
+void motion_jerk_hold(struct motion *m);
+/* Whether the average has come to rest on the executor's pose (always without jerk limits):
+ * the machine counts as stopped only then. */
+bool motion_jerk_settled(const struct motion *m);
+/* The period over which a chord's and the average's cut of a curved path is bounded: the
+ * set-point period T_s and the average's window T_j give the same cut as a set-point chord
+ * of sqrt(T_s^2 + T_j^2 / 3) (a chord cuts q d^2 / 8, the average q (v T_j)^2 / 24). */
+double motion_chord_period(const struct motion_config *c);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

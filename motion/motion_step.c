@@ -152,10 +152,25 @@ static int wait_here(struct motion *m)
     return 1;
 }
 
+/* At the start of a pause or a wait not yet honoured, with jerk limits: held there until the
+ * moving average has come to rest on it (motion_jerk.c), so that the machine stands still
+ * when the pause or the wait begins. */
+static int settle_here(struct motion *m)
+{
+    const struct motion_seg *sg = &m->run->segs[m->cs];
+    bool stop = (sg->kind == SEG_PAUSE && m->paused_at_seg != m->cs + 1) ||
+                (sg->kind == SEG_WAIT && m->waited_at_seg != m->cs + 1 && !m->waiting);
+    if (!stop || m->ci != sg->k0 || motion_jerk_settled(m))
+        return 0;
+    m->tau_s = m->run->kt[m->ci];
+    m->rate = 0;
+    return 1;
+}
+
 /* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
 static int pause_here(struct motion *m)
 {
-    if (wait_here(m))
+    if (settle_here(m) || wait_here(m))
         return 1;
     const struct motion_seg *sg = &m->run->segs[m->cs];
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
@@ -318,7 +333,7 @@ static void advance(struct motion *m, double dt)
             /* at rest after an M66: on into the next part once the interpreter, which has
              * the answer now, has planned it */
             struct motion_chunk *c = m->chunk, *n = atomic_load(&c->next);
-            if (n && n != MOTION_TAIL_TAKEN) {
+            if (n && n != MOTION_TAIL_TAKEN && motion_jerk_settled(m)) {
                 pass_marks_to(m, c->plan.nseg);
                 pass_ios_to(m, c->plan.nseg);
                 /* (the part after the wait may hold no move: the program's end) */
@@ -335,13 +350,15 @@ static void advance(struct motion *m, double dt)
                            e->file ? e->file : "program", e->line, e->line);
             m->state = MOTION_FAULT;
             m->fault_status = MOTION_ERR_STARVED;
-        } else {
+        } else if (motion_jerk_settled(m)) {
             m->state = MOTION_DONE;
         }
     }
-    if (m->rate == 0 && m->state == MOTION_PAUSING)
+    /* (with jerk limits the machine has stopped once the moving average has) */
+    bool still = m->rate == 0 && motion_jerk_settled(m);
+    if (still && m->state == MOTION_PAUSING)
         m->state = MOTION_PAUSED;
-    if (m->rate == 0 && m->state == MOTION_STOPPING) {
+    if (still && m->state == MOTION_STOPPING) {
         m->state = MOTION_IDLE;
         m->loaded = 0;
     }
@@ -574,6 +591,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         m->state = MOTION_DONE;  /* a streamed program without a move */
     if (m->state == MOTION_MANUAL) {
         motion_manual_step(m, period_s);
+        motion_jerk_hold(m);
     } else if (moving && m->loaded && stream_ready(m) && m->run->nseg) {
         m->io_age++;
         pass_ios(m);           /* the commands at the present place first: a wait there */
@@ -582,6 +600,10 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         pass_ios(m);
         /* (a streamed end holds no move; at rest on a probe's trip the pose holds) */
         int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m) : KINS_OK;
+        if (st == KINS_OK)
+            motion_jerk_follow(m);
+        else
+            motion_jerk_restore(m);
         motion_probe_settle(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
@@ -600,6 +622,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         m->path_vel = 0;
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         memset(m->joint_vel, 0, sizeof m->joint_vel);
+        motion_jerk_hold(m);
     }
     stream_watch(m);
     memcpy(out->pose, m->pose, sizeof out->pose);
