@@ -13,6 +13,7 @@ static const char *const kind_names[CHECK_KIND_COUNT] = {
     [CHECK_LEG_RANGE] = "leg_range",
     [CHECK_LEG_VELOCITY] = "leg_velocity",
     [CHECK_LEG_ACCELERATION] = "leg_acceleration",
+    [CHECK_LEG_JERK] = "leg_jerk",
     [CHECK_SINGULAR] = "singular",
     [CHECK_PLAN] = "plan",
     [CHECK_TIP_DEVIATION] = "tip_deviation",

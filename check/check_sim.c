@@ -21,6 +21,8 @@ struct sim {
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
     double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s (the
                                         * machine starts at rest: 0) */
+    double a0[KINS_MAX_JOINTS];        /* leg acceleration of the previous period, mm/s^2 */
+    double jerk_thr[KINS_MAX_JOINTS];  /* jerk beyond which a leg is over (HUGE_VAL: none) */
     double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
     double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
@@ -50,12 +52,15 @@ static void leg_limit(struct sim *s, const struct motion_out *out, enum check_ki
     struct check_problem p = { .kind = k, .line = out->line, .leg = leg, .value = value,
                                .limit = limit, .time_s = t_s, .count = 1 };
     snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
-    const char *what = k == CHECK_LEG_VELOCITY ? "moves at" : "accelerates at";
-    const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : "mm/s^2";
+    const char *what = k == CHECK_LEG_VELOCITY ? "moves at"
+                       : k == CHECK_LEG_JERK ? "changes its acceleration at" : "accelerates at";
+    const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : k == CHECK_LEG_JERK ? "mm/s^3"
+                                                                              : "mm/s^2";
     const struct check_leg *lg = &s->r->leg[leg];
     snprintf(p.message, sizeof p.message, "leg %d %s %.3f %s, over its limit of %.3f %s "
              "([JOINT_%d] %s) at %.3f s", leg + 1, what, value, unit, limit, unit, leg,
-             k == CHECK_LEG_VELOCITY ? lg->vel_key : lg->acc_key, t_s);
+             k == CHECK_LEG_VELOCITY ? lg->vel_key : k == CHECK_LEG_JERK ? "MAX_JERK"
+                                                                         : lg->acc_key, t_s);
     check_add_problem(s->r, &p);
 }
 
@@ -79,7 +84,8 @@ static void legs_period(struct sim *s, const struct motion_out *out)
     for (int i = 0; i < s->nj; i++) {
         struct check_leg *lg = &s->r->leg[i];
         double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
-        double av = fabs(v), aa = fabs(v - s->v0[i]) * s->inv_T;
+        double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
+        double aj = fabs(a - s->a0[i]) * s->inv_T;
         lg->min_mm = L < lg->min_mm ? L : lg->min_mm;
         lg->max_mm = L > lg->max_mm ? L : lg->max_mm;
         lg->peak_vel_mm_s = av > lg->peak_vel_mm_s ? av : lg->peak_vel_mm_s;
@@ -90,7 +96,11 @@ static void legs_period(struct sim *s, const struct motion_out *out)
             leg_limit(s, out, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
         if (aa > s->acc_thr[i])
             leg_limit(s, out, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
+        lg->peak_jerk_mm_s3 = aj > lg->peak_jerk_mm_s3 ? aj : lg->peak_jerk_mm_s3;
+        if (aj > s->jerk_thr[i])
+            leg_limit(s, out, CHECK_LEG_JERK, i, aj, lg->limit_jerk_mm_s3);
         s->v0[i] = v;
+        s->a0[i] = a;
     }
 }
 
@@ -297,6 +307,9 @@ static void leg_limits(struct sim *s)
             lg->limit_acc_mm_s2 = s->mc->drive_acc[i], lg->acc_key = "STEPGEN_MAXACCEL";
         s->vel_thr[i] = lg->limit_vel_mm_s * (1 + LIMIT_SLACK);
         s->acc_thr[i] = lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK);
+        lg->limit_jerk_mm_s3 = s->mc->mcfg.joint[i].max_jerk_mm_s3;
+        s->jerk_thr[i] = lg->limit_jerk_mm_s3 > 0 ? lg->limit_jerk_mm_s3 * (1 + LIMIT_SLACK)
+                                                  : HUGE_VAL;
         lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
     }
 }

@@ -186,8 +186,11 @@ static void push(struct motion *m, const double *x, const struct motion_jerk_met
                 j->sum[d] += j->ring[(size_t)k * JERK_DIM + d];
         j->since_sum = 0;
     }
-    for (int d = 0; d < JERK_DIM; d++)
-        j->last[d] = j->sum[d] / j->n;
+    if (j->still >= j->n - 1)           /* settled: exactly the leader's, not a rounded mean */
+        memcpy(j->last, x, sizeof j->last);
+    else
+        for (int d = 0; d < JERK_DIM; d++)
+            j->last[d] = j->sum[d] / j->n;
     /* the window's middle sample: where the mean lies on the path */
     j->last_meta = j->meta[(j->head + j->n / 2) % j->n];
     scatter(m, j->last, &j->last_meta);
@@ -217,16 +220,6 @@ void motion_jerk_hold(struct motion *m)
     struct motion_jerk *j = m->jerk;
     if (!j)
         return;
-    if (j->primed && !motion_jerk_settled(m) && m->state == MOTION_FAULT &&
-        m->fault_status == MOTION_ERR_STARVED) {
-        /* stopped on the path for want of plan: the mean comes to rest on the leader, as
-         * it would have at a planned stop */
-        double x[JERK_DIM];
-        struct motion_jerk_meta mt = j->meta[(j->head + j->n - 1) % j->n];
-        memcpy(x, j->ring + (size_t)((j->head + j->n - 1) % j->n) * JERK_DIM, sizeof x);
-        push(m, x, &mt);
-        return;
-    }
     gather(m, j->last, &j->last_meta);
     j->primed = 0;
 }

@@ -342,7 +342,10 @@ static void advance(struct motion *m, double dt)
                     m->state = MOTION_DONE;
             }
         } else if (m->chunk && !m->chunk->last) {
-            /* the tail of a chunk whose successor never came: stopped on the path */
+            /* the tail of a chunk whose successor never came: stopped on the path (once the
+             * jerk limiter's average has come to rest too) */
+            if (!motion_jerk_settled(m))
+                return;
             const struct motion_seg *e = &p->segs[p->nseg - 1];
             motion_set_msg(m, "%s:%d: the program's next part was not planned in time (the "
                            "planner fell behind the machine, or stopped on an error): the "
@@ -566,8 +569,9 @@ static void stream_watch(struct motion *m)
             wait = MOTION_TAIL_TAKEN;
         else if (m->probe_halt == PROBE_PARKED)  /* stopped on the probe: read on */
             wait = !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
-        else if (c->sync)    /* after the M66 wait: the interpreter reads on */
-            wait = m->tau_s >= c->plan.total_time_s && !m->waiting &&
+        else if (c->sync)    /* after the M66 wait: the interpreter reads on (once the
+                              * jerk limiter's average has come to rest there) */
+            wait = m->tau_s >= c->plan.total_time_s && !m->waiting && motion_jerk_settled(m) &&
                    !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
         else if (!c->last && !m->tail_taken &&
                  !atomic_load_explicit(&c->next, memory_order_acquire) &&

@@ -16,7 +16,7 @@ import time
 
 ROOT = os.environ.get("HEXCNC_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("HEXCNC_BIN", os.path.join(ROOT, "bin", "hexcnc"))
-SIM = os.path.join(ROOT, "configs", "sim")
+SIM = os.environ.get("HEXCNC_SIM_DIR", os.path.join(ROOT, "configs", "sim"))
 FAILS = []
 
 
