@@ -16,8 +16,9 @@
 #define LIN_JERK 50000.0       /* mm/s^3, [TRAJ] MAX_LINEAR_JERK */
 #define ANG_JERK 30000.0       /* deg/s^3, [TRAJ] MAX_ANGULAR_JERK */
 
-/* One check of prog on ini, trapezoidal (jerk 0) or with the jerk limits above. */
-static int check_one(const char *ini, const char *prog, int jerk, struct check_result *r,
+/* One check of prog on ini, trapezoidal (scale 0) or with the jerk limits above times
+ * scale. */
+static int check_one(const char *ini, const char *prog, double jerk, struct check_result *r,
                      double *window_s)
 {
     char err[1024];
@@ -27,10 +28,10 @@ static int check_one(const char *ini, const char *prog, int jerk, struct check_r
         return -1;
     }
     if (jerk) {       /* the same machine with jerk limits: a new motion on the same limits */
-        mc->mcfg.max_lin_jerk_mm_s3 = LIN_JERK;
-        mc->mcfg.max_ang_jerk_deg_s3 = ANG_JERK;
+        mc->mcfg.max_lin_jerk_mm_s3 = jerk * LIN_JERK;
+        mc->mcfg.max_ang_jerk_deg_s3 = jerk * ANG_JERK;
         for (int i = 0; i < mc->mcfg.njoints; i++)
-            mc->mcfg.joint[i].max_jerk_mm_s3 = LEG_JERK;
+            mc->mcfg.joint[i].max_jerk_mm_s3 = jerk * LEG_JERK;
         motion_destroy(mc->motion);
         mc->motion = NULL;
         if (motion_create(&mc->mcfg, mc->kins, &mc->motion, err, sizeof err) != MOTION_OK) {
@@ -49,27 +50,27 @@ static int check_one(const char *ini, const char *prog, int jerk, struct check_r
     return st == CHECK_OK && !r->nproblems ? 0 : -1;
 }
 
-/* The largest ratio to its limit over the legs: speed, acceleration, jerk (to LEG_JERK). */
-static void peaks(const struct check_result *r, double out[3])
+/* The largest ratio to its limit over the legs: speed, acceleration, jerk (to jerk_mm_s3). */
+static void peaks(const struct check_result *r, double jerk_mm_s3, double out[3])
 {
     out[0] = out[1] = out[2] = 0;
     for (int i = 0; i < r->njoints; i++) {
         const struct check_leg *l = &r->leg[i];
         out[0] = fmax(out[0], l->peak_vel_mm_s / l->limit_vel_mm_s);
         out[1] = fmax(out[1], l->peak_acc_mm_s2 / l->limit_acc_mm_s2);
-        out[2] = fmax(out[2], l->peak_jerk_mm_s3 / LEG_JERK);
+        out[2] = fmax(out[2], l->peak_jerk_mm_s3 / jerk_mm_s3);
     }
 }
 
-/* Both checks of one program, one row. */
-static int row(const char *label, const char *ini, const char *prog)
+/* Both checks of one program (the jerk limits times scale), one row. */
+static int row(const char *label, const char *ini, const char *prog, double scale)
 {
     struct check_result t, j;
     double w0, w1, pt[3], pj[3];
-    if (check_one(ini, prog, 0, &t, &w0) || check_one(ini, prog, 1, &j, &w1))
+    if (check_one(ini, prog, 0, &t, &w0) || check_one(ini, prog, scale, &j, &w1))
         return -1;
-    peaks(&t, pt);
-    peaks(&j, pj);
+    peaks(&t, scale * LEG_JERK, pt);
+    peaks(&j, scale * LEG_JERK, pj);
     printf("%-22s %9.3f s %9.3f s %6.3fx   %4.2f %4.2f %7.2f   %4.2f %4.2f %5.2f\n", label,
            t.machining_time_s, j.machining_time_s, j.machining_time_s / t.machining_time_s,
            pt[0], pt[1], pt[2], pj[0], pj[1], pj[2]);
@@ -109,10 +110,15 @@ int main(int argc, char **argv)
            "ratio", "trap. v a j", "jerk-lim. v a j");
     int fail = 0;
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
-        fail |= row(progs[i].label, progs[i].ini, progs[i].prog);
+        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1);
     char label[64];
     snprintf(label, sizeof label, "dense, %d blocks", blocks);
-    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1);
+    printf("\nthe same with 4 x the jerk limits (a 10 ms moving average; jerk to 200000 "
+           "mm/s^3):\n");
+    fail |= row("TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc",
+                4);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4);
     unlink(dense);
     return fail ? 1 : 0;
 }

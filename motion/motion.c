@@ -173,6 +173,7 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);
+    motion_jerk_hold(m);               /* the average starts at rest where the program does */
     if (err && errlen)
         err[0] = 0;
     return MOTION_OK;
@@ -396,6 +397,7 @@ int motion_stream_attach(struct motion *m, struct motion_stream *s,
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);
+    motion_jerk_hold(m);               /* the average starts at rest where the program does */
     return MOTION_OK;
 }
 

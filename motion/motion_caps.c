@@ -156,7 +156,7 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
         return -1;
     across_path(sg, S, q, &perp, &ang);
     if (perp > 1e-15)
-        dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / perp);
+        dmax = sqrt(8 * motion_round_tol_mm(m, sg) / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
         dmax = fmin(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
     return dmax / setpoint_period(c);
@@ -171,12 +171,12 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
  *     (k f + |q_kin,perp|) d^2 / 8 <= KIN_TOL_SHARE tol,
  * and the same for A B C with the arc's A B C curvature kabc (blend arcs) and tol_deg. */
 double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
-                        const struct motion_sample *S, double k_mm, double kabc)
+                        const struct motion_sample *S, double k_mm, double kabc, double tol_mm)
 {
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0)
         return HUGE_VAL;
-    double qk[6] = {0}, perp = 0, ang = 0, tol = KIN_TOL_SHARE * c->kin_tol_mm;
+    double qk[6] = {0}, perp = 0, ang = 0, tol = tol_mm;
     if (m->nj == 6) {
         if (pose_curvature(m, S, qk) < 0)
             return -1;

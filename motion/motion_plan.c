@@ -38,13 +38,15 @@ static double knot_spacing(const struct motion_plan *p, const struct motion_seg 
 static double chord_cap(struct motion *m, const struct motion_seg *sg, double s,
                         const struct motion_sample *S)
 {
-    double eps = 1e-9 * (1 + sg->len), k = 0, kabc = 0;
+    double eps = 1e-9 * (1 + sg->len), k = 0, kabc = 0, tol = HUGE_VAL;
     for (int e = 0; e < 2; e++) {
         double from_end = e ? sg->len - s : s;
-        if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps)
+        if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps) {
             k = fmax(k, sg->chord_k[e]), kabc = fmax(kabc, sg->chord_kabc[e]);
+            tol = fmin(tol, sg->chord_tol[e]);
+        }
     }
-    return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc) : HUGE_VAL;
+    return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc, tol) : HUGE_VAL;
 }
 
 /* Caps of the knots of one segment: hard caps into kt, caps into kv, acceleration into iacc

@@ -71,8 +71,10 @@ struct motion_seg {
                               * seek loss of contact */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
-     * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
-    double chord_mm[2], chord_k[2], chord_kabc[2];
+     * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. The cut
+     * of such a chord stays within chord_tol (mm), the smallest rounding budget of those
+     * arcs (motion_round_tol_mm). */
+    double chord_mm[2], chord_k[2], chord_kabc[2], chord_tol[2];
     int tcp;                 /* tool centre point control: the path (start, end, arcs) is the
                               * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
                               * gives the platform's pose */
@@ -365,6 +367,22 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
  * use: 10 % is kept in hand for the terms they leave out. */
 #define KIN_TOL_SHARE 0.9
 
+/* With jerk limits, the share of a G64 tolerance P the rounding of the path by set-point
+ * chords and the moving average may use (the blend arcs keep to the rest of P, so blend and
+ * rounding together stay within P of the programmed path). */
+#define JERK_ROUND_SHARE 0.5
+
+/* How far the set-point chords (and with jerk limits the moving average) may cut a curve of
+ * segment sg, mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE; with jerk limits under G64 P, the
+ * larger JERK_ROUND_SHARE of P (motion_jerk.c). */
+static inline double motion_round_tol_mm(const struct motion *m, const struct motion_seg *sg)
+{
+    double t = KIN_TOL_SHARE * m->cfg.kin_tol_mm;
+    if (m->jerk && sg->blend_tol_mm > 0 && JERK_ROUND_SHARE * sg->blend_tol_mm > t)
+        t = JERK_ROUND_SHARE * sg->blend_tol_mm;
+    return t;
+}
+
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */
 #define JUMP_SHARE 0.5
 /* A joint that could be passed only as fast as full acceleration reaches in this many servo
@@ -393,10 +411,11 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
                      char *err, size_t errlen);
 /* The speed cap of a knot within reach of a set-point chord touching an arc of path
  * curvature k_mm (1/mm) and A B C curvature kabc (deg/mm^2): the chord's cut of the path
- * plus the legs' own deviation stay within KIN_TOL_SHARE of the tolerances. HUGE_VAL when
- * the bound is off; -1 when the pose is singular. */
+ * plus the legs' own deviation stay within tol_mm (motion_round_tol_mm of the arcs), and
+ * KIN_TOL_SHARE of the angular tolerance. HUGE_VAL when the bound is off; -1 when the pose
+ * is singular. */
 double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
-                        const struct motion_sample *S, double k_mm, double kabc);
+                        const struct motion_sample *S, double k_mm, double kabc, double tol_mm);
 
 /* Chords near arcs (motion_chord.c). Marks the path within reach of a set-point chord that
  * touches an arc (chord_mm, chord_k, chord_kabc of every segment) and puts a knot where

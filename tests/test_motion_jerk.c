@@ -53,6 +53,34 @@ static void square(struct canon_prog *p)
         tm_add(p, CANON_FEED, (int)i + 1, pts[i], 6000, 0);
 }
 
+/* Distance from q (X Y Z) to the program's path of lines and XY arcs turning either way
+ * (tm_dist_path takes arcs counter-clockwise only). */
+static double path_dist(const double *q, const struct canon_prog *p)
+{
+    double at[6], best = HUGE_VAL;
+    memcpy(at, p->start, sizeof at);
+    for (size_t i = 0; i < p->count; i++) {
+        const struct canon_cmd *c = &p->cmds[i];
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE) {
+            best = fmin(best, tm_dist_seg(q, at, c->end));
+        } else if (c->type == CANON_ARC) {
+            const double *o = c->arc.center;
+            double r = hypot(at[0] - o[0], at[1] - o[1]), dir = c->arc.rotation > 0 ? 1 : -1;
+            double a0 = atan2(at[1] - o[1], at[0] - o[0]);
+            double sweep = dir * (atan2(c->end[1] - o[1], c->end[0] - o[0]) - a0);
+            sweep -= 2 * M_PI * floor(sweep / (2 * M_PI));      /* 0 .. 2 pi, turning dir */
+            double aq = dir * (atan2(q[1] - o[1], q[0] - o[0]) - a0);
+            aq -= 2 * M_PI * floor(aq / (2 * M_PI));
+            double d = aq <= sweep ? hypot(hypot(q[0] - o[0], q[1] - o[1]) - r, q[2] - at[2])
+                                   : fmin(tm_dist_seg(q, at, at), tm_dist_seg(q, c->end, c->end));
+            best = fmin(best, d);
+        }
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE || c->type == CANON_ARC)
+            memcpy(at, c->end, sizeof at);
+    }
+    return best;
+}
+
 /* What a hook watches: the farthest the tool (forward kinematics of the commanded legs)
  * strays from the program's path, commands at given periods, and that a stopped state is
  * reported only once the legs stand still. */
@@ -76,7 +104,7 @@ static int watch_hook(struct motion *m, const struct motion_out *o, int step, vo
     ck_assert_int_eq(kins_forward(w->kins, o->joint_pos, P, NULL), KINS_OK);
     memcpy(w->guess, P, sizeof P);
     if (w->prog)
-        w->dev_mm = fmax(w->dev_mm, tm_dist_path(P, w->prog));
+        w->dev_mm = fmax(w->dev_mm, path_dist(P, w->prog));
     if (o->state == MOTION_PAUSED || o->state == MOTION_DONE || o->state == MOTION_IDLE) {
         for (int j = 0; j < o->njoints; j++)
             if (o->joint_pos[j] != w->prev_L[j])
@@ -229,15 +257,51 @@ START_TEST(test_small_arcs)
     tm_small_arcs(&p, 40, 4.0, 30, cases[_i].kink_deg, 6000, 645, cases[_i].tol_mm);
     struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
     struct watch wt = wj;
-    struct tm_stats sj = run(1, &p, &wj, 0), st = run(0, &p, &wt, 0);
+    struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
     ck_assert_int_eq(sj.last.state, MOTION_DONE);
     double r = assert_limits(&sj, "small arcs");
     double rt = 0;
     for (int j = 0; j < 6; j++)
         rt = fmax(rt, st.max_leg_j[j] / LEG_JERK);
+    /* blend arcs within half of P, the chords' and the average's rounding within the other
+     * half: the tool stays within P of the programmed arcs */
+    ck_assert_msg(wj.dev_mm <= cases[_i].tol_mm, "the tool strays %.5f mm from the path",
+                  wj.dev_mm);
     printf("small arcs, kinks %.0f deg, G64 P%.2f: jerk-limited %.3f s (peak leg jerk %.3f of "
-           "the limit) against trapezoidal %.3f s (%.1f x the limit): %.3f x the time\n",
-           cases[_i].kink_deg, cases[_i].tol_mm, sj.t_s, r, st.t_s, rt, sj.t_s / st.t_s);
+           "the limit, %.4f mm from the path) against trapezoidal %.3f s (%.1f x the limit, "
+           "%.4f mm): %.3f x the time\n", cases[_i].kink_deg, cases[_i].tol_mm, sj.t_s, r,
+           wj.dev_mm, st.t_s, rt, wt.dev_mm, sj.t_s / st.t_s);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* G64 corners between straight feeds (a zigzag of 10 mm lines turning 60 and 120 degrees):
+ * the blend arcs take half of P, the rounding the other half; the tool stays within P of the
+ * programmed corners, every limit kept. */
+START_TEST(test_blended_corners)
+{
+    static const double tols[] = { 0.01, 0.05 };
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double at[6] = { -40, 0, 645, 0, 0, 0 };
+    memcpy(p.start, at, sizeof at);
+    p.start_path_mode = 640;
+    p.start_path_tol_mm = tols[_i];
+    for (int i = 0; i < 10; i++) {
+        double a = (i % 2 ? -1 : 1) * (i % 4 < 2 ? 60 : 30) * M_PI / 180;
+        at[0] += 10 * cos(a), at[1] += 10 * sin(a);
+        tm_add(&p, CANON_FEED, i + 1, at, 6000, 0);
+    }
+    struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
+    struct watch wt = wj;
+    struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
+    ck_assert_int_eq(sj.last.state, MOTION_DONE);
+    double r = assert_limits(&sj, "blended corners");
+    ck_assert_msg(wj.dev_mm <= tols[_i], "the tool strays %.5f mm from the corners",
+                  wj.dev_mm);
+    printf("zigzag, G64 P%.2f: jerk-limited %.3f s (peak leg jerk %.3f of the limit, %.4f mm "
+           "from the programmed corners) against trapezoidal %.3f s (%.4f mm): %.3f x the "
+           "time\n", tols[_i], sj.t_s, r, wj.dev_mm, st.t_s, wt.dev_mm, sj.t_s / st.t_s);
     canon_prog_free(&p);
 }
 END_TEST
@@ -251,6 +315,7 @@ int main(void)
     tcase_add_test(tc, test_exact_stops);
     tcase_add_test(tc, test_hold_override_abort);
     tcase_add_loop_test(tc, test_small_arcs, 0, 3);
+    tcase_add_loop_test(tc, test_blended_corners, 0, 2);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
