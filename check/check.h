@@ -99,6 +99,10 @@ struct check_result {
                                       * tool tip's swing without G43.4): reported, the
                                       * program still passes */
     size_t nwarnings, capwarnings;
+    size_t *pindex, *windex;         /* hash slots of problems and warnings by kind, file,
+                                      * line and leg (entry + 1, 0 empty): merging stays
+                                      * O(1) when a program has warnings on every line */
+    size_t pindex_cap, windex_cap;
     int simulated;                   /* 1 if the program was run through motion */
     char program[256];               /* program path */
     char config[256];                /* INI path */

@@ -39,6 +39,7 @@ struct sim {
     int tip_swing;                     /* the move turns A B C (the tip may leave the line
                                         * the platform follows) and is not under G43.4 */
     double blk_tip_max;                /* the tip's largest deviation in this move, its line */
+    double blk_tip_tol;                /* and how far the planner may round the move, mm */
     int blk_tip_line;
     const char *blk_tip_file;
     long trace_every, trace_count;
@@ -118,16 +119,17 @@ static void tip_of(const struct sim *s, const struct motion_out *out, const doub
 static void tip_flush(struct sim *s)
 {
     struct check_result *r = s->r;
-    if (s->blk_tip_max > r->kin_tol_mm && r->kin_tol_mm > 0) {
+    if (s->blk_tip_max > s->blk_tip_tol && r->kin_tol_mm > 0) {
         struct check_problem p = { .kind = CHECK_TIP_DEVIATION, .line = s->blk_tip_line,
-                                   .leg = -1, .value = s->blk_tip_max, .limit = r->kin_tol_mm,
+                                   .leg = -1, .value = s->blk_tip_max, .limit = s->blk_tip_tol,
                                    .time_s = -1, .count = 1 };
         snprintf(p.file, sizeof p.file, "%s", s->blk_tip_file ? s->blk_tip_file : "");
         snprintf(p.message, sizeof p.message, "the tool tip leaves the straight line between "
                  "its positions at the move's ends by %.3f mm, over the tolerance of %.3f mm "
-                 "([TRAJ] KINEMATIC_TOLERANCE): the move turns A B C about the platform, not "
-                 "about the tip; program the tip under G43.4 to keep it on the line",
-                 s->blk_tip_max, r->kin_tol_mm);
+                 "(%s): the move turns A B C about the platform, not about the tip; program "
+                 "the tip under G43.4 to keep it on the line", s->blk_tip_max, s->blk_tip_tol,
+                 s->blk_tip_tol > r->kin_tol_mm ? "with jerk limits, half the G64 P"
+                                                : "[TRAJ] KINEMATIC_TOLERANCE");
         check_add_warning(r, &p);
     }
     s->blk_tip_max = 0;
@@ -162,6 +164,7 @@ static void tip_move(struct sim *s, const struct motion_out *out)
                                  out->seg_from[4] != out->seg_to[4] ||
                                  out->seg_from[5] != out->seg_to[5]);
     s->blk_tip_line = out->line, s->blk_tip_file = out->file;
+    s->blk_tip_tol = out->path_tol_mm;
 }
 
 /* The tip's deviation d of this period from its move's line, into the figures. */

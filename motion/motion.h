@@ -220,6 +220,9 @@ struct motion_out {
                                         * 3 a rapid, 0 none (a stop, or no program) ... */
     double seg_from[KINS_POSE_DIM];    /* ... from and to these path poses (the tool tip's */
     double seg_to[KINS_POSE_DIM];      /* under tcp): for checks of the path between them */
+    double path_tol_mm;                /* how far the planner lets that move's path be
+                                        * rounded, mm: KINEMATIC_TOLERANCE, or with jerk limits
+                                        * under G64 P the larger of it and half of P */
     double joint_pos[KINS_MAX_JOINTS]; /* leg position commands, mm */
     double joint_vel[KINS_MAX_JOINTS]; /* leg rate commands, mm/s */
     double motor_pos[KINS_MAX_JOINTS]; /* what the drives get: joint_pos + home offset, mm */

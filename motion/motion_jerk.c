@@ -40,7 +40,7 @@
 struct motion_jerk_meta {
     int line, seg_kind, tcp;
     const char *file;
-    double tool_len_mm;
+    double tool_len_mm, path_tol_mm;
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM];
 };
 
@@ -92,6 +92,7 @@ static void gather(const struct motion *m, double *x, struct motion_jerk_meta *m
     x[o] = m->dist_mm;
     mt->line = m->line, mt->seg_kind = m->seg_kind, mt->tcp = m->tcp, mt->file = m->file;
     mt->tool_len_mm = m->tool_len_mm;
+    mt->path_tol_mm = m->path_tol_mm;
     memcpy(mt->seg_from, m->seg_from, sizeof mt->seg_from);
     memcpy(mt->seg_to, m->seg_to, sizeof mt->seg_to);
 }
@@ -109,6 +110,7 @@ static void scatter(struct motion *m, const double *x, const struct motion_jerk_
     m->dist_mm = x[o];
     m->line = mt->line, m->seg_kind = mt->seg_kind, m->tcp = mt->tcp, m->file = mt->file;
     m->tool_len_mm = mt->tool_len_mm;
+    m->path_tol_mm = mt->path_tol_mm;
     memcpy(m->seg_from, mt->seg_from, sizeof m->seg_from);
     memcpy(m->seg_to, mt->seg_to, sizeof m->seg_to);
 }

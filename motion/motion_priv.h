@@ -246,6 +246,7 @@ struct motion {
     double tool_len_mm;      /* ... with this tool length */
     int seg_kind;            /* it is a line (1), an arc (2), a stop (0) ... */
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM]; /* ... from and to these poses */
+    double path_tol_mm;      /* ... rounded by at most this (motion_out) */
     double joint_cmd[KINS_MAX_JOINTS];
     double joint_vel[KINS_MAX_JOINTS];
     double ferror[KINS_MAX_JOINTS];

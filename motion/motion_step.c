@@ -392,6 +392,9 @@ static int evaluate(struct motion *m)
     m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
     memcpy(m->seg_from, sg->start, sizeof m->seg_from);
     memcpy(m->seg_to, sg->end, sizeof m->seg_to);
+    m->path_tol_mm = m->cfg.kin_tol_mm;
+    if (m->jerk && sg->blend_tol_mm > 0)
+        m->path_tol_mm = fmax(m->path_tol_mm, JERK_ROUND_SHARE * sg->blend_tol_mm);
     if (sg->tcp && vr == 0) {
         kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
@@ -637,6 +640,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->seg_kind = m->loaded ? m->seg_kind : 0;
     memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
     memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
+    out->path_tol_mm = m->path_tol_mm;
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
     memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
     for (int i = 0; i < m->nj; i++) {
