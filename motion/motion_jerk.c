@@ -49,10 +49,13 @@ struct motion_jerk {
     int head;                /* ring slot the next leader sample goes to */
     int primed;              /* the ring holds the leader's samples (0: at rest on last) */
     int still;               /* consecutive leader samples equal to the one before */
-    int since_sum;           /* samples since the sums were last recomputed from the ring */
+    int fresh_n;             /* samples in fresh since it was last taken as the sums */
     double *ring;            /* n x JERK_DIM leader samples */
     struct motion_jerk_meta *meta; /* n */
-    double sum[JERK_DIM];
+    double sum[JERK_DIM];    /* running sums of the window: the newest in, the oldest out */
+    double fresh[JERK_DIM];  /* the newest fresh_n samples summed anew: after n of them it is
+                              * the window's exact sum and replaces sum, so rounding never
+                              * accumulates (O(1) a period, no recount of the window) */
     double last[JERK_DIM];   /* the last output, or the pose held while not following */
     struct motion_jerk_meta last_meta;
 };
@@ -166,7 +169,8 @@ static void prime(struct motion_jerk *j)
         j->sum[d] = j->n * j->last[d];
     j->primed = 1;
     j->still = j->n - 1;
-    j->since_sum = 0;
+    memset(j->fresh, 0, sizeof j->fresh);
+    j->fresh_n = 0;
 }
 
 /* The leader's sample x in, the mean of the window into the motion. */
@@ -177,16 +181,14 @@ static void push(struct motion *m, const double *x, const struct motion_jerk_met
     const double *newest = j->ring + (size_t)((j->head + j->n - 1) % j->n) * JERK_DIM;
     j->still = memcmp(x, newest, JERK_DIM * sizeof *x) ? 0 : j->still + 1;
     for (int d = 0; d < JERK_DIM; d++)
-        j->sum[d] += x[d] - slot[d];
+        j->sum[d] += x[d] - slot[d], j->fresh[d] += x[d];
     memcpy(slot, x, JERK_DIM * sizeof *x);
     j->meta[j->head] = *mt;
     j->head = (j->head + 1) % j->n;
-    if (++j->since_sum >= j->n) {     /* rounding of the running sums does not accumulate */
-        memset(j->sum, 0, sizeof j->sum);
-        for (int k = 0; k < j->n; k++)
-            for (int d = 0; d < JERK_DIM; d++)
-                j->sum[d] += j->ring[(size_t)k * JERK_DIM + d];
-        j->since_sum = 0;
+    if (++j->fresh_n == j->n) {        /* fresh holds exactly the window now */
+        memcpy(j->sum, j->fresh, sizeof j->sum);
+        memset(j->fresh, 0, sizeof j->fresh);
+        j->fresh_n = 0;
     }
     if (j->still >= j->n - 1)           /* settled: exactly the leader's, not a rounded mean */
         memcpy(j->last, x, sizeof j->last);
