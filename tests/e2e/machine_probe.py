@@ -123,6 +123,13 @@ def main():
         c.ok("mdi.execute", line="G0 X0 Y0 Z645")
         c.wait()
         c.ok("hal.set", name="sim-probe.stuck", value=True)
+        # (the servo thread carries the pin to motion in its next period: on a loaded
+        # machine that can come after the program's start, as a real probe that closes
+        # the instant the cycle starts)
+        for _ in range(500):
+            if c.status()["probe"]["input"]:
+                break
+            ms.time.sleep(0.01)
         c.notes.clear()
         program(c, tmp, "stuck.ngc", "G21 G90 F300\nG38.2 Z600\nG0 X5\nM2\n")
         c.ok("program.run")
