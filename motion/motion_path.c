@@ -468,6 +468,13 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             }
             nseg0 = p->nseg;
         }
+        if (c->type == CANON_FEED && c->sync) {
+            snprintf(err, errlen, "%s:%d: %s follows the spindle, and this machine's spindle "
+                     "has no position feedback (spindle.0.revs is not connected)",
+                     c->file ? c->file : "program", c->line,
+                     c->sync == CANON_SYNC_THREAD ? "G33" : "G33.1");
+            return MOTION_ERR_PROGRAM;
+        }
         switch (c->type) {
         case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
         case CANON_PROBE: rc = add_probe(m, p, c, at); break;
