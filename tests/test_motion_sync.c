@@ -1,0 +1,244 @@
+/* test_motion_sync.c: G33 and G33.1 on the executor: the path position follows pitch x
+ * spindle revolutions from a whole revolution on, a rigid tap reverses the spindle at the
+ * bottom, follows it out and comes back to its start; and what the planner refuses. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tests/test_motion_util.h"
+
+#define DT 0.001                 /* servo period, s */
+#define ACC 1000.0               /* the trivial machine's path acceleration, mm/s^2 */
+#define SPINDLE_ACC 2000.0       /* rpm/s, the simulated spindle's and [SPINDLE_SYNC]'s */
+
+/* Appends a synchronised move (enum canon_sync kind) to end with pitch k_mm. */
+static void add_sync(struct canon_prog *p, int line, const double *end, int kind, double k_mm,
+                     double i_factor)
+{
+    struct canon_cmd c;
+    memset(&c, 0, sizeof c);
+    c.type = CANON_FEED;
+    c.line = line;
+    c.file = "test.ngc";
+    memcpy(c.end, end, sizeof c.end);
+    c.sync = kind;
+    c.pitch_mm_rev = c.pitch_word = k_mm;
+    c.retract_factor = i_factor;
+    c.feed_mm_min = 600;
+    if (canon_prog_sink(p, &c))
+        abort();
+}
+
+/* M3 S rpm, then a tap from top to bottom and back (as the interpreter makes G33.1). */
+static void tap_prog(struct canon_prog *p, const double *top, const double *bottom,
+                     double rpm, double k_mm, double i_factor)
+{
+    canon_prog_init(p);
+    memcpy(p->start, top, sizeof p->start);
+    tm_add(p, CANON_SPINDLE_SPEED, 1, NULL, 0, rpm);
+    tm_add(p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    add_sync(p, 2, bottom, CANON_SYNC_TAP_IN, k_mm, i_factor);
+    add_sync(p, 2, top, CANON_SYNC_TAP_OUT, k_mm, i_factor);
+    tm_add(p, CANON_PROGRAM_END, 3, NULL, 0, 2);
+}
+
+/* The simulated spindle (as sim-spindle): ramps to the commanded speed, integrates it to
+ * revolutions, which it gives motion as spindle.0.revs. Records what the run did. */
+struct spindle {
+    double rpm, revs;
+    int reversed, restored;      /* the command went to reverse, then forward again */
+    double z_min, z_end;
+    /* following: z + K revs is constant while the tool follows the spindle into the hole */
+    double k_mm, z_top, lo, hi, c_min, c_max;
+    int n_follow;
+};
+
+static int spindle_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct spindle *s = ctx;
+    (void)step;
+    double want = o->spindle.dir * o->spindle.rpm, diff = want - s->rpm, st = SPINDLE_ACC * DT;
+    double r0 = s->rpm;
+    s->rpm += fabs(diff) <= st ? diff : copysign(st, diff);
+    s->revs += 0.5 * (r0 + s->rpm) / 60.0 * DT;
+    motion_set_spindle_revs(m, s->revs, true);
+    if (o->spindle.dir < 0)
+        s->reversed = 1;
+    if (s->reversed && o->spindle.dir > 0)
+        s->restored = 1;
+    double z = o->pose[2];
+    s->z_min = fmin(s->z_min, z);
+    s->z_end = z;
+    /* into the hole, between lo and hi (past the catch-up, before the bottom): the pose is
+     * that of the revolutions of the period before (motion reads them, then steps) */
+    if (!s->reversed && z <= s->hi && z >= s->lo) {
+        double c = z + s->k_mm * (s->revs - (r0 + s->rpm) / 120.0 * DT);
+        s->c_min = fmin(s->c_min, c);
+        s->c_max = fmax(s->c_max, c);
+        s->n_follow++;
+    }
+    return 0;
+}
+
+static void open_trivial(struct tm_machine *mc)
+{
+    struct tk_cfg *c = tm_trivial_cfg();
+    tk_set(c, "SPINDLE_SYNC", "ACCELERATION", "2000");
+    tk_set(c, "SPINDLE_SYNC", "SPEED_MARGIN", "0.1");
+    ck_assert_int_eq(tm_open(mc, c, &kins_trivial_ops), 0);
+}
+
+/* A tap from Z10 to Z0 at K1.25, S600 on the spindle already at speed: into the hole the
+ * tool is where 1.25 mm x the revolutions since a whole one put it (within 1 um), the
+ * spindle is reversed at the bottom, the tool runs on while it stops (K x rps^2 / 2a: 1.25
+ * mm here) and no further, comes out, the spindle is set forward again, and the tool ends
+ * at rest at Z10, never over the path's acceleration. */
+START_TEST(test_tap_follows_spindle)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    struct spindle s = { .rpm = 600, .revs = 0.37, .z_min = 1e9, .k_mm = 1.25, .lo = 0.2,
+                         .hi = 8, .c_min = 1e9, .c_max = -1e9 };
+    motion_set_spindle_revs(mc.m, s.revs, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, spindle_hook, &s);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    ck_assert_int_gt(s.n_follow, 500);
+    ck_assert_msg(s.c_max - s.c_min < 0.001, "z + K revs spread %.6f mm", s.c_max - s.c_min);
+    /* the thread starts at a whole revolution: z = 10 - K (revs - n) */
+    double n = (10.0 - s.c_min) / -1.25;
+    ck_assert_msg(fabs(n - round(n)) < 0.002, "index at %.4f revolutions", n);
+    ck_assert(s.reversed && s.restored);
+    double run_on = 1.25 * 10.0 * 10.0 / (2 * SPINDLE_ACC / 60.0);
+    ck_assert_msg(s.z_min < -0.9 * run_on && s.z_min > -run_on - 0.05, "z min %.4f, run-on "
+                  "%.4f", s.z_min, run_on);
+    ck_assert_double_eq_tol(s.z_end, 10.0, 1e-9);
+    ck_assert_double_eq_tol(st.last.pose[2], 10.0, 1e-9);
+    ck_assert_int_eq(st.last.spindle.dir, 1);
+    ck_assert_double_eq_tol(st.last.spindle.rpm, 600, 1e-9);
+    ck_assert_msg(st.max_a_mm_s2 <= ACC * 1.001, "acceleration %.1f", st.max_a_mm_s2);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Without spindle.0.revs connected a program with G33.1 is refused before anything moves,
+ * naming the line and why. */
+START_TEST(test_no_feedback_refused)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    char err[400] = "";
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_ERR_PROGRAM);
+    ck_assert_msg(strstr(err, "test.ngc:2: G33.1") && strstr(err, "no position feedback"),
+                  "%s", err);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* S6000 x K1.25 = 125 mm/s (137.5 with the 10 % margin): more than the machine's 100 mm/s,
+ * refused at plan time naming the line and the speeds. */
+START_TEST(test_too_fast_refused)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 6000, 1.25, 1.0);
+    motion_set_spindle_revs(mc.m, 0, true);
+    char err[400] = "";
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_ERR_PROGRAM);
+    ck_assert_msg(strstr(err, "test.ngc:2: G33.1 at S6000 with K1.25 needs 137.50 mm/s") &&
+                  strstr(err, "can follow 100.00 mm/s"), "%s", err);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* Two G33 passes of one thread start at the same spindle angle: each waits for a whole
+ * revolution, so the spindle's revolutions at Z5 differ by a whole number between them. */
+struct pass_rec {
+    struct spindle sp;
+    double revs_at_5[2];
+    int pass;
+    double zprev;
+};
+
+static int pass_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct pass_rec *r = ctx;
+    spindle_hook(m, o, step, &r->sp);
+    double z = o->pose[2];
+    if (r->zprev > 5 && z <= 5 && r->pass < 2)
+        r->revs_at_5[r->pass++] = r->sp.revs - (5 - z) / (r->zprev - z) * (r->sp.rpm / 60 * DT);
+    r->zprev = z;
+    return 0;
+}
+
+START_TEST(test_passes_in_phase)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, top, sizeof top);
+    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
+    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    add_sync(&p, 2, bottom, CANON_SYNC_THREAD, 1.5, 1);
+    tm_add(&p, CANON_TRAVERSE, 3, top, 0, 0);
+    tm_add(&p, CANON_DWELL, 4, NULL, 0, 0.123);  /* the spindle goes on meanwhile */
+    add_sync(&p, 5, bottom, CANON_SYNC_THREAD, 1.5, 1);
+    tm_add(&p, CANON_PROGRAM_END, 6, NULL, 0, 2);
+    struct pass_rec r = { .sp = { .rpm = 600, .revs = 0.61, .z_min = 1e9, .k_mm = 1.5,
+                                  .lo = 100, .hi = -100 }, .zprev = 10 };
+    motion_set_spindle_revs(mc.m, r.sp.revs, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, pass_hook, &r);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    ck_assert_int_eq(r.pass, 2);
+    double dn = r.revs_at_5[1] - r.revs_at_5[0];
+    ck_assert_msg(dn > 1 && fabs(dn - round(dn)) < 0.002, "revolutions between passes %.4f",
+                  dn);
+    ck_assert_double_eq_tol(st.last.pose[2], 0, 1e-9);
+    ck_assert_msg(st.max_a_mm_s2 <= ACC * 1.001, "acceleration %.1f", st.max_a_mm_s2);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+static Suite *sync_suite(void)
+{
+    Suite *s = suite_create("motion_sync");
+    TCase *tc = tcase_create("core");
+    tcase_add_test(tc, test_tap_follows_spindle);
+    tcase_add_test(tc, test_no_feedback_refused);
+    tcase_add_test(tc, test_too_fast_refused);
+    tcase_add_test(tc, test_passes_in_phase);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(sync_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
