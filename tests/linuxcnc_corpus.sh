@@ -10,8 +10,8 @@
 # where rs274 or the programs are not installed.
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
-MIN_ACCEPTED=168     # of the programs rs274 accepts (measured: 168 of 169)
-MIN_IDENTICAL=167    # of those, motion identical to rs274's (measured: 167)
+MIN_ACCEPTED=169     # of the programs rs274 accepts (measured: 169 of 169)
+MIN_IDENTICAL=168    # of those, motion identical to rs274's (measured: 168)
 if ! command -v rs274 > /dev/null 2>&1 || [ ! -d /usr/share/linuxcnc/ncfiles ] ||
    [ ! -f /usr/share/doc/linuxcnc/examples/sample-configs/sim/sim.tbl ]; then
     echo "SKIP linuxcnc_corpus: rs274 or LinuxCNC's programs are not installed (linuxcnc-uspace)"
