@@ -255,6 +255,8 @@ static void sync_leave(struct motion *m, const struct motion_seg *sg, enum motio
     size_t k = sg->k0 + sg->nk;
     m->tau_s = m->run->kt[k < m->run->nknot ? k : k - 1];
     m->sync.phase = ph;
+    if (ph != SYNC_OUT)
+        m->rate = 0;                  /* at rest: a pause asked for meanwhile holds here */
 }
 
 /* An abort on a synchronised move: the path brakes where it is; at rest, stopped. */
@@ -264,9 +266,8 @@ static void sync_abort(struct motion *m, double dt)
     double dv = fmin(fabs(y->v_mm_s), y->acc_mm_s2 * dt), vn = y->v_mm_s - copysign(dv, y->v_mm_s);
     y->d_mm += 0.5 * (y->v_mm_s + vn) * dt;
     y->v_mm_s = vn;
-    m->rate = vn != 0 ? 1 : 0;        /* at rest: motion_step's abort ends it */
-    if (vn == 0)
-        y->phase = SYNC_IDLE;
+    m->rate = vn != 0 ? 1 : 0;        /* at rest: motion_step's abort ends it (the phase
+                                       * stays, so the pose stays where it stopped) */
 }
 
 /* The tap's phases after the way in (see the top of the file). */

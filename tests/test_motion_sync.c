@@ -222,6 +222,136 @@ START_TEST(test_passes_in_phase)
 }
 END_TEST
 
+/* An abort in the middle of the way in: the path brakes on its line within the path's
+ * acceleration (no longer following the spindle), the machine goes idle and the spindle is
+ * stopped. */
+struct abort_rec {
+    struct spindle sp;
+    int aborted;
+    double z_abort;
+};
+
+static int abort_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct abort_rec *r = ctx;
+    spindle_hook(m, o, step, &r->sp);
+    if (!r->aborted && o->pose[2] < 5) {
+        r->aborted = 1;
+        r->z_abort = o->pose[2];
+        motion_abort(m);
+    }
+    return 0;
+}
+
+START_TEST(test_abort_mid_tap)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    struct abort_rec r = { .sp = { .rpm = 600, .z_min = 1e9, .lo = 100, .hi = -100 } };
+    motion_set_spindle_revs(mc.m, 0, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, abort_hook, &r);
+    ck_assert(r.aborted);
+    ck_assert_int_eq(st.last.state, MOTION_IDLE);
+    /* 12.5 mm/s braked at 1000 mm/s^2: 0.078 mm further, one period's travel of slack */
+    double z = st.last.pose[2];
+    ck_assert_msg(z < r.z_abort && z > r.z_abort - 0.078 - 0.02, "stopped at %.4f after the "
+                  "abort at %.4f", z, r.z_abort);
+    ck_assert_msg(st.max_a_mm_s2 <= ACC * 1.001, "acceleration %.1f", st.max_a_mm_s2);
+    struct motion_out o;
+    motion_step(mc.m, DT, &o);         /* idle after the abort: the spindle is stopped */
+    ck_assert_int_eq(o.spindle.dir, 0);
+    ck_assert_double_eq_tol(o.pose[2], z, 1e-12);
+    ck_assert(!r.sp.reversed);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* hexcnc check's ideal spindle: no encoder, the commanded speed reached at [SPINDLE_SYNC]
+ * ACCELERATION (from rest here): the tap runs to its end, runs on K rps^2 / 2a past the
+ * bottom, and ends at its start with the spindle forward again. */
+START_TEST(test_ideal_spindle)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    motion_set_spindle_ideal(mc.m, true);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 2.0);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    double z_min = 1e9;
+    motion_step(mc.m, DT, &st.last);
+    for (int k = 0; k < 20000 && st.last.state == MOTION_RUNNING; k++) {
+        motion_step(mc.m, DT, &st.last);
+        z_min = fmin(z_min, st.last.pose[2]);
+    }
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    double run_on = 1.25 * 10.0 * 10.0 / (2 * SPINDLE_ACC / 60.0);
+    ck_assert_msg(-z_min > run_on - 0.001 && -z_min < run_on + 0.02, "z min %.4f", z_min);
+    ck_assert_double_eq_tol(st.last.pose[2], 10, 1e-9);
+    ck_assert_int_eq(st.last.spindle.dir, 1);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
+/* A pause in the middle of the way in waits until the tap is over (a tap cannot stop in the
+ * hole while the spindle turns): the tool comes out to its start and the machine pauses
+ * there, before the move after the tap. */
+static int pause_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct abort_rec *r = ctx;
+    spindle_hook(m, o, step, &r->sp);
+    if (!r->aborted && o->pose[2] < 5) {
+        r->aborted = 1;
+        motion_pause(m);
+    }
+    return o->state == MOTION_PAUSED;
+}
+
+START_TEST(test_pause_waits_for_tap)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    const double aside[6] = { 5, 0, 10, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    p.count--;                         /* the program's end goes after one more move */
+    tm_add(&p, CANON_TRAVERSE, 3, aside, 0, 0);
+    tm_add(&p, CANON_PROGRAM_END, 4, NULL, 0, 2);
+    struct abort_rec r = { .sp = { .rpm = 600, .z_min = 1e9, .lo = 100, .hi = -100 } };
+    motion_set_spindle_revs(mc.m, 0, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, pause_hook, &r);
+    ck_assert(r.aborted);
+    ck_assert_int_eq(st.last.state, MOTION_PAUSED);
+    ck_assert(r.sp.reversed && r.sp.restored);
+    ck_assert_msg(r.sp.z_min < -1.8, "the tap went to its bottom and beyond: %.4f", r.sp.z_min);
+    ck_assert_double_eq_tol(st.last.pose[2], 10, 1e-9);
+    ck_assert_double_eq_tol(st.last.pose[0], 0, 1e-9);
+    motion_resume(mc.m);
+    tm_run(mc.m, DT, 20000, &st, spindle_hook, &r.sp);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    ck_assert_double_eq_tol(st.last.pose[0], 5, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *sync_suite(void)
 {
     Suite *s = suite_create("motion_sync");
@@ -230,6 +360,9 @@ static Suite *sync_suite(void)
     tcase_add_test(tc, test_no_feedback_refused);
     tcase_add_test(tc, test_too_fast_refused);
     tcase_add_test(tc, test_passes_in_phase);
+    tcase_add_test(tc, test_abort_mid_tap);
+    tcase_add_test(tc, test_ideal_spindle);
+    tcase_add_test(tc, test_pause_waits_for_tap);
     suite_add_tcase(s, tc);
     return s;
 }
