@@ -44,7 +44,7 @@ def config(tmp, extra_hal):
     return path
 
 
-def run(tmp, ini, name, text):
+def run(tmp, ini, name, text, after=None):
     sock = os.path.join(tmp, "m.sock")
     if os.path.exists(sock):
         os.unlink(sock)
@@ -61,8 +61,22 @@ def run(tmp, ini, name, text):
     r = c.call("program.run")
     st = c.wait(120)
     msgs = c.messages() + ([r["error"]["message"]] if "error" in r else [])
+    if after:
+        after(c)
     ms.stop(p, c)
     return st, msgs
+
+
+def mdi_tap(c):
+    """MDI lines plan as a whole program: a tap from where the machine stands."""
+    for line in ("G0 X0 Y0 Z648", "S400 M4", "G33.1 Z644 K0.5 I2"):
+        c.ok("mdi.execute", line=line)
+        st = c.wait(60)
+    check("MDI G33.1 (under M4, out at twice the speed) ends done at its start, the spindle "
+          "turning backwards again", st["motion"] == "done" and
+          abs(st["machine_pose"]["commanded"][2] - 648) < 1e-9 and
+          st["spindle"]["direction"] == -1, (st["motion"], st["machine_pose"], st["spindle"],
+                                             c.messages()))
 
 
 def spread(values):
@@ -78,7 +92,7 @@ def tap_run(tmp):
                        "net spindle-revs => sampler.0.pin.2",
                        "net spindle-cmd => sampler.0.pin.3",
                        "addf sampler.0 servo-thread"])
-    st, msgs = run(tmp, ini, "tap.ngc", TAP)
+    st, msgs = run(tmp, ini, "tap.ngc", TAP, mdi_tap)
     check("the tap program ran to its end", st["motion"] == "done", (st["motion"], msgs))
     rows = [[float(v) for v in l.split()] for l in open(trace)]
     # the program: from the first period the spindle is commanded (S600 M3) on
