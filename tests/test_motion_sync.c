@@ -352,10 +352,87 @@ START_TEST(test_pause_waits_for_tap)
 }
 END_TEST
 
+/* Streamed (the machine session): 4,000 taps in one place, their ways in and out, cut into
+ * windows of about 2,048 commands wherever the planner likes: after a way in (then the way
+ * out is the next window's: so it was at all three cuts when this was written) or after a
+ * way out. Every tap reverses the
+ * spindle, none runs on deeper than its spindle's stop, and the program ends at the top. */
+struct stream_rec {
+    struct spindle sp;
+    struct motion_stream *s;
+    const struct canon_prog *p;
+    size_t next;
+    int reversals, last_dir;
+};
+
+static int stream_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct stream_rec *r = ctx;
+    spindle_hook(m, o, step, &r->sp);
+    if (o->spindle.dir < 0 && r->last_dir > 0)
+        r->reversals++;
+    r->last_dir = o->spindle.dir;
+    while (r->next < r->p->count && motion_stream_backlog(r->s) < 2) {
+        ck_assert_int_eq(motion_stream_add(r->s, &r->p->cmds[r->next++]), MOTION_OK);
+        if (r->next == r->p->count)
+            ck_assert_int_eq(motion_stream_finish(r->s), MOTION_OK);
+    }
+    return 0;
+}
+
+START_TEST(test_streamed_taps)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 9, 0, 0, 0 };
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, top, sizeof top);
+    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
+    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    enum { TAPS = 4000 };
+    for (int i = 0; i < TAPS; i++) {
+        add_sync(&p, 2 + i, bottom, CANON_SYNC_TAP_IN, 0.5, 1.0);
+        add_sync(&p, 2 + i, top, CANON_SYNC_TAP_OUT, 0.5, 1.0);
+    }
+    tm_add(&p, CANON_PROGRAM_END, 2 + TAPS, NULL, 0, 2);
+    motion_set_spindle_revs(mc.m, 0, true);
+    struct stream_rec r = { .sp = { .rpm = 600, .z_min = 1e9, .lo = 100, .hi = -100 },
+                            .p = &p, .last_dir = 1 };
+    char err[400] = "";
+    ck_assert_msg(motion_stream_create(mc.m, p.start, NULL, &r.s, err, sizeof err) ==
+                  MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_stream_attach(mc.m, r.s, NULL), MOTION_OK);
+    stream_hook(mc.m, &(struct motion_out){ .pose = { 0, 0, 10 }, .spindle = { .dir = 1,
+                                                                        .rpm = 600 } }, 1, &r);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 8000000, &st, stream_hook, &r);
+    ck_assert_msg(st.last.state == MOTION_DONE, "state %d: %s", st.last.state,
+                  motion_last_error(mc.m));
+    struct motion_stream_info si;
+    motion_stream_info(r.s, &si);
+    printf("streamed taps: %zu windows, %d reversals, %.1f s, deepest %.4f\n", si.windows,
+           r.reversals, st.t_s, r.sp.z_min);
+    ck_assert_uint_gt(si.windows, 2);
+    ck_assert_int_eq(r.reversals, TAPS);
+    double run_on = 0.5 * 10.0 * 10.0 / (2 * SPINDLE_ACC / 60.0);
+    ck_assert_msg(r.sp.z_min > 9 - run_on - 0.02 && r.sp.z_min < 9 - run_on + 0.001,
+                  "deepest %.4f", r.sp.z_min);
+    ck_assert_double_eq_tol(st.last.pose[2], 10, 1e-9);
+    ck_assert_msg(st.max_a_mm_s2 <= ACC * 1.001, "acceleration %.1f", st.max_a_mm_s2);
+    motion_stream_detach(mc.m);
+    motion_stream_destroy(r.s);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *sync_suite(void)
 {
     Suite *s = suite_create("motion_sync");
     TCase *tc = tcase_create("core");
+    tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_tap_follows_spindle);
     tcase_add_test(tc, test_no_feedback_refused);
     tcase_add_test(tc, test_too_fast_refused);
@@ -363,6 +440,7 @@ static Suite *sync_suite(void)
     tcase_add_test(tc, test_abort_mid_tap);
     tcase_add_test(tc, test_ideal_spindle);
     tcase_add_test(tc, test_pause_waits_for_tap);
+    tcase_add_test(tc, test_streamed_taps);
     suite_add_tcase(s, tc);
     return s;
 }
