@@ -263,7 +263,8 @@ static void sync_leave(struct motion *m, const struct motion_seg *sg, enum motio
 static void sync_abort(struct motion *m, double dt)
 {
     struct motion_sync *y = &m->sync;
-    double dv = fmin(fabs(y->v_mm_s), y->acc_mm_s2 * dt), vn = y->v_mm_s - copysign(dv, y->v_mm_s);
+    double dv = fmin(fabs(y->v_mm_s), y->acc_mm_s2 * dt);
+    double vn = y->v_mm_s - copysign(dv, y->v_mm_s);
     y->d_mm += 0.5 * (y->v_mm_s + vn) * dt;
     y->v_mm_s = vn;
     m->rate = vn != 0 ? 1 : 0;        /* at rest: motion_step's abort ends it (the phase
@@ -296,7 +297,7 @@ static void sync_tap(struct motion *m, const struct motion_seg *sg, double d_t, 
         break;
     case SYNC_RESTORING:              /* run-on above the start until it turns forward */
         follow(y, d_t, v_t, dt, NULL);
-        if (v_t * y->k_mm_rev / fabs(y->k_mm_rev) > 0 || y->v_mm_s >= 0)
+        if (v_t > 0 || y->v_mm_s >= 0)  /* (v_t > 0: turning the way in again) */
             y->phase = SYNC_PLACE;
         break;
     case SYNC_PLACE: {                /* not synchronised: back to the start, then rest */

@@ -130,6 +130,45 @@ START_TEST(test_tap_follows_spindle)
 }
 END_TEST
 
+/* Under M4 the same: the revolutions count down, the tap follows them, reverses the spindle
+ * to M3 at the bottom, and at the top sets M4 again, running on above the start while the
+ * spindle stops (as far as below the bottom: I is 1) before it goes back to the start. */
+static int z_max_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct spindle *s = ctx;
+    spindle_hook(m, o, step, s);
+    s->hi = fmax(s->hi, o->pose[2]);
+    return 0;
+}
+
+START_TEST(test_tap_m4)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    p.cmds[1].value = -1;              /* M4 */
+    struct spindle s = { .rpm = -600, .revs = 0.37, .z_min = 1e9, .lo = 100, .hi = -100 };
+    motion_set_spindle_revs(mc.m, s.revs, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, z_max_hook, &s);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    double run_on = 1.25 * 10.0 * 10.0 / (2 * SPINDLE_ACC / 60.0);
+    ck_assert_msg(s.z_min < -run_on + 0.001 && s.z_min > -run_on - 0.02, "z min %.4f",
+                  s.z_min);
+    ck_assert_msg(s.hi > 10 + run_on - 0.001 && s.hi < 10 + run_on + 0.02, "z max %.4f", s.hi);
+    ck_assert_double_eq_tol(st.last.pose[2], 10, 1e-9);
+    ck_assert_int_eq(st.last.spindle.dir, -1);
+    ck_assert_msg(st.max_a_mm_s2 <= ACC * 1.001, "acceleration %.1f", st.max_a_mm_s2);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* Without spindle.0.revs connected a program with G33.1 is refused before anything moves,
  * naming the line and why. */
 START_TEST(test_no_feedback_refused)
@@ -434,6 +473,7 @@ static Suite *sync_suite(void)
     TCase *tc = tcase_create("core");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_tap_follows_spindle);
+    tcase_add_test(tc, test_tap_m4);
     tcase_add_test(tc, test_no_feedback_refused);
     tcase_add_test(tc, test_too_fast_refused);
     tcase_add_test(tc, test_passes_in_phase);
