@@ -255,8 +255,14 @@ static void sync_leave(struct motion *m, const struct motion_seg *sg, enum motio
     size_t k = sg->k0 + sg->nk;
     m->tau_s = m->run->kt[k < m->run->nknot ? k : k - 1];
     m->sync.phase = ph;
-    if (ph != SYNC_OUT)
-        m->rate = 0;                  /* at rest: a pause asked for meanwhile holds here */
+    /* at rest with nothing synchronised to follow at once: a pause asked for meanwhile
+     * holds here (between G33s that follow each other it would let the spindle run ahead
+     * of the thread) */
+    const struct motion_plan *p = m->run;
+    bool chained = ph == SYNC_CHAIN && m->cs + 1 < p->nseg &&
+                   p->segs[m->cs + 1].sync == CANON_SYNC_THREAD;
+    if (ph != SYNC_OUT && !chained)
+        m->rate = 0;
 }
 
 /* An abort on a synchronised move: the path brakes where it is; at rest, stopped. */

@@ -351,7 +351,7 @@ static int pause_hook(struct motion *m, const struct motion_out *o, int step, vo
 {
     struct abort_rec *r = ctx;
     spindle_hook(m, o, step, &r->sp);
-    if (!r->aborted && o->pose[2] < 5) {
+    if (!r->aborted && o->pose[2] < (r->z_abort != 0 ? r->z_abort : 5)) {
         r->aborted = 1;
         motion_pause(m);
     }
@@ -467,6 +467,40 @@ START_TEST(test_streamed_taps)
 }
 END_TEST
 
+/* A pause during a G33 that another follows at once waits until the last of them has
+ * ended (at the corner between them the spindle would run ahead of the thread). */
+START_TEST(test_pause_after_chain)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, mid[6] = { 0, 0, 5, 0, 0, 0 };
+    const double out[6] = { 2, 0, 3, 0, 0, 0 }, aside[6] = { 5, 0, 10, 0, 0, 0 };
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, top, sizeof top);
+    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
+    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    add_sync(&p, 2, mid, CANON_SYNC_THREAD, 1.5, 1);
+    add_sync(&p, 3, out, CANON_SYNC_THREAD, 1.5 * sqrt(2), 1);
+    tm_add(&p, CANON_TRAVERSE, 4, aside, 0, 0);
+    tm_add(&p, CANON_PROGRAM_END, 5, NULL, 0, 2);
+    struct abort_rec r = { .sp = { .rpm = 600, .z_min = 1e9, .lo = 100, .hi = -100 },
+                           .z_abort = 8 };
+    motion_set_spindle_revs(mc.m, 0, true);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+    motion_start(mc.m);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 20000, &st, pause_hook, &r);    /* pauses once z < 8: on line 2 */
+    ck_assert(r.aborted);
+    ck_assert_int_eq(st.last.state, MOTION_PAUSED);
+    ck_assert_double_eq_tol(st.last.pose[0], 2, 1e-9);
+    ck_assert_double_eq_tol(st.last.pose[2], 3, 1e-9);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *sync_suite(void)
 {
     Suite *s = suite_create("motion_sync");
@@ -480,6 +514,7 @@ static Suite *sync_suite(void)
     tcase_add_test(tc, test_abort_mid_tap);
     tcase_add_test(tc, test_ideal_spindle);
     tcase_add_test(tc, test_pause_waits_for_tap);
+    tcase_add_test(tc, test_pause_after_chain);
     tcase_add_test(tc, test_streamed_taps);
     suite_add_tcase(s, tc);
     return s;
