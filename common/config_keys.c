@@ -276,9 +276,10 @@ const struct config_key config_keys[] = {
     { "SPINDLE_SYNC", "ACCELERATION", NUM, "rpm/s", "> 0", 0, 0, "", "how fast the spindle "
       "gains or loses speed: the path must follow it, and a rigid tap (G33.1) runs on past "
       "its bottom by K x the revolutions the spindle takes to stop before it reverses" },
-    { "SPINDLE_SYNC", "SPEED_MARGIN", NUM, "", ">= 0", 0, 0, "", "how much faster than "
+    { "SPINDLE_SYNC", "SPEED_MARGIN", NUM, "", "> 0", 0, 0, "", "how much faster than "
       "commanded the spindle may turn, as a fraction (0.1: 10 %); a synchronised move is "
-      "refused where the path or legs could not keep up with S x K at that speed" },
+      "refused where the path or legs could not keep up with S x K at that speed, and the "
+      "path catches up with the turning spindle at the margin's share of that speed" },
     /* [PROBE] */
     { "PROBE", "MODEL", ENUM, "", "NONE|PLANE|BOX", 0, 0, "NONE", "the workpiece G38.2..G38.5 "
       "probe in `hexcnc interp -i` and `hexcnc check`: NONE (as LinuxCNC's rs274: no trip, "

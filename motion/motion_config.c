@@ -195,7 +195,7 @@ static const struct motion_key {
     {"TRAJ", "BLEND_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, blend_tol_mm)},
     {"SPINDLE_SYNC", "ACCELERATION", 1, 0, 0,
      offsetof(struct motion_config, spindle_acc_rpm_s)},
-    {"SPINDLE_SYNC", "SPEED_MARGIN", 1, 1, 0,
+    {"SPINDLE_SYNC", "SPEED_MARGIN", 1, 0, 0,
      offsetof(struct motion_config, spindle_speed_margin)},
 };
 
