@@ -93,10 +93,10 @@ static int sync_check_run_on(struct motion *m, const struct motion_seg *sg, char
         motion_seg_pose(&m->plan, sg, s, P);
         int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, P, L);
         if (st != KINS_OK) {
-            snprintf(err, errlen, "%s:%d: %s: while the spindle reverses the tap runs on %.3f mm "
-                     "past %s (K x the revolutions it takes to stop at [SPINDLE_SYNC] "
-                     "ACCELERATION %g rpm/s), to X%.3f Y%.3f Z%.3f, which is out of reach "
-                     "(%s)", sg->file ? sg->file : "program", sg->line, sync_name(sg), run_on,
+            snprintf(err, errlen, "%s:%d: %s: the tap may run on %.3f mm past %s while the "
+                     "spindle stops to reverse ([SPINDLE_SYNC] ACCELERATION %g rpm/s); "
+                     "X%.3f Y%.3f Z%.3f on the way is out of reach (%s)",
+                     sg->file ? sg->file : "program", sg->line, sync_name(sg), run_on,
                      sg->sync == CANON_SYNC_TAP_IN ? "the bottom" : "the start",
                      m->cfg.spindle_acc_rpm_s, P[0], P[1], P[2], kins_strerror(st));
             return -2;

@@ -206,6 +206,26 @@ START_TEST(test_too_fast_refused)
 }
 END_TEST
 
+/* A tap whose run-on past the bottom (1.875 mm at S600 K1.25, checked with the margin and a
+ * fifth more) would leave the machine's reach (the trivial machine's Z stops at -1000) is
+ * refused at plan time, naming the line. */
+START_TEST(test_run_on_out_of_reach_refused)
+{
+    struct tm_machine mc;
+    open_trivial(&mc);
+    const double top[6] = { 0, 0, -990, 0, 0, 0 }, bottom[6] = { 0, 0, -999, 0, 0, 0 };
+    struct canon_prog p;
+    tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+    motion_set_spindle_revs(mc.m, 0, true);
+    char err[400] = "";
+    ck_assert_int_eq(motion_load(mc.m, &p, err, sizeof err), MOTION_ERR_PROGRAM);
+    ck_assert_msg(strstr(err, "test.ngc:2: G33.1: the tap may run on 2.722 mm past the bottom")
+                  && strstr(err, "out of reach"), "%s", err);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* Two G33 passes of one thread start at the same spindle angle: each waits for a whole
  * revolution, so the spindle's revolutions at Z5 differ by a whole number between them. */
 struct pass_rec {
@@ -510,6 +530,7 @@ static Suite *sync_suite(void)
     tcase_add_test(tc, test_tap_m4);
     tcase_add_test(tc, test_no_feedback_refused);
     tcase_add_test(tc, test_too_fast_refused);
+    tcase_add_test(tc, test_run_on_out_of_reach_refused);
     tcase_add_test(tc, test_passes_in_phase);
     tcase_add_test(tc, test_abort_mid_tap);
     tcase_add_test(tc, test_ideal_spindle);
