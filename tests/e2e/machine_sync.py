@@ -5,8 +5,10 @@ the legs' Z (kins.pose-fb-z, forward kinematics of the stepgens' feedback), the 
 (sim-spindle.revs) and the spindle command. From that record: into the hole and out again Z
 is the start less K x (revolutions since a whole one), the spindle is reversed at the bottom
 and set forward again at the top, the tool runs on past the bottom by the revolutions the
-spindle takes to stop and no further, and it ends where it started. Without spindle.0.revs
-connected the same program is refused before anything moves. Standard library only; run by
+spindle takes to stop and no further, and it ends where it started. Two G33 passes of one
+thread, a dwell apart, are in phase (a whole number of revolutions between them at one
+height). Without spindle.0.revs connected the same program is refused before anything
+moves. Standard library only; run by
 machine_sync.sh."""
 import os
 import shutil
@@ -27,6 +29,11 @@ G0 X0 Y0 Z%g
 S%g M3
 G33.1 Z%g K%g
 G0 X2
+G33 Z642 K1.5
+G0 Z650
+G4 P0.37
+G33 Z642 K1.5
+G0 Z650
 M2
 """ % (TOP, S, BOTTOM, K)
 
@@ -158,6 +165,19 @@ def tap_run(tmp):
           any(abs(z - TOP) < 1e-9 for z in zc[i_fwd:]) and
           abs(st["machine_pose"]["commanded"][2] - TOP) < 1e-9 and
           abs(st["machine_pose"]["commanded"][0] - 2) < 1e-9, st["machine_pose"])
+    # two G33 passes of one thread (K1.5 from Z650), a dwell of 0.37 s between them: each
+    # starts at a whole revolution, so where they cross Z645 the spindle's revolutions differ
+    # by a whole number
+    at = []
+    for i in range(max(i_fwd, 2), len(zc)):
+        if zc[i - 1] > 645 >= zc[i] and cmd[i] > 0:
+            f = (zc[i - 1] - 645) / (zc[i - 1] - zc[i])
+            at.append(revs[i - 2] + f * (revs[i - 1] - revs[i - 2]))
+    dn = at[1] - at[0] if len(at) == 2 else 0.5
+    print("     two G33 passes cross Z645 %.4f revolutions apart" % dn)
+    check("two G33 passes of a thread cross Z645 a whole number of revolutions apart (in "
+          "phase, within 0.001 rev)", len(at) == 2 and dn > 1 and abs(dn - round(dn)) < 0.001,
+          at)
 
 
 def refused_without_encoder(tmp):
