@@ -189,6 +189,22 @@ static void tip_period(struct sim *s, const struct motion_out *out)
     tip_record(s, out, motion_dist_seg(tip, s->tip_t0, s->tip_t1));
 }
 
+/* Distance of p from the line through a and b, mm: a synchronised move's tool runs on past
+ * its ends along it (a tap while the spindle reverses), which is no deviation. */
+static double dist_line(const double p[3], const double a[3], const double b[3])
+{
+    double d[3], n2 = 0, u = 0, e2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], n2 += d[i] * d[i];
+    if (!(n2 > 1e-24))
+        return motion_dist_seg(p, a, b);
+    for (int i = 0; i < 3; i++)
+        u += (p[i] - a[i]) * d[i];
+    for (int i = 0; i < 3; i++)
+        e2 += (p[i] - a[i] - u / n2 * d[i]) * (p[i] - a[i] - u / n2 * d[i]);
+    return sqrt(e2);
+}
+
 /* Kinematic deviation between the previous set point and this one: the legs at mid-chord
  * (where linear leg motion strays furthest) through the forward kinematics, distance from
  * the commanded chord. Returns the distance, mm, or -1 when the forward solve failed. */
@@ -221,7 +237,9 @@ static double deviation(struct sim *s, const struct motion_out *out, double *ang
         double tm[3], t0[3], t1[3];
         tip_of(s, out, P, tm);
         if (s->tip_line && !s->tip_fresh) {
-            tip_record(s, out, motion_dist_seg(tm, s->tip_t0, s->tip_t1));
+            tip_record(s, out, motion_sync_running(s->mc->motion) ?
+                       dist_line(tm, s->tip_t0, s->tip_t1) :
+                       motion_dist_seg(tm, s->tip_t0, s->tip_t1));
         } else if (out->seg_kind) {
             tip_of(s, out, s->p0, t0);
             tip_of(s, out, out->pose, t1);

@@ -104,6 +104,14 @@ struct motion_config {
                                      * program gives G64 without P (canon value 0) */
     int optional_stop;              /* [TRAJ] OPTIONAL_STOP: 1 = M1 pauses like M0 (default) */
     int num_dio, num_aio;           /* [EMCMOT] NUM_DIO, NUM_AIO: outputs M62..M68 may set */
+    /* Spindle-synchronised moves (G33, G33.1; motion_sync.c). NAN: not given, and a program
+     * with such a move is refused naming the key (they protect the thread and the tap). */
+    double spindle_acc_rpm_s;       /* [SPINDLE_SYNC] ACCELERATION: how fast the spindle
+                                     * changes speed, rpm/s (how far a tap runs on while the
+                                     * spindle reverses) */
+    double spindle_speed_margin;    /* [SPINDLE_SYNC] SPEED_MARGIN: how much faster than
+                                     * commanded the spindle may turn, a fraction (0.1: 10 %);
+                                     * the path's speed limits must hold at that speed */
     int njoints;                    /* joints configured (the kinematics' count) */
     struct motion_joint_config joint[KINS_MAX_JOINTS]; /* [JOINT_0..] */
 };
@@ -171,6 +179,18 @@ double motion_input_result(const struct motion *m, unsigned *seq);
  * acceleration limits, as a pause does. */
 void motion_set_probe_input(struct motion *m, bool on);
 /* (Until it is first called, as in `hexcnc check`, probe moves run as plain feeds.) */
+
+/* G33, G33.1: the spindle's position, revolutions (spindle.0.revs), this period, and whether
+ * anything gives it (wired: the pin is connected). A synchronised move's path position is
+ * its pitch times the revolutions since it began (motion_sync.c); without feedback such a
+ * program is refused when it is planned. */
+void motion_set_spindle_revs(struct motion *m, double revs, bool wired);
+/* `hexcnc check`: no spindle, an ideal one instead: it turns at the commanded speed, reached
+ * at [SPINDLE_SYNC] ACCELERATION, and synchronised moves follow it. */
+void motion_set_spindle_ideal(struct motion *m, bool on);
+/* Whether the path follows the spindle now: on a synchronised move, whose path may run on
+ * past its ends along its line (a tap while the spindle reverses). */
+bool motion_sync_running(const struct motion *m);
 struct motion_probe_result {
     int already;             /* G38.2/G38.4: the input was already as sought where the move
                               * starts (LinuxCNC's error); nothing moved */

@@ -110,7 +110,8 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
         int switched = moves && (c->tcp != at_tcp || len_c != at_len);
         if (moves)
             at_tcp = c->tcp, at_len = len_c;
-        if (c->type == CANON_FEED && !switched) {
+        if (c->type == CANON_FEED && !switched && !c->sync) {  /* (G33 follows the spindle:
+                                                                * never rounded) */
             double d[3] = {c->end[0] - at[0], c->end[1] - at[1], c->end[2] - at[2]};
             double len = sqrt(dot3(d, d));
             if (len > LINE_EPS_MM) {

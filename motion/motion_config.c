@@ -58,6 +58,8 @@ void motion_config_default(struct motion_config *c)
     c->optional_stop = 1;
     c->num_dio = c->num_aio = 4;
     c->njoints = 6;
+    c->spindle_acc_rpm_s = NAN;     /* no default: synchronised moves need them given */
+    c->spindle_speed_margin = NAN;
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         c->joint[i].max_vel_mm_s = 100;
         c->joint[i].max_acc_mm_s2 = 1000;
@@ -230,6 +232,10 @@ static const struct motion_key {
     {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_mm)},
     {"TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_deg)},
     {"TRAJ", "BLEND_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, blend_tol_mm)},
+    {"SPINDLE_SYNC", "ACCELERATION", 1, 0, 0,
+     offsetof(struct motion_config, spindle_acc_rpm_s)},
+    {"SPINDLE_SYNC", "SPEED_MARGIN", 1, 0, 0,
+     offsetof(struct motion_config, spindle_speed_margin)},
 };
 
 /* Reads [EMCMOT], [TRAJ] and [JOINT_n] through cfg (see motion.h). */

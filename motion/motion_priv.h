@@ -79,6 +79,12 @@ struct motion_seg {
                               * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
                               * gives the platform's pose */
     double tool_len_mm;
+    int sync;                /* SEG_LINE of G33/G33.1 (enum canon_sync): the spindle drives
+                              * the path position, not the plan's clock (motion_sync.c) */
+    double pitch_mm_rev;     /* K, mm of path per spindle revolution */
+    double retract_factor;   /* G33.1's I: the spindle's speed multiple for the way out */
+    double sync_rpm;         /* the commanded spindle speed at the move, rpm */
+    int sync_dir;            /* ... and its direction (1 M3, -1 M4) */
 };
 
 /* The planned program: segments and the velocity profile at knots along them. Interval i
@@ -135,6 +141,38 @@ struct motion_chunk {
                                         * executor went on into the tail) */
     _Atomic int retired;     /* the executor has left it (the planner may free it) */
     struct motion_chunk *newer; /* the planner's list */
+};
+
+/* Where a spindle-synchronised move is (motion_sync.c). */
+enum motion_sync_phase {
+    SYNC_IDLE,               /* not on a synchronised move */
+    SYNC_INDEX,              /* at rest at its start, waiting for the spindle to pass a
+                              * whole revolution (the index), so passes line up */
+    SYNC_FOLLOW,             /* d follows pitch x revolutions (into the hole, or a thread) */
+    SYNC_REVERSING,          /* G33.1 past the bottom: the spindle was told to reverse;
+                              * still following it while it stops and turns back */
+    SYNC_OUT,                /* G33.1 on the way out, following the reversed spindle */
+    SYNC_RESTORING,          /* past the start: the spindle was told its own direction
+                              * again; following it until it turns forward */
+    SYNC_PLACE,              /* not synchronised: back to the start, then rest */
+    SYNC_CHAIN,              /* a G33 ended; the next one, if it follows at once, goes on
+                              * from the same revolutions (no new index) */
+    SYNC_LEFT,               /* a tap ended: the plan's clock goes on from its end */
+};
+/* The executor's state of a synchronised move, servo thread only. d is the path position
+ * along the first move of the run (a G33.1's way in): the way out runs back along it. */
+struct motion_sync {
+    enum motion_sync_phase phase;
+    const struct motion_plan *run; /* the plan and segment being followed */
+    size_t seg;
+    double revs0;            /* revolutions where d is 0 */
+    double k_mm_rev;         /* pitch, mm/rev (signed with the spindle's direction) */
+    double d_mm, v_mm_s;     /* path position and speed along the move */
+    double len_mm;           /* the move's length (G33.1: the hole's depth) */
+    double vmax_mm_s, acc_mm_s2; /* speed and acceleration the follower keeps within */
+    int dir0;                /* the spindle's direction and speed before a tap reversed it */
+    double rpm0;
+    double revs_prev;        /* last period's revolutions (the spindle's speed) */
 };
 
 /* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
@@ -238,6 +276,12 @@ struct motion {
     int probe_halt;          /* enum motion_probe_phase of the move at probe_seg */
     struct motion_probe_result probe_res; /* the last probe move's result ... */
     _Atomic unsigned probe_seq;  /* ... published by counting probe moves answered */
+    /* G33/G33.1 (motion_sync.c), servo thread only but spindle_wired (set from there) */
+    double spindle_revs;     /* spindle.0.revs this period, revolutions */
+    _Atomic bool spindle_wired; /* spindle.0.revs is connected: synchronised moves may run */
+    bool spindle_ideal;      /* no encoder: an ideal spindle (hexcnc check) */
+    double ideal_rps;        /* the ideal spindle's speed, rev/s */
+    struct motion_sync sync;
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];
@@ -331,6 +375,16 @@ bool motion_jerk_settled(const struct motion *m);
  * set-point period T_s and the average's window T_j give the same cut as a set-point chord
  * of sqrt(T_s^2 + T_j^2 / 3) (a chord cuts q d^2 / 8, the average q (v T_j)^2 / 24). */
 double motion_chord_period(const struct motion_config *c);
+/* Spindle-synchronised moves (motion_sync.c). At plan time: whether the machine can follow
+ * the synchronised line sg (spindle feedback, the speed and acceleration the spindle's
+ * speed asks of path and legs, the reach of a tap's run-on); -2 with err naming file and
+ * line if not. On the executor: before the clock advances, drives a synchronised segment
+ * from the spindle (true when it did: the plan clock is left alone); in evaluate, the path
+ * position and speed there (true when on one). */
+int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
+                      size_t errlen);
+bool motion_sync_advance(struct motion *m, double dt);
+bool motion_sync_at(const struct motion *m, double *s, double *v);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

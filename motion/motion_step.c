@@ -306,7 +306,9 @@ static void advance(struct motion *m, double dt)
             return;
         }
     }
-    if (resting(p, m->ci, sg)) {
+    if (motion_sync_advance(m, dt))
+        ;                               /* the spindle drives the path (motion_sync.c) */
+    else if (resting(p, m->ci, sg)) {
         if (m->state == MOTION_RUNNING && !probe_halt)
             m->tau_s += dt;             /* a rest lasts its time whatever the override */
         else
@@ -374,6 +376,7 @@ static int evaluate(struct motion *m)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
     plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+    motion_sync_at(m, &s, &vp);        /* a synchronised move: where the spindle has it */
     if (m->state == MOTION_DONE) {
         s = sg->len;
         vp = 0;

@@ -564,11 +564,8 @@ def homing_ini(tmp):
                 "net leg-%d-fb => sim-home.%d.motor-pos" % (i, i),
                 "net home-sw-%d sim-home.%d.home-sw => motion.joint-home-sw-in-%d" % (i, i, i)]
     hal.append("addf sim-home.update servo-thread")
-    # a spindle that takes 0.5 s to reach 1000 rpm, its at-speed wired back to motion
-    hal += ["loadrt sim-spindle",
-            "net spindle-cmd spindle.0.speed-out => sim-spindle.speed-in",
-            "net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed",
-            "addf sim-spindle.update servo-thread"]
+    # the sim config's spindle (0.5 s to reach 1000 rpm), its at-speed wired back to motion
+    hal += ["net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed"]
     # a tool changer that takes 0.5 s to prepare and 2 s to change
     hal += ["loadrt sim-toolchanger",
             "net tool-prepare iocontrol.0.tool-prepare => sim-toolchanger.prepare",
