@@ -28,7 +28,8 @@
  * keeps within KINEMATIC_TOLERANCE together with the set-point chords (motion_chord_period).
  * Where the path changes direction at a stop the leader rests T (motion_plan.c), so the mean
  * comes to rest exactly on the corner. The machine counts as stopped (paused, done, idle,
- * parked on a probe trip) only once the mean has settled on the leader.
+ * parked on a probe trip) only once the mean has settled on the leader. Spindle-synchronised
+ * moves (G33, G33.1) bypass the mean: their jerk is the spindle's.
  */
 
 /* Values averaged, in this order: pose, pose rate, path pose, legs, leg rates, path speed,
@@ -205,6 +206,14 @@ void motion_jerk_follow(struct motion *m)
     struct motion_jerk *j = m->jerk;
     if (!j)
         return;
+    if (motion_sync_direct(m)) {
+        /* a synchronised move follows the spindle itself: a lag of T/2 would put the tool
+         * off the thread, by a different amount on the way out of a tap than on the way in.
+         * It starts and ends at rest, with the average settled (motion_sync.c), so the
+         * average stands aside and starts again from where it ends. */
+        motion_jerk_hold(m);
+        return;
+    }
     double x[JERK_DIM];
     struct motion_jerk_meta mt;
     gather(m, x, &mt);

@@ -385,6 +385,9 @@ int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
                       size_t errlen);
 bool motion_sync_advance(struct motion *m, double dt);
 bool motion_sync_at(const struct motion *m, double *s, double *v);
+/* Whether the spindle drives the path now (following it, or a tap's own moves between): the
+ * jerk limiter's moving average stands aside, so the tool keeps its place on the thread. */
+bool motion_sync_direct(const struct motion *m);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

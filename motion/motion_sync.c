@@ -51,6 +51,12 @@ void motion_set_spindle_ideal(struct motion *m, bool on)
         m->spindle_ideal = on;
 }
 
+bool motion_sync_direct(const struct motion *m)
+{
+    return m->sync.phase != SYNC_IDLE && m->sync.phase != SYNC_INDEX &&
+           m->sync.phase != SYNC_LEFT;
+}
+
 bool motion_sync_running(const struct motion *m)
 {
     return m && m->sync.phase != SYNC_IDLE && m->sync.phase != SYNC_CHAIN &&
@@ -332,7 +338,9 @@ bool motion_sync_advance(struct motion *m, double dt)
         sync_enter(m, sg);
     double revs = m->spindle_revs, rps = (revs - y->revs_prev) / dt;
     if (y->phase == SYNC_INDEX) {
-        bool go = m->state == MOTION_RUNNING && sync_index(y, revs);
+        /* (with jerk limits, once the moving average has come to rest here: the move then
+         * follows the spindle without it, motion_jerk.c) */
+        bool go = m->state == MOTION_RUNNING && motion_jerk_settled(m) && sync_index(y, revs);
         y->revs_prev = revs;
         if (!go) {
             m->rate = 0;              /* at rest: a pause or an abort may take it here */

@@ -1,8 +1,9 @@
 #!/bin/sh
-# jerk_session.sh: the machine session's and the probing end-to-end runs again on the simulated
-# TMU with jerk limits ([TRAJ] MAX_LINEAR_JERK, MAX_ANGULAR_JERK, [JOINT_n] MAX_JERK added to
+# jerk_session.sh: the machine session's, probing and rigid-tapping end-to-end runs again on the
+# simulated TMU with jerk limits ([TRAJ] MAX_LINEAR_JERK, MAX_ANGULAR_JERK, [JOINT_n] MAX_JERK added to
 # a copy of configs/sim): streaming, holds, aborts, M66 and tool waits, MDI, probing and jogs
-# behave as without them. Needs HEXCNC_ROOT and HEXCNC_BIN (make test sets them).
+# behave as without them; a tap follows the spindle as without them (the moving average stands
+# aside on synchronised moves). Needs HEXCNC_ROOT and HEXCNC_BIN (make test sets them).
 set -u
 root=${HEXCNC_ROOT:-.}
 py=/usr/bin/python3
@@ -19,4 +20,5 @@ export HEXCNC_SIM_DIR="$tmp/sim"
 fail=0
 "$py" "$root/tests/e2e/machine_session.py" || fail=1
 "$py" "$root/tests/e2e/machine_probe.py" || fail=1
+"$py" "$root/tests/e2e/machine_sync.py" || fail=1
 exit $fail
