@@ -30,9 +30,19 @@ class Conn:
     """One client: requests by id, notifications kept aside."""
 
     def __init__(self, path):
-        self.s = socket.socket(socket.AF_UNIX)
-        self.s.settimeout(30)
-        self.s.connect(path)
+        # (the socket's file appears at bind(), a moment before listen(): on a loaded
+        # machine a client may come in between; it tries again for up to 5 s)
+        for attempt in range(500):
+            self.s = socket.socket(socket.AF_UNIX)
+            self.s.settimeout(30)
+            try:
+                self.s.connect(path)
+                break
+            except ConnectionRefusedError:
+                self.s.close()
+                if attempt == 499:
+                    raise
+                time.sleep(0.01)
         self.buf = b""
         self.notes = []
         self.id = 0
