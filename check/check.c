@@ -14,6 +14,7 @@ static const char *const kind_names[CHECK_KIND_COUNT] = {
     [CHECK_LEG_RANGE] = "leg_range",
     [CHECK_LEG_VELOCITY] = "leg_velocity",
     [CHECK_LEG_ACCELERATION] = "leg_acceleration",
+    [CHECK_LEG_JERK] = "leg_jerk",
     [CHECK_SINGULAR] = "singular",
     [CHECK_PLAN] = "plan",
     [CHECK_TIP_DEVIATION] = "tip_deviation",
@@ -44,19 +45,67 @@ void check_result_free(struct check_result *r)
 {
     free(r->problems);
     free(r->warnings);
+    free(r->pindex);
+    free(r->windex);
     r->problems = r->warnings = NULL;
+    r->pindex = r->windex = NULL;
+    r->pindex_cap = r->windex_cap = 0;
     r->nproblems = r->capproblems = r->nwarnings = r->capwarnings = 0;
 }
 
-/* Adds or merges a problem (same kind, file, line and leg) in a list. */
-static int add_to(struct check_problem **list, size_t *n, size_t *capn,
-                  const struct check_problem *p)
+/* Hash of what makes two problems one: kind, file, line, leg. */
+static size_t problem_hash(const struct check_problem *p)
 {
-    for (size_t i = 0; i < *n; i++) {
-        struct check_problem *q = &(*list)[i];
-        if (q->kind != p->kind || q->line != p->line || q->leg != p->leg ||
-            strcmp(q->file, p->file) != 0)
-            continue;
+    size_t h = 1469598103934665603ULL;
+    for (const char *c = p->file; *c; c++)
+        h = (h ^ (unsigned char)*c) * 1099511628211ULL;
+    h = (h ^ (size_t)p->kind) * 1099511628211ULL;
+    h = (h ^ (size_t)(unsigned)p->line) * 1099511628211ULL;
+    return (h ^ (size_t)(unsigned)p->leg) * 1099511628211ULL;
+}
+
+static int same_problem(const struct check_problem *q, const struct check_problem *p)
+{
+    return q->kind == p->kind && q->line == p->line && q->leg == p->leg &&
+           strcmp(q->file, p->file) == 0;
+}
+
+/* The slot of p in the index (open addressing; cap a power of two): its entry's or the empty
+ * one where it goes. */
+static size_t *index_slot(size_t *index, size_t cap, const struct check_problem *list,
+                          const struct check_problem *p)
+{
+    size_t i = problem_hash(p) & (cap - 1);
+    while (index[i] && !same_problem(&list[index[i] - 1], p))
+        i = (i + 1) & (cap - 1);
+    return &index[i];
+}
+
+/* Rebuilds the index at twice the entries' count at least, 64 slots or more. */
+static int index_grow(size_t **index, size_t *cap, const struct check_problem *list, size_t n)
+{
+    size_t nc = 64;
+    while (nc < 4 * (n + 1))
+        nc *= 2;
+    size_t *ni = calloc(nc, sizeof *ni);
+    if (!ni)
+        return CHECK_ERR_NOMEM;
+    for (size_t k = 0; k < n; k++)
+        *index_slot(ni, nc, list, &list[k]) = k + 1;
+    free(*index);
+    *index = ni, *cap = nc;
+    return CHECK_OK;
+}
+
+/* Adds or merges a problem (same kind, file, line and leg) in a list. */
+static int add_to(struct check_problem **list, size_t *n, size_t *capn, size_t **index,
+                  size_t *capi, const struct check_problem *p)
+{
+    if (2 * (*n + 1) > *capi && index_grow(index, capi, *list, *n) != CHECK_OK)
+        return CHECK_ERR_NOMEM;
+    size_t *slot = index_slot(*index, *capi, *list, p);
+    if (*slot) {
+        struct check_problem *q = &(*list)[*slot - 1];
         int count = q->count + p->count;
         if (fabs(p->value) > fabs(q->value))  /* keep the worst occurrence's figures */
             *q = *p;
@@ -71,17 +120,19 @@ static int add_to(struct check_problem **list, size_t *n, size_t *capn,
         *list = np, *capn = cap;
     }
     (*list)[(*n)++] = *p;
+    *slot = *n;
     return CHECK_OK;
 }
 
 int check_add_problem(struct check_result *r, const struct check_problem *p)
 {
-    return add_to(&r->problems, &r->nproblems, &r->capproblems, p);
+    return add_to(&r->problems, &r->nproblems, &r->capproblems, &r->pindex, &r->pindex_cap, p);
 }
 
 int check_add_warning(struct check_result *r, const struct check_problem *p)
 {
-    return add_to(&r->warnings, &r->nwarnings, &r->capwarnings, p);
+    return add_to(&r->warnings, &r->nwarnings, &r->capwarnings, &r->windex, &r->windex_cap,
+                  p);
 }
 
 /* The file and line a motion message names ("file:line: ..."), line 0 when it names none. */

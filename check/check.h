@@ -46,6 +46,7 @@ enum check_kind {
     CHECK_PLAN,              /* the planner refused the program for another reason */
     CHECK_TIP_DEVIATION,     /* a warning: the tool tip leaves a straight feed's line
                               * beyond KINEMATIC_TOLERANCE (A B C turned without G43.4) */
+    CHECK_LEG_JERK,          /* a leg's jerk exceeds [JOINT_n] MAX_JERK (when set) */
     CHECK_KIND_COUNT
 };
 const char *check_kind_name(enum check_kind k);
@@ -69,6 +70,8 @@ struct check_leg {
     double min_mm, max_mm;           /* shortest and longest commanded length, mm */
     double peak_vel_mm_s;            /* largest |rate| from successive set points, mm/s */
     double peak_acc_mm_s2;           /* largest |change of rate| per period, mm/s^2 */
+    double peak_jerk_mm_s3;          /* largest |change of acceleration| per period, mm/s^3 */
+    double limit_jerk_mm_s3;         /* [JOINT_n] MAX_JERK, mm/s^3 (0: none) */
     double limit_min_mm, limit_max_mm, limit_vel_mm_s, limit_acc_mm_s2; /* from the INI */
     const char *vel_key, *acc_key;   /* the INI keys of the rate limits: MAX_VELOCITY, or
                                       * STEPGEN_MAXVEL when the drive's limit is lower */
@@ -96,6 +99,10 @@ struct check_result {
                                       * tool tip's swing without G43.4): reported, the
                                       * program still passes */
     size_t nwarnings, capwarnings;
+    size_t *pindex, *windex;         /* hash slots of problems and warnings by kind, file,
+                                      * line and leg (entry + 1, 0 empty): merging stays
+                                      * O(1) when a program has warnings on every line */
+    size_t pindex_cap, windex_cap;
     int simulated;                   /* 1 if the program was run through motion */
     char program[256];               /* program path */
     char config[256];                /* INI path */

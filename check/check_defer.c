@@ -50,6 +50,22 @@ static void tip_at(const struct check_defer *d, double len_mm, const double pose
     memcpy(tip, prog, 3 * sizeof *tip);
 }
 
+/* Distance of p from the line through a and b, mm: a synchronised move's tool runs on past
+ * its ends along it (a tap while the spindle reverses), which is no deviation. */
+static double dist_line(const double p[3], const double a[3], const double b[3])
+{
+    double d[3], n2 = 0, u = 0, e2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], n2 += d[i] * d[i];
+    if (!(n2 > 1e-24))
+        return motion_dist_seg(p, a, b);
+    for (int i = 0; i < 3; i++)
+        u += (p[i] - a[i]) * d[i];
+    for (int i = 0; i < 3; i++)
+        e2 += (p[i] - a[i] - u / n2 * d[i]) * (p[i] - a[i] - u / n2 * d[i]);
+    return sqrt(e2);
+}
+
 /* Kinematic deviation between two set points: the legs at mid-chord (where linear leg motion
  * strays furthest) through the forward kinematics, distance from the commanded chord; the
  * tip of those legs against its move's line or the chord between the set points' tips. */
@@ -85,6 +101,8 @@ static void deviation(const struct check_defer *d, struct check_defer_slot *s)
     tip_at(d, s->tool_len_mm, P, tm);
     if (s->tip_mode == CHECK_TIP_LINE) {
         s->tip = motion_dist_seg(tm, s->t0, s->t1);
+    } else if (s->tip_mode == CHECK_TIP_AXIS) {
+        s->tip = dist_line(tm, s->t0, s->t1);
     } else {
         tip_at(d, s->tool_len_mm, p0, t0);
         tip_at(d, s->tool_len_mm, p1, t1);

@@ -21,7 +21,9 @@ enum check_defer_kind {
 };
 enum check_defer_state { CHECK_DEFER_WAITING, CHECK_DEFER_DONE };
 /* How a deviation measures the tip of the interpolated legs. */
-enum check_defer_tip { CHECK_TIP_NONE, CHECK_TIP_LINE /* against t0 t1 */,
+enum check_defer_tip { CHECK_TIP_NONE, CHECK_TIP_LINE /* against the segment t0 t1 */,
+                       CHECK_TIP_AXIS /* against the line through t0 t1 (a synchronised
+                                       * move's tool runs on past its ends along it) */,
                        CHECK_TIP_CHORD /* against the chord between the set points' tips */ };
 
 /* One measure: what the pass took (written before commit, read-only after) and the result
@@ -37,9 +39,10 @@ struct check_defer_slot {
     double L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS];
     enum check_defer_tip tip_mode;
     double tool_len_mm;              /* the tool of the period, for the tip */
-    double t0[3], t1[3];             /* CHECK_TIP_LINE and TIP: the move's tip line */
+    double t0[3], t1[3];             /* CHECK_TIP_LINE, _AXIS and TIP: the move's tip line */
     int ok;                          /* result: the solve succeeded */
-    double value;                    /* deviation (mm), condition number, tip's (mm) */
+    double value;                    /* deviation (mm), condition number, tip's (mm);
+                                      * MOVE: how far the planner may round the move, mm */
     double value2;                   /* deviation: the orientation's, deg */
     double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
 };

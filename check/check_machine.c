@@ -116,6 +116,7 @@ int check_machine_open(const char *ini, struct check_machine **out, char *err, s
                   inifile_locate_msg(hal_ini_file(mc->hal), msg, where, sizeof where));
         goto fail;
     }
+    motion_set_spindle_ideal(mc->motion, true);  /* G33, G33.1: no encoder, an ideal one */
     mc->cond_limit = 100;
     if (hal_ini_double(mc->hal, "KINS", "SINGULAR_CONDITION", 100, &mc->cond_limit) ==
         HAL_ERR_SYNTAX) {

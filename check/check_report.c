@@ -48,6 +48,8 @@ static void json_legs(const struct check_result *r, FILE *f)
         json_field(f, "max_mm", l->max_mm, 0);
         json_field(f, "peak_vel_mm_s", l->peak_vel_mm_s, 0);
         json_field(f, "peak_acc_mm_s2", l->peak_acc_mm_s2, 0);
+        json_field(f, "peak_jerk_mm_s3", l->peak_jerk_mm_s3, 0);
+        json_field(f, "limit_jerk_mm_s3", l->limit_jerk_mm_s3, 0);
         json_field(f, "limit_min_mm", l->limit_min_mm, 0);
         json_field(f, "limit_max_mm", l->limit_max_mm, 0);
         json_field(f, "limit_vel_mm_s", l->limit_vel_mm_s, 0);
@@ -158,13 +160,17 @@ void check_print_table(const struct check_result *r, FILE *f)
         schedule(when, sizeof when, r->condition_every_s, moved);
         fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
                 r->max_condition, r->max_condition_line, r->condition_limit, when);
-        fputs("leg   min mm     max mm     range mm         peak mm/s  limit   "
-              "peak mm/s^2  limit\n", f);
+        int jerk = r->njoints > 0 && r->leg[0].limit_jerk_mm_s3 > 0;
+        fprintf(f, "leg   min mm     max mm     range mm         peak mm/s  limit   "
+                "peak mm/s^2  limit%s\n", jerk ? "    peak mm/s^3     limit" : "");
         for (int i = 0; i < r->njoints; i++) {
             const struct check_leg *l = &r->leg[i];
-            fprintf(f, "%-3d %9.3f  %9.3f  %6.1f..%-7.1f %9.3f  %6.1f  %11.3f  %6.1f\n", i + 1,
+            fprintf(f, "%-3d %9.3f  %9.3f  %6.1f..%-7.1f %9.3f  %6.1f  %11.3f  %6.1f", i + 1,
                     l->min_mm, l->max_mm, l->limit_min_mm, l->limit_max_mm, l->peak_vel_mm_s,
                     l->limit_vel_mm_s, l->peak_acc_mm_s2, l->limit_acc_mm_s2);
+            if (jerk)
+                fprintf(f, "  %13.0f  %8.0f", l->peak_jerk_mm_s3, l->limit_jerk_mm_s3);
+            fputc('\n', f);
         }
         fputc('\n', f);
     } else {

@@ -22,6 +22,8 @@ struct sim {
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
     double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s (the
                                         * machine starts at rest: 0) */
+    double a0[KINS_MAX_JOINTS];        /* leg acceleration of the previous period, mm/s^2 */
+    double jerk_thr[KINS_MAX_JOINTS];  /* jerk beyond which a leg is over (HUGE_VAL: none) */
     double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
     double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
@@ -38,6 +40,7 @@ struct sim {
     int tip_swing;                     /* the move turns A B C (the tip may leave the line
                                         * the platform follows) and is not under G43.4 */
     double blk_tip_max;                /* the tip's largest deviation in this move, its line */
+    double blk_tip_tol;                /* and how far the planner may round the move, mm */
     int blk_tip_line;
     const char *blk_tip_file;
     long trace_every, trace_count;
@@ -55,12 +58,15 @@ static void leg_limit(struct sim *s, const struct motion_out *out, enum check_ki
     struct check_problem p = { .kind = k, .line = out->line, .leg = leg, .value = value,
                                .limit = limit, .time_s = t_s, .count = 1 };
     snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
-    const char *what = k == CHECK_LEG_VELOCITY ? "moves at" : "accelerates at";
-    const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : "mm/s^2";
+    const char *what = k == CHECK_LEG_VELOCITY ? "moves at"
+                       : k == CHECK_LEG_JERK ? "changes its acceleration at" : "accelerates at";
+    const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : k == CHECK_LEG_JERK ? "mm/s^3"
+                                                                              : "mm/s^2";
     const struct check_leg *lg = &s->r->leg[leg];
     snprintf(p.message, sizeof p.message, "leg %d %s %.3f %s, over its limit of %.3f %s "
              "([JOINT_%d] %s) at %.3f s", leg + 1, what, value, unit, limit, unit, leg,
-             k == CHECK_LEG_VELOCITY ? lg->vel_key : lg->acc_key, t_s);
+             k == CHECK_LEG_VELOCITY ? lg->vel_key : k == CHECK_LEG_JERK ? "MAX_JERK"
+                                                                         : lg->acc_key, t_s);
     check_add_problem(s->r, &p);
 }
 
@@ -85,7 +91,8 @@ static void legs_period(struct sim *s, const struct motion_out *out)
     for (int i = 0; i < s->nj; i++) {
         struct check_leg *lg = &s->r->leg[i];
         double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
-        double av = fabs(v), aa = fabs(v - s->v0[i]) * s->inv_T;
+        double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
+        double aj = fabs(a - s->a0[i]) * s->inv_T;
         lg->min_mm = L < lg->min_mm ? L : lg->min_mm;
         lg->max_mm = L > lg->max_mm ? L : lg->max_mm;
         lg->peak_vel_mm_s = av > lg->peak_vel_mm_s ? av : lg->peak_vel_mm_s;
@@ -96,7 +103,11 @@ static void legs_period(struct sim *s, const struct motion_out *out)
             leg_limit(s, out, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
         if (aa > s->acc_thr[i])
             leg_limit(s, out, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
+        lg->peak_jerk_mm_s3 = aj > lg->peak_jerk_mm_s3 ? aj : lg->peak_jerk_mm_s3;
+        if (aj > s->jerk_thr[i])
+            leg_limit(s, out, CHECK_LEG_JERK, i, aj, lg->limit_jerk_mm_s3);
         s->v0[i] = v;
+        s->a0[i] = a;
     }
 }
 
@@ -114,16 +125,17 @@ static void tip_of(const struct sim *s, const struct motion_out *out, const doub
 static void tip_flush(struct sim *s)
 {
     struct check_result *r = s->r;
-    if (s->blk_tip_max > r->kin_tol_mm && r->kin_tol_mm > 0) {
+    if (s->blk_tip_max > s->blk_tip_tol && r->kin_tol_mm > 0) {
         struct check_problem p = { .kind = CHECK_TIP_DEVIATION, .line = s->blk_tip_line,
-                                   .leg = -1, .value = s->blk_tip_max, .limit = r->kin_tol_mm,
+                                   .leg = -1, .value = s->blk_tip_max, .limit = s->blk_tip_tol,
                                    .time_s = -1, .count = 1 };
         snprintf(p.file, sizeof p.file, "%s", s->blk_tip_file ? s->blk_tip_file : "");
         snprintf(p.message, sizeof p.message, "the tool tip leaves the straight line between "
                  "its positions at the move's ends by %.3f mm, over the tolerance of %.3f mm "
-                 "([TRAJ] KINEMATIC_TOLERANCE): the move turns A B C about the platform, not "
-                 "about the tip; program the tip under G43.4 to keep it on the line",
-                 s->blk_tip_max, r->kin_tol_mm);
+                 "(%s): the move turns A B C about the platform, not about the tip; program "
+                 "the tip under G43.4 to keep it on the line", s->blk_tip_max, s->blk_tip_tol,
+                 s->blk_tip_tol > r->kin_tol_mm ? "with jerk limits, half the G64 P"
+                                                : "[TRAJ] KINEMATIC_TOLERANCE");
         check_add_warning(r, &p);
     }
     s->blk_tip_max = 0;
@@ -166,7 +178,8 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     s->tip_swing = !out->tcp && (out->seg_from[3] != out->seg_to[3] ||
                                  out->seg_from[4] != out->seg_to[4] ||
                                  out->seg_from[5] != out->seg_to[5]);
-    slot_for(s, CHECK_DEFER_MOVE, out);      /* the warning's line and file */
+    struct check_defer_slot *q = slot_for(s, CHECK_DEFER_MOVE, out);
+    q->value = out->path_tol_mm;             /* the warning's line, file and tolerance */
     check_defer_commit(s->dq);
 }
 
@@ -206,7 +219,9 @@ static void deviation(struct sim *s, const struct motion_out *out)
     q->tool_len_mm = out->tcp ? out->tool_len_mm : s->tf.length_mm;
     q->tip_mode = CHECK_TIP_NONE;
     if (s->have_tf && s->tip_line && !s->tip_fresh) {
-        q->tip_mode = CHECK_TIP_LINE;        /* from its move's line, or (arcs, rapids) from */
+        /* from its move's line (a synchronised move's tool runs on past its ends along it:
+         * a tap while the spindle reverses, no deviation), or (arcs, rapids) from */
+        q->tip_mode = motion_sync_running(s->mc->motion) ? CHECK_TIP_AXIS : CHECK_TIP_LINE;
         memcpy(q->t0, s->tip_t0, sizeof q->t0);   /* the chord between the set points' tips */
         memcpy(q->t1, s->tip_t1, sizeof q->t1);
     } else if (s->have_tf && out->seg_kind) {
@@ -263,7 +278,9 @@ static void apply(struct sim *s, const struct check_defer_slot *q)
     case CHECK_DEFER_CONDITION: singularity(s, q); break;
     case CHECK_DEFER_TIP: tip_record(s, q->line, q->value); break;
     case CHECK_DEFER_FLUSH: tip_flush(s); break;
-    case CHECK_DEFER_MOVE: s->blk_tip_line = q->line, s->blk_tip_file = q->file; break;
+    case CHECK_DEFER_MOVE:
+        s->blk_tip_line = q->line, s->blk_tip_file = q->file, s->blk_tip_tol = q->value;
+        break;
     }
 }
 
@@ -340,6 +357,9 @@ static void leg_limits(struct sim *s)
             lg->limit_acc_mm_s2 = s->mc->drive_acc[i], lg->acc_key = "STEPGEN_MAXACCEL";
         s->vel_thr[i] = lg->limit_vel_mm_s * (1 + LIMIT_SLACK);
         s->acc_thr[i] = lg->limit_acc_mm_s2 * (1 + LIMIT_SLACK);
+        lg->limit_jerk_mm_s3 = s->mc->mcfg.joint[i].max_jerk_mm_s3;
+        s->jerk_thr[i] = lg->limit_jerk_mm_s3 > 0 ? lg->limit_jerk_mm_s3 * (1 + LIMIT_SLACK)
+                                                  : HUGE_VAL;
         lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
     }
 }

@@ -138,7 +138,10 @@ static int merge_found(struct check_result *r, struct check_result *found)
     for (size_t i = 0; i < r->nproblems && !st; i++)
         st = check_add_problem(&all, &r->problems[i]);
     free(r->problems);
+    free(r->pindex);
     r->problems = all.problems, r->nproblems = all.nproblems, r->capproblems = all.capproblems;
+    r->pindex = all.pindex, r->pindex_cap = all.pindex_cap;
+    free(all.windex);
     return st;
 }
 

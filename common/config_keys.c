@@ -29,6 +29,7 @@ const struct config_section config_sections[] = {
     { "RS274NGC", CONFIG_STRICT, "interpreter settings (docs/gcode.md)" },
     { "PROBE", CONFIG_STRICT, "the workpiece G38 probing touches in `hexcnc interp -i` and "
       "`hexcnc check` (docs/gcode.md)" },
+    { "SPINDLE_SYNC", CONFIG_STRICT, "the spindle as G33 and G33.1 follow it (docs/gcode.md)" },
     { "EMCIO", CONFIG_OPEN, "LinuxCNC's I/O controller; hexcnc reads TOOL_TABLE only" },
     { "HAL", CONFIG_STRICT, "HAL files run when the machine starts (docs/hal.md)" },
     { "TASK", CONFIG_STRICT, "`hexcnc run` (docs/running.md)" },
@@ -148,6 +149,11 @@ const struct config_key config_keys[] = {
       "corner cut when blending" },
     { "TRAJ", "SETPOINT_PERIOD", INT, "ns", ">= 0", 0, 0, "servo period", "period at which "
       "drives take set points, for the kinematic-error bound" },
+    { "TRAJ", "MAX_LINEAR_JERK", NUM, "mm/s^3", "> 0", 0, 0, "none (trapezoidal)", "path "
+      "jerk limit, X Y Z: with MAX_ANGULAR_JERK and every [JOINT_#] MAX_JERK, motion is "
+      "jerk-limited (docs/motion.md); all or none" },
+    { "TRAJ", "MAX_ANGULAR_JERK", NUM, "deg/s^3", "> 0", 0, 0, "none (trapezoidal)", "jerk "
+      "limit of each of A B C; all or none, with MAX_LINEAR_JERK" },
     { "TRAJ", "NO_FORCE_HOMING", BOOL, "", "", 0, 0, "0", "1: programs and MDI may run "
       "before the legs are homed (the session, docs/machine.md)" },
     { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },
@@ -176,6 +182,8 @@ const struct config_key config_keys[] = {
     { "JOINT_#", "MAX_VELOCITY", NUM, "mm/s", "> 0", 0, REQ, "", "leg speed limit" },
     { "JOINT_#", "MAX_ACCELERATION", NUM, "mm/s^2", "> 0", 0, REQ, "", "leg acceleration "
       "limit" },
+    { "JOINT_#", "MAX_JERK", NUM, "mm/s^3", "> 0", 0, 0, "none (trapezoidal)", "leg jerk "
+      "limit; all or none, with [TRAJ] MAX_LINEAR_JERK" },
     { "JOINT_#", "FERROR", NUM, "mm", "> 0", 0, REQ, "", "following-error limit at "
       "MAX_VELOCITY" },
     { "JOINT_#", "MIN_FERROR", NUM, "mm", "> 0", 0, 0, "0.1", "following-error limit at "
@@ -271,6 +279,14 @@ const struct config_key config_keys[] = {
       "to the INI) where `o<name> call` finds name.ngc, after the program's folder" },
     { "RS274NGC", "LOOP_LIMIT", INT, "", "> 0", 0, 0, "10000000", "loop iterations (while, "
       "do, repeat) one program may run before it is refused as a loop that never ends" },
+    /* [SPINDLE_SYNC]: no defaults; a program with G33 or G33.1 is refused without them */
+    { "SPINDLE_SYNC", "ACCELERATION", NUM, "rpm/s", "> 0", 0, 0, "", "how fast the spindle "
+      "gains or loses speed: the path must follow it, and a rigid tap (G33.1) runs on past "
+      "its bottom by K x the revolutions the spindle takes to stop before it reverses" },
+    { "SPINDLE_SYNC", "SPEED_MARGIN", NUM, "", "> 0", 0, 0, "", "how much faster than "
+      "commanded the spindle may turn, as a fraction (0.1: 10 %); a synchronised move is "
+      "refused where the path or legs could not keep up with S x K at that speed, and the "
+      "path catches up with the turning spindle at the margin's share of that speed" },
     /* [PROBE] */
     { "PROBE", "MODEL", ENUM, "", "NONE|PLANE|BOX", 0, 0, "NONE", "the workpiece G38.2..G38.5 "
       "probe in `hexcnc interp -i` and `hexcnc check`: NONE (as LinuxCNC's rs274: no trip, "

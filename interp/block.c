@@ -15,21 +15,16 @@ static const struct { int code, group; } g_table[] = {
     {810, 1},  {820, 1},  {830, 1},  {850, 1},  {890, 1},  {900, 3},  {901, 4},  {910, 3},
     {911, 4},  {920, 0},  {921, 0},  {922, 0},  {923, 0},  {930, 5},  {940, 5},  {980, 10},
     {990, 10}, {1410, 0}, {1420, 0}, {51, 1},   {520, 0},  {50, 1},   {52, 1},   {53, 0},
-    {950, 5},  {382, 1},  {383, 1},  {384, 1},  {385, 1},
+    {950, 5},  {382, 1},  {383, 1},  {384, 1},  {385, 1},  {330, 1},  {331, 1},
 };
 
 /* RS274/NGC codes LinuxCNC knows that this interpreter does not run. */
 static const int g_unsupported[] = {55, 61, 840, 860, 870, 880};
 
-/* LinuxCNC's lathe codes and spindle-synchronised motion: refused as such, not as unknown
- * or "not yet". */
+/* LinuxCNC's lathe codes: refused as such, not as unknown or "not yet". */
 #define LATHE ", a lathe code: a hexapod has no turning spindle axis to run it"
 static const struct { int code; const char *what; } g_lathe[] = {
     {70, "lathe diameter mode" LATHE}, {80, "lathe radius mode" LATHE},
-    {330, "spindle-synchronised motion (threading): this machine has no spindle position "
-     "feedback to follow"},
-    {331, "rigid tapping, spindle-synchronised motion: this machine has no spindle position "
-     "feedback to follow"},
     {700, "a lathe finishing cycle" LATHE}, {710, "a lathe roughing cycle" LATHE},
     {711, "a lathe roughing cycle" LATHE}, {720, "a lathe roughing cycle" LATHE},
     {721, "a lathe roughing cycle" LATHE}, {760, "lathe threading" LATHE},
@@ -185,9 +180,12 @@ static int word_used(const struct interp *in, char w)
     int cycle = !comp && g0 < 0 && is_cycle(m);
     int spline = !comp && g0 < 0;                      /* G5, G5.1 (with m) */
     int nurbs = spline && m == 52 && (b->g[1] == 52 || has_axis(b));  /* a G5.2 point */
+    int sync = !comp && g0 < 0 && (m == 330 || m == 331);      /* G33 K, G33.1 K I */
     switch (w) {
-    case 'i': case 'j': return arc || g0 == 100 || (spline && (m == 51 || m == 50));
-    case 'k': return arc || g0 == 100;
+    case 'i': return arc || g0 == 100 || (spline && (m == 51 || m == 50)) ||
+                     (sync && m == 331);
+    case 'j': return arc || g0 == 100 || (spline && (m == 51 || m == 50));
+    case 'k': return arc || g0 == 100 || sync;
     case 'r': return arc || cycle || g0 == 100;
     case 'p': return arc || g0 == 40 || g0 == 100 || b->g[13] == 640 || b->m[4] == 98 ||
                      (cycle && (m == 820 || m == 890)) || (b->m[5] >= 62 && b->m[5] <= 66) ||
@@ -209,9 +207,9 @@ static int check_unused(struct interp *in)
 {
     static const char words[] = "ijkrpqlhdwe";
     static const char *const why[] = {
+        "I is an arc centre word of G2/G3, and G33.1's spindle speed multiple for the way out",
         "I, J and K are arc centre words: use them with G2 or G3",
-        "I, J and K are arc centre words: use them with G2 or G3",
-        "I, J and K are arc centre words: use them with G2 or G3",
+        "K is an arc centre word of G2/G3, and the distance per revolution of G33 and G33.1",
         "R is used by G2/G3 (radius), canned cycles (retract plane) and G10",
         "P is used by G4 (dwell), G10, G64, G2/G3 (turns), G5, G5.2, G82/G89 (dwell) and "
         "M62..M66",

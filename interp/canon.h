@@ -86,6 +86,17 @@ enum canon_note {
     CANON_NOTE_LOGCLOSE,   /* (LOGCLOSE) */
 };
 
+/* Spindle-synchronised moves (G33, G33.1). A rigid tap is two moves, into the hole and back
+ * out to where it started, so that every consumer sees where the tool goes; printers show
+ * the pair as rs274's one RIGID_TAP. */
+enum canon_sync {
+    CANON_SYNC_NONE = 0,
+    CANON_SYNC_THREAD,     /* G33: the path position is pitch x spindle revolutions */
+    CANON_SYNC_TAP_IN,     /* G33.1 into the hole: at its end the spindle reverses */
+    CANON_SYNC_TAP_OUT,    /* G33.1 back out, following the reversed spindle; at its end the
+                            * spindle's direction is restored */
+};
+
 /* The payload of CANON_SETTING: what the machine saves (or says, or logs) when it executes
  * the line. */
 struct canon_setting {
@@ -116,6 +127,12 @@ struct canon_cmd {
                             * geometry) is the tool tip and orientation (kins_tcp_to_pose
                             * gives the platform's pose), tool_len_mm the tool's length */
     double tool_len_mm;
+    int sync;              /* FEED: 0, or a spindle-synchronised move whose path position
+                            * follows the spindle (motion/motion_sync.c): CANON_SYNC_* */
+    double pitch_mm_rev;   /* FEED with sync: K, mm of path per spindle revolution */
+    double pitch_word;     /* ... K as the program wrote it (inch under G20), for printers */
+    double retract_factor; /* CANON_SYNC_TAP_IN/OUT: G33.1's I, the multiple of the spindle's
+                            * speed it reverses to for the way out (1 without I) */
     int immediate;         /* DIGITAL_OUT, ANALOG_OUT: M64/M65/M68 (else M62/M63/M67) */
     int analog;            /* WAIT_INPUT: an analog input (E), else digital (P) */
     int wait_mode;         /* WAIT_INPUT: L, 0..4 */

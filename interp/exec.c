@@ -549,7 +549,7 @@ static int exec_motion(struct interp *in)
     if (b->g[1] >= 0) {
         in->motion = b->g[1] == 800 ? -1 : b->g[1];
         if (b->g[1] == 0 || b->g[1] == 10 || b->g[1] == 20 || b->g[1] == 30 || b->g[1] == 800 ||
-            (b->g[1] >= 382 && b->g[1] <= 385))
+            (b->g[1] >= 382 && b->g[1] <= 385) || b->g[1] == 330 || b->g[1] == 331)
             in->cycle_mode = in->cycle_il_on = 0;
     }
     if (g0 == 100 || g0 == 280 || g0 == 300 || g0 == 920 || g0 == 520 || b->g[8] == 431 ||
@@ -590,6 +590,8 @@ static int exec_motion(struct interp *in)
     }
     if (m == 52)
         return b->g[1] == 52 || axis ? interp_nurbs_point(in, prev_motion) : 0;
+    if (m == 330 || m == 331)
+        return interp_sync_move(in, m, axis);
     if (m >= 0 && axis)
         return interp_cycle(in, m);
     return 0;

@@ -1,9 +1,9 @@
-/* feed.c: G95, feed per revolution, on a machine without spindle position feedback. */
+/* feed.c: G95, feed per revolution, at the commanded spindle speed. */
 #include "interp/interp_int.h"
 
 /*
- * LinuxCNC's motion follows the spindle's measured speed under G95. hexcnc's machine has no
- * spindle feedback (G33 is refused for the same reason), so a G95 move runs at F times the
+ * LinuxCNC's motion follows the spindle's measured speed under G95. Here only G33 and G33.1
+ * follow the spindle's encoder (motion/motion_sync.c), so a G95 move runs at F times the
  * commanded S, in mm/min: what the spindle turns at when it keeps its speed. The check below
  * refuses a G95 feed with the spindle stopped, where LinuxCNC's motion would wait for the
  * spindle and this machine would otherwise feed as if it turned.
@@ -34,7 +34,7 @@ int interp_need_spindle(struct interp *in, const char *what, int col)
     if (in->spindle_dir == 0)
         return interp_fail(in, INTERP_ERR_MODAL, col, "%s in feed per revolution mode (G95) "
                            "with the spindle stopped: start it with M3 or M4 (this machine "
-                           "has no spindle feedback: it feeds F x S, the commanded speed)",
+                           "feeds F x S under G95, the commanded speed, not the measured one)",
                            what);
     return 0;
 }

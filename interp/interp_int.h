@@ -345,6 +345,8 @@ double interp_len_mm(const struct interp *in, double v); /* program length -> mm
 void interp_prog_pos(const struct interp *in, double prog[6]); /* current pos, program units */
 /* Resolves axis words to a machine target (G90/G91, offsets, units; G53 when machine). */
 void interp_target(struct interp *in, int machine, double target[6]);
+/* G33 (g 330) and G33.1 (331), the block's axis words present or not (sync.c). */
+int interp_sync_move(struct interp *in, int g, int axis);
 int interp_straight(struct interp *in, enum canon_type t, const double end[6]);
 /* feed.c: G95, feed per revolution. The feed in mm/min a block runs at (G94 and G95);
  * the feed mode command's value (0 G94, 1 G93, 2 G95); the checks of a feed move under G95. */

@@ -16,6 +16,6 @@ BENCHES += bench_interp bench_oword
 SCRIPT_TESTS += tests/interp_expected.sh tests/interp_errors.sh tests/linuxcnc_tooltables.sh \
                 tests/linuxcnc_corpus.sh
 LIB_SRCS += interp/interp_setup.c
-LIB_SRCS += interp/rotation.c interp/nurbs.c interp/feed.c
-TESTS += test_interp_spline test_interp_feed
+LIB_SRCS += interp/rotation.c interp/nurbs.c interp/feed.c interp/sync.c
+TESTS += test_interp_spline test_interp_feed test_interp_sync
 TESTS += test_interp_rotation

@@ -260,6 +260,29 @@ static void put_other(struct interp_printer *p, const struct interp_view *v,
     puts_(p, tmp);
 }
 
+/* A synchronised move as rs274 prints it: START_SPEED_FEED_SYNC(K, 0), the move (a rigid
+ * tap's way in as RIGID_TAP(x, y, z); its way out, which rs274 leaves to the machine, as
+ * nothing), STOP_SPEED_FEED_SYNCH(). */
+static void put_sync(struct interp_printer *p, const struct interp_view *v,
+                     const struct canon_cmd *c)
+{
+    if (c->sync == CANON_SYNC_TAP_OUT)
+        return;
+    double e[6];
+    char tmp[64];
+    to_program(v, c->end, e);
+    line_start(p, c);
+    put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "START_SPEED_FEED_SYNC(%f,0)\n",
+                                 c->pitch_word));
+    line_start(p, c);
+    if (c->sync == CANON_SYNC_TAP_IN)
+        put_call(p, "RIGID_TAP", e, 3, p->digits);
+    else
+        put_call(p, "STRAIGHT_FEED", e, 6, p->digits);
+    line_start(p, c);
+    puts_(p, "STOP_SPEED_FEED_SYNCH()\n");
+}
+
 /* Prints one command (and a units or offsets line first when they changed). */
 int interp_printer_sink(void *ctx, const struct canon_cmd *c)
 {
@@ -288,6 +311,10 @@ int interp_printer_sink(void *ctx, const struct canon_cmd *c)
             char tmp[40];
             put(p, tmp, (size_t)snprintf(tmp, sizeof tmp, "NURBS_FEED(%d, ...)\n", c->ivalue));
         }
+        return p->failed ? -1 : 0;
+    }
+    if (c->type == CANON_FEED && c->sync) {
+        put_sync(p, &v, c);
         return p->failed ? -1 : 0;
     }
     line_start(p, c);

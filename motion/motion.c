@@ -67,6 +67,10 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     m->pose_known = 1;
     m->run = &m->plan;
     m->pb_at[0] = m->pb_at[1] = SIZE_MAX;
+    if ((st = motion_jerk_init(m, err, errlen)) != MOTION_OK) {
+        free(m);
+        return st;
+    }
     *out = m;
     return MOTION_OK;
 }
@@ -78,6 +82,7 @@ void motion_destroy(struct motion *m)
         return;
     motion_plan_free(&m->plan);
     motion_plan_free(&m->names);
+    motion_jerk_free(m);
     free(m);
 }
 
@@ -105,6 +110,7 @@ static void rewind_plan(struct motion *m)
     atomic_store(&m->input_seq, 0);
     motion_probe_reset(m);
     atomic_store(&m->probe_seq, 0);
+    m->sync.phase = SYNC_IDLE;
     m->line = m->run && m->run->nseg ? m->run->segs[0].line : 0;
     m->file = m->run && m->run->nseg ? m->run->segs[0].file : NULL;
 }
@@ -168,6 +174,7 @@ int motion_load(struct motion *m, const struct canon_prog *prog, char *err, size
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);
+    motion_jerk_hold(m);               /* the average starts at rest where the program does */
     if (err && errlen)
         err[0] = 0;
     return MOTION_OK;
@@ -391,6 +398,7 @@ int motion_stream_attach(struct motion *m, struct motion_stream *s,
     kins_inverse(m->kins, m->pose, m->joint_cmd);
     m->loaded = 1;
     rewind_plan(m);
+    motion_jerk_hold(m);               /* the average starts at rest where the program does */
     return MOTION_OK;
 }
 

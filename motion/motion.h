@@ -63,6 +63,7 @@ const char *motion_state_name(enum motion_state s);
 struct motion_joint_config {
     double max_vel_mm_s;     /* MAX_VELOCITY, mm/s (deg/s for a rotary joint of trivial kins) */
     double max_acc_mm_s2;    /* MAX_ACCELERATION, mm/s^2 */
+    double max_jerk_mm_s3;   /* MAX_JERK, mm/s^3; 0: none (jerk limiting off) */
     double ferror_mm;        /* FERROR: following-error limit at MAX_VELOCITY, mm */
     double min_ferror_mm;    /* MIN_FERROR: following-error limit at standstill, mm */
     /* Homing ([JOINT_n] HOME_*, docs/machine.md). search_vel 0: no switch (absolute). */
@@ -87,6 +88,10 @@ struct motion_config {
     double max_lin_acc_mm_s2;       /* [TRAJ] MAX_LINEAR_ACCELERATION, mm/s^2 */
     double max_ang_vel_deg_s;       /* [TRAJ] MAX_ANGULAR_VELOCITY, deg/s, per rotary axis */
     double max_ang_acc_deg_s2;      /* [TRAJ] MAX_ANGULAR_ACCELERATION, deg/s^2 */
+    double max_lin_jerk_mm_s3;      /* [TRAJ] MAX_LINEAR_JERK, mm/s^3; 0: none. Jerk limiting
+                                     * is on when this, max_ang_jerk_deg_s3 and every joint's
+                                     * max_jerk_mm_s3 are set, off when none is */
+    double max_ang_jerk_deg_s3;     /* [TRAJ] MAX_ANGULAR_JERK, deg/s^3; 0: none */
     double default_lin_vel_mm_s;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY, mm/s: feed of a move
                                      * programmed before any F word (canon feed 0) */
     double kin_tol_mm;              /* [TRAJ] KINEMATIC_TOLERANCE, mm: largest deviation of the
@@ -99,6 +104,14 @@ struct motion_config {
                                      * program gives G64 without P (canon value 0) */
     int optional_stop;              /* [TRAJ] OPTIONAL_STOP: 1 = M1 pauses like M0 (default) */
     int num_dio, num_aio;           /* [EMCMOT] NUM_DIO, NUM_AIO: outputs M62..M68 may set */
+    /* Spindle-synchronised moves (G33, G33.1; motion_sync.c). NAN: not given, and a program
+     * with such a move is refused naming the key (they protect the thread and the tap). */
+    double spindle_acc_rpm_s;       /* [SPINDLE_SYNC] ACCELERATION: how fast the spindle
+                                     * changes speed, rpm/s (how far a tap runs on while the
+                                     * spindle reverses) */
+    double spindle_speed_margin;    /* [SPINDLE_SYNC] SPEED_MARGIN: how much faster than
+                                     * commanded the spindle may turn, a fraction (0.1: 10 %);
+                                     * the path's speed limits must hold at that speed */
     int njoints;                    /* joints configured (the kinematics' count) */
     struct motion_joint_config joint[KINS_MAX_JOINTS]; /* [JOINT_0..] */
 };
@@ -111,6 +124,12 @@ void motion_config_default(struct motion_config *c);
  * [SECTION]KEY when a value is not a positive number. */
 int motion_config_read(struct motion_config *c, const struct kins_config *cfg, int njoints,
                        char *err, size_t errlen);
+
+/* Jerk limiting (motion_jerk.c): the length of the moving average the legs' and the pose's
+ * set points go through, s (0: jerk limiting off). With it no leg's jerk, measured by
+ * differencing the set points period by period, exceeds MAX_JERK wherever the unfiltered
+ * motion keeps its acceleration limits. */
+double motion_jerk_window_s(const struct motion_config *c);
 
 struct motion;
 
@@ -160,6 +179,18 @@ double motion_input_result(const struct motion *m, unsigned *seq);
  * acceleration limits, as a pause does. */
 void motion_set_probe_input(struct motion *m, bool on);
 /* (Until it is first called, as in `hexcnc check`, probe moves run as plain feeds.) */
+
+/* G33, G33.1: the spindle's position, revolutions (spindle.0.revs), this period, and whether
+ * anything gives it (wired: the pin is connected). A synchronised move's path position is
+ * its pitch times the revolutions since it began (motion_sync.c); without feedback such a
+ * program is refused when it is planned. */
+void motion_set_spindle_revs(struct motion *m, double revs, bool wired);
+/* `hexcnc check`: no spindle, an ideal one instead: it turns at the commanded speed, reached
+ * at [SPINDLE_SYNC] ACCELERATION, and synchronised moves follow it. */
+void motion_set_spindle_ideal(struct motion *m, bool on);
+/* Whether the path follows the spindle now: on a synchronised move, whose path may run on
+ * past its ends along its line (a tap while the spindle reverses). */
+bool motion_sync_running(const struct motion *m);
 struct motion_probe_result {
     int already;             /* G38.2/G38.4: the input was already as sought where the move
                               * starts (LinuxCNC's error); nothing moved */
@@ -209,6 +240,9 @@ struct motion_out {
                                         * 3 a rapid, 0 none (a stop, or no program) ... */
     double seg_from[KINS_POSE_DIM];    /* ... from and to these path poses (the tool tip's */
     double seg_to[KINS_POSE_DIM];      /* under tcp): for checks of the path between them */
+    double path_tol_mm;                /* how far the planner lets that move's path be
+                                        * rounded, mm: KINEMATIC_TOLERANCE, or with jerk limits
+                                        * under G64 P the larger of it and half of P */
     double joint_pos[KINS_MAX_JOINTS]; /* leg position commands, mm */
     double joint_vel[KINS_MAX_JOINTS]; /* leg rate commands, mm/s */
     double motor_pos[KINS_MAX_JOINTS]; /* what the drives get: joint_pos + home offset, mm */

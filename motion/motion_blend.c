@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "motion/motion_blend.h"
+#include "motion/motion_priv.h"
 
 #define LINE_EPS_MM 1e-9       /* shorter XYZ motion is not a line to blend (as motion_path) */
 
@@ -13,6 +14,8 @@ struct blend_rec {
     double len_mm;           /* XYZ length of a straight feed move, 0 for anything else */
     double dir[3];           /* its unit XYZ direction */
     double tol_mm;           /* G64 tolerance in force at the command, 0 = exact path */
+    double arc_tol_mm;       /* the part of it a blend arc may cut the corner by (with jerk
+                              * limits the rest is the rounding's, JERK_ROUND_SHARE) */
     double trim_in_mm;       /* length given to the blend at its start, mm */
     double trim_out_mm;      /* length given to the blend at its end, mm */
     size_t next;             /* command the end blends into (0 = none; it is always > this) */
@@ -90,6 +93,7 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
                  struct blend_rec *rec)
 {
     double at[6], tol = motion_blend_start(cfg, in);
+    double arc_share = motion_jerk_window_s(cfg) > 0 ? 1 - JERK_ROUND_SHARE : 1;
     double at_len = in->start_tcp ? in->start_tool_len_mm : 0;
     int at_tcp = in->start_tcp;
     memcpy(at, in->start, sizeof at);
@@ -98,6 +102,7 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
         struct blend_rec *b = &rec[i];
         memcpy(b->from, at, sizeof at);
         b->tol_mm = tol;
+        b->arc_tol_mm = tol * arc_share;
         /* a move after G43.4 or G49 starts from a pose in other coordinates: never blended
          * (the planner stops there) */
         int moves = c->type == CANON_TRAVERSE || c->type == CANON_FEED || c->type == CANON_ARC;
@@ -105,7 +110,8 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
         int switched = moves && (c->tcp != at_tcp || len_c != at_len);
         if (moves)
             at_tcp = c->tcp, at_len = len_c;
-        if (c->type == CANON_FEED && !switched) {
+        if (c->type == CANON_FEED && !switched && !c->sync) {  /* (G33 follows the spindle:
+                                                                * never rounded) */
             double d[3] = {c->end[0] - at[0], c->end[1] - at[1], c->end[2] - at[2]};
             double len = sqrt(dot3(d, d));
             if (len > LINE_EPS_MM) {
@@ -140,7 +146,7 @@ static size_t find_blends(const struct canon_prog *in, struct blend_rec *rec)
             continue;
         struct motion_blend_geom g;
         if (!motion_blend_corner(rec[i].dir, rec[j].dir, rec[i].len_mm, rec[j].len_mm,
-                                 rec[i].tol_mm, &g))
+                                 rec[i].arc_tol_mm, &g))
             continue;
         rec[i].g = g;
         rec[i].next = j;

@@ -148,10 +148,11 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
     *ang_deg = ang;
 }
 
-/* The set-point period: drives move their legs linearly over it. */
+/* The set-point period: drives move their legs linearly over it (with jerk limits, the
+ * chord that cuts a curve as much as the chords and the moving average together). */
 static double setpoint_period(const struct motion_config *c)
 {
-    return c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+    return motion_chord_period(c);
 }
 
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
@@ -171,7 +172,7 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
         return -1;
     across_path(sg, S, S->q, &perp, &ang);
     if (perp > 1e-15)
-        dmax = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / perp);
+        dmax = sqrt(8 * motion_round_tol_mm(m, sg) / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
         dmax = min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
     return dmax / setpoint_period(c);
@@ -186,12 +187,12 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
  *     (k f + |q_kin,perp|) d^2 / 8 <= KIN_TOL_SHARE tol,
  * and the same for A B C with the arc's A B C curvature kabc (blend arcs) and tol_deg. */
 double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
-                        const struct motion_sample *S, double k_mm, double kabc)
+                        const struct motion_sample *S, double k_mm, double kabc, double tol_mm)
 {
     const struct motion_config *c = &m->cfg;
     if (c->kin_tol_mm <= 0)
         return HUGE_VAL;
-    double qk[6] = {0}, perp = 0, ang = 0, tol = KIN_TOL_SHARE * c->kin_tol_mm;
+    double qk[6] = {0}, perp = 0, ang = 0, tol = tol_mm;
     if (m->nj == 6) {
         struct motion_sample T;       /* a sample whose q was not taken yet (not the planner's
                                        * knots: motion_knot_caps takes it) */
@@ -437,6 +438,9 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     const struct motion_sample *A = Ap, *B = Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
     double dx = 0, da = 0, v = HUGE_VAL;
+    /* a jump of the direction by dx at speed v: a set-point chord across it cuts the corner
+     * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8 */
+    Ts += motion_jerk_window_s(c) / 2;
     for (int i = 0; i < 3; i++)
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);

@@ -38,17 +38,21 @@ double motion_arc_curvature(const struct motion_plan *p, const struct motion_seg
     return (1 + 2 * (rp / r) * (rp / r)) / r;
 }
 
-/* Marks the first (end 0) or last (end 1) len_mm of o as within reach of an arc. */
-static void mark(struct motion_seg *o, int end, double len_mm, double k, double kabc)
+/* Marks the first (end 0) or last (end 1) len_mm of o as within reach of an arc (curvatures
+ * k, kabc; rounding budget tol, mm). */
+static void mark(struct motion_seg *o, int end, double len_mm, double k, double kabc,
+                 double tol)
 {
     o->chord_mm[end] = fmax(o->chord_mm[end], len_mm);
     o->chord_k[end] = fmax(o->chord_k[end], k);
     o->chord_kabc[end] = fmax(o->chord_kabc[end], kabc);
+    o->chord_tol[end] = fmin(o->chord_tol[end], tol);
 }
 
 /* Marks the segments before (dir -1) or after (dir +1) arc segment j within d_mm of path.
  * Dwells, pauses and rotary-only moves have no X Y Z travel: the reach goes on past them. */
-static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double k, double kabc)
+static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double k, double kabc,
+                  double tol)
 {
     size_t i = j;
     while (d_mm > 0) {
@@ -58,7 +62,7 @@ static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double 
         struct motion_seg *o = &p->segs[i];
         if (o->kind > SEG_ARC || o->rotary)
             continue;
-        mark(o, dir < 0 ? 1 : 0, fmin(d_mm, o->len), k, kabc);
+        mark(o, dir < 0 ? 1 : 0, fmin(d_mm, o->len), k, kabc, tol);
         d_mm -= o->len;
     }
 }
@@ -157,6 +161,7 @@ int motion_chord_zones(struct motion *m)
         memset(sg->chord_mm, 0, sizeof sg->chord_mm);
         memset(sg->chord_k, 0, sizeof sg->chord_k);
         memset(sg->chord_kabc, 0, sizeof sg->chord_kabc);
+        sg->chord_tol[0] = sg->chord_tol[1] = HUGE_VAL;
     }
     if (c->kin_tol_mm <= 0)
         return 0;
@@ -164,15 +169,15 @@ int motion_chord_zones(struct motion *m)
         struct motion_seg *sg = &p->segs[j];
         if (sg->kind != SEG_ARC || !(sg->len > 0))
             continue;
-        double kabc, k = motion_arc_curvature(p, sg, &kabc);
-        double d = sqrt(8 * KIN_TOL_SHARE * c->kin_tol_mm / k);
+        double kabc, k = motion_arc_curvature(p, sg, &kabc), tol = motion_round_tol_mm(m, sg);
+        double d = sqrt(8 * tol / k);
         if (kabc > 1e-30 && c->kin_tol_deg > 0)
             d = fmin(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / kabc));
         d *= CHORD_MARGIN;
-        mark(sg, 0, sg->len, k, kabc);
-        mark(sg, 1, sg->len, k, kabc);
-        reach(p, j, -1, d, k, kabc);
-        reach(p, j, +1, d, k, kabc);
+        mark(sg, 0, sg->len, k, kabc, tol);
+        mark(sg, 1, sg->len, k, kabc, tol);
+        reach(p, j, -1, d, k, kabc, tol);
+        reach(p, j, +1, d, k, kabc, tol);
     }
     return insert_knots(p);
 }

@@ -58,6 +58,8 @@ void motion_config_default(struct motion_config *c)
     c->optional_stop = 1;
     c->num_dio = c->num_aio = 4;
     c->njoints = 6;
+    c->spindle_acc_rpm_s = NAN;     /* no default: synchronised moves need them given */
+    c->spindle_speed_margin = NAN;
     for (int i = 0; i < KINS_MAX_JOINTS; i++) {
         c->joint[i].max_vel_mm_s = 100;
         c->joint[i].max_acc_mm_s2 = 1000;
@@ -151,6 +153,43 @@ static int read_num(const struct kins_config *cfg, const char *sec, const char *
     return MOTION_OK;
 }
 
+/* Jerk limits: all or none (a limit left out would leave that axis or leg unlimited
+ * without a word), not negative, and a moving average no longer than MOTION_JERK_MAX_S. */
+static int check_jerk(const struct motion_config *c, char *err, size_t errlen)
+{
+    int set = (c->max_lin_jerk_mm_s3 != 0) + (c->max_ang_jerk_deg_s3 != 0), all = 2;
+    const char *missing = c->max_lin_jerk_mm_s3 == 0 ? "[TRAJ] MAX_LINEAR_JERK"
+                          : c->max_ang_jerk_deg_s3 == 0 ? "[TRAJ] MAX_ANGULAR_JERK" : NULL;
+    char joint_key[40] = "";
+    if (c->max_lin_jerk_mm_s3 < 0 || c->max_ang_jerk_deg_s3 < 0) {
+        snprintf(err, errlen, "[TRAJ] MAX_LINEAR_JERK and MAX_ANGULAR_JERK must be positive");
+        return MOTION_ERR_CONFIG;
+    }
+    for (int i = 0; i < c->njoints; i++, all++) {
+        if (c->joint[i].max_jerk_mm_s3 < 0) {
+            snprintf(err, errlen, "[JOINT_%d] MAX_JERK must be positive", i);
+            return MOTION_ERR_CONFIG;
+        }
+        set += c->joint[i].max_jerk_mm_s3 != 0;
+        if (c->joint[i].max_jerk_mm_s3 == 0 && !missing && !joint_key[0])
+            snprintf(joint_key, sizeof joint_key, "[JOINT_%d] MAX_JERK", i);
+    }
+    if (set != 0 && set != all) {
+        snprintf(err, errlen, "%s: missing; jerk limits are all set ([TRAJ] MAX_LINEAR_JERK, "
+                 "MAX_ANGULAR_JERK and every [JOINT_n] MAX_JERK) or none (docs/motion.md)",
+                 missing ? missing : joint_key);
+        return MOTION_ERR_CONFIG;
+    }
+    double w = motion_jerk_window_s(c);
+    if (w > MOTION_JERK_MAX_S) {
+        snprintf(err, errlen, "jerk limits: motion would need a %.3f s moving average to keep "
+                 "them (2 x acceleration / jerk), over the %.1f s allowed; raise the jerk "
+                 "limits or lower the accelerations", w, MOTION_JERK_MAX_S);
+        return MOTION_ERR_CONFIG;
+    }
+    return MOTION_OK;
+}
+
 /* Checks the fields a caller filled directly. */
 static int check_config(const struct motion_config *c, char *err, size_t errlen)
 {
@@ -167,7 +206,7 @@ static int check_config(const struct motion_config *c, char *err, size_t errlen)
                      "positive", i);
             return MOTION_ERR_CONFIG;
         }
-    return MOTION_OK;
+    return check_jerk(c, err, errlen);
 }
 
 /* The machine-wide keys: section, key, scale to the field's unit, 0 allowed, required (the
@@ -186,11 +225,17 @@ static const struct motion_key {
     {"TRAJ", "MAX_ANGULAR_VELOCITY", 1, 0, 1, offsetof(struct motion_config, max_ang_vel_deg_s)},
     {"TRAJ", "MAX_ANGULAR_ACCELERATION", 1, 0, 1,
      offsetof(struct motion_config, max_ang_acc_deg_s2)},
+    {"TRAJ", "MAX_LINEAR_JERK", 1, 0, 0, offsetof(struct motion_config, max_lin_jerk_mm_s3)},
+    {"TRAJ", "MAX_ANGULAR_JERK", 1, 0, 0, offsetof(struct motion_config, max_ang_jerk_deg_s3)},
     {"TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, 0,
      offsetof(struct motion_config, default_lin_vel_mm_s)},
     {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_mm)},
     {"TRAJ", "KINEMATIC_ANGULAR_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_deg)},
     {"TRAJ", "BLEND_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, blend_tol_mm)},
+    {"SPINDLE_SYNC", "ACCELERATION", 1, 0, 0,
+     offsetof(struct motion_config, spindle_acc_rpm_s)},
+    {"SPINDLE_SYNC", "SPEED_MARGIN", 1, 0, 0,
+     offsetof(struct motion_config, spindle_speed_margin)},
 };
 
 /* Reads [EMCMOT], [TRAJ] and [JOINT_n] through cfg (see motion.h). */
@@ -236,6 +281,8 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
         struct motion_joint_config *j = &c->joint[i];
         st = read_num(cfg, sec, "MAX_VELOCITY", 1, 0, 1, &j->max_vel_mm_s, err, errlen);
         st = st ? st : read_num(cfg, sec, "MAX_ACCELERATION", 1, 0, 1, &j->max_acc_mm_s2, err,
+                                errlen);
+        st = st ? st : read_num(cfg, sec, "MAX_JERK", 1, 0, 0, &j->max_jerk_mm_s3, err,
                                 errlen);
         st = st ? st : read_num(cfg, sec, "FERROR", 1, 0, 1, &j->ferror_mm, err, errlen);
         st = st ? st : read_num(cfg, sec, "MIN_FERROR", 1, 0, 0, &j->min_ferror_mm, err,

@@ -16,10 +16,11 @@ void motion_merge_init(struct motion_merge *g, const double start[KINS_POSE_DIM]
 }
 
 /* Whether a feed may be held at all: a straight feed in G64 with a Q, at units per minute,
- * not made by G141/G142 nor a spline's chord, that keeps A B C and G43.4's state, and moves. */
+ * not made by G141/G142 nor a spline's chord, not synchronised with the spindle, that keeps A B C and G43.4's state, and moves. */
 static int holdable(const struct motion_merge *g, const struct canon_cmd *c)
 {
     if (c->type != CANON_FEED || !g->continuous || !(g->tol_mm > 0) || c->compensated ||
+        c->sync ||
         c->spline || c->inverse_time_min > 0 || c->tcp != g->at_tcp ||
         (c->tcp && c->tool_len_mm != g->at_len_mm))
         return 0;

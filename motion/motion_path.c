@@ -357,6 +357,8 @@ static int add_stop(struct motion_plan *p, const struct canon_cmd *c, const doub
 
 static void set_speed(const struct motion *m, struct motion_seg *sg, const struct canon_cmd *c,
                       double blend_tol_mm);
+static int add_sync(struct motion *m, struct motion_plan *p, const struct canon_cmd *c,
+                    const double *from, int sp_dir, double sp_rpm, char *err, size_t errlen);
 
 /* G38.2..G38.5: a straight feed from rest to rest towards probe_stop (where the planner is
  * told the move ends: the whole move on the machine, which stops earlier on a trip), which
@@ -390,6 +392,29 @@ static int add_probe(struct motion *m, struct motion_plan *p, const struct canon
         sg->probe_type = c->ivalue;
     }
     return add_stop(p, c, c->probe_stop, SEG_DWELL, 0);
+}
+
+/* G33/G33.1: a straight line whose path position the spindle drives (motion_sync.c). A run
+ * of them is met at rest; within a run (a tap's way in and out, G33s that follow on) the
+ * executor hands over itself. Refused (-2, err) when the machine cannot follow it. */
+static int add_sync(struct motion *m, struct motion_plan *p, const struct canon_cmd *c,
+                    const double *from, int sp_dir, double sp_rpm, char *err, size_t errlen)
+{
+    if (!(p->nseg && p->segs[p->nseg - 1].sync) && add_stop(p, c, from, SEG_DWELL, 0) < 0)
+        return -1;
+    size_t n0 = p->nseg;
+    if (add_line(p, c, from) < 0)
+        return -1;
+    if (p->nseg == n0)
+        return 0;              /* no length (the interpreter refuses those) */
+    struct motion_seg *sg = &p->segs[p->nseg - 1];
+    set_speed(m, sg, c, 0);
+    sg->sync = c->sync;
+    sg->pitch_mm_rev = c->pitch_mm_rev;
+    sg->retract_factor = c->retract_factor > 0 ? c->retract_factor : 1.0;
+    sg->sync_rpm = sp_rpm;
+    sg->sync_dir = sp_dir;
+    return motion_sync_check(m, sg, err, errlen);
 }
 
 /* The programmed speed of a move (feed, G93 inverse time, or rapid) and its path mode. */
@@ -503,8 +528,22 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
             }
             nseg0 = p->nseg;
         }
+        bool moves = c->type == CANON_TRAVERSE || c->type == CANON_FEED ||
+                     c->type == CANON_ARC || c->type == CANON_PROBE;
+        if (moves && p->nseg && p->segs[p->nseg - 1].sync && !(c->type == CANON_FEED &&
+                                                                c->sync))
+            rc = add_stop(p, c, at, SEG_DWELL, 0);  /* a synchronised run ends at rest */
+        if (rc < 0) {
+            snprintf(err, errlen, "out of memory planning the program");
+            return MOTION_ERR_NOMEM;
+        }
+        nseg0 = p->nseg;
         switch (c->type) {
-        case CANON_TRAVERSE: case CANON_FEED: rc = add_line(p, c, at); break;
+        case CANON_FEED:
+            rc = c->sync ? add_sync(m, p, c, at, sp_dir, sp_rpm, err, errlen)
+                         : add_line(p, c, at);
+            break;
+        case CANON_TRAVERSE: rc = add_line(p, c, at); break;
         case CANON_PROBE: rc = add_probe(m, p, c, at); break;
         case CANON_ARC:
             rc = add_arc(p, c, at, err, errlen);
@@ -581,7 +620,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         }
         if (p->nseg > nseg0) {
             struct motion_seg *sg = &p->segs[p->nseg - 1];
-            set_speed(m, sg, c, blend);
+            set_speed(m, sg, c, sg->sync ? 0 : blend);
             sg->tcp = at_tcp;
             sg->tool_len_mm = at_len;
         }

@@ -38,13 +38,15 @@ static double knot_spacing(const struct motion_plan *p, const struct motion_seg 
 static double chord_cap(struct motion *m, const struct motion_seg *sg, double s,
                         const struct motion_sample *S)
 {
-    double eps = 1e-9 * (1 + sg->len), k = 0, kabc = 0;
+    double eps = 1e-9 * (1 + sg->len), k = 0, kabc = 0, tol = HUGE_VAL;
     for (int e = 0; e < 2; e++) {
         double from_end = e ? sg->len - s : s;
-        if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps)
+        if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps) {
             k = fmax(k, sg->chord_k[e]), kabc = fmax(kabc, sg->chord_kabc[e]);
+            tol = fmin(tol, sg->chord_tol[e]);
+        }
     }
-    return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc) : HUGE_VAL;
+    return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc, tol) : HUGE_VAL;
 }
 
 /* Caps of the knots of one segment: hard caps into kt, caps into kv, acceleration into iacc
@@ -230,15 +232,19 @@ static void pose_direction(const struct motion_plan *p, const struct motion_seg 
         u[i] = n > 0 ? u[i] / n : 0;
 }
 
-/* Rest to add where move j stops (s): one set-point period less the dwells already there,
- * when the next move leaves in another direction, so that the drive has a set point on the
- * corner whatever its phase; 0 before a pause (the machine waits there), at the program's
- * end and where the path goes on straight. */
+/* Rest to add where move j stops (s), less the dwells already there, when the next move
+ * leaves in another direction: one set-point period, so that the drive has a set point on
+ * the corner whatever its phase; and with jerk limits the moving average's window, so that
+ * the average comes to rest on the corner (motion_jerk.c). 0 before a pause or a wait (the
+ * machine waits there until the average has settled), at the program's end and where the
+ * path goes on straight. */
 static double stop_rest_s(const struct motion *m, size_t j)
 {
     const struct motion_plan *p = &m->plan;
     const struct motion_config *c = &m->cfg;
-    double T = c->setpoint_period_s > 0 ? c->setpoint_period_s : c->servo_period_s;
+    double T = (stops_need_rest(c) ? c->setpoint_period_s > 0 ? c->setpoint_period_s
+                                                               : c->servo_period_s : 0) +
+               motion_jerk_window_s(c);
     double rested = 0, u0[KINS_POSE_DIM], u1[KINS_POSE_DIM], du = 0;
     size_t k = j + 1;
     for (; k < p->nseg && p->segs[k].kind > SEG_ARC; k++) {
@@ -246,7 +252,7 @@ static double stop_rest_s(const struct motion *m, size_t j)
             return 0;
         rested += p->segs[k].dwell_s;
     }
-    if (k >= p->nseg || rested >= T || !stops_need_rest(c))
+    if (k >= p->nseg || rested >= T)
         return 0;
     pose_direction(p, &p->segs[j], p->segs[j].len, u0);
     pose_direction(p, &p->segs[k], 0, u1);

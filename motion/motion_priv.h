@@ -71,12 +71,20 @@ struct motion_seg {
                               * seek loss of contact */
     /* Set-point chords near arcs (motion_chord.c): the first [0] and last [1] chord_mm of
      * the path lie within reach of a chord touching an arc whose path curvature is at most
-     * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. */
-    double chord_mm[2], chord_k[2], chord_kabc[2];
+     * chord_k (1/mm) and A B C curvature at most chord_kabc (deg/mm^2); 0: none. The cut
+     * of such a chord stays within chord_tol (mm), the smallest rounding budget of those
+     * arcs (motion_round_tol_mm). */
+    double chord_mm[2], chord_k[2], chord_kabc[2], chord_tol[2];
     int tcp;                 /* tool centre point control: the path (start, end, arcs) is the
                               * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
                               * gives the platform's pose */
     double tool_len_mm;
+    int sync;                /* SEG_LINE of G33/G33.1 (enum canon_sync): the spindle drives
+                              * the path position, not the plan's clock (motion_sync.c) */
+    double pitch_mm_rev;     /* K, mm of path per spindle revolution */
+    double retract_factor;   /* G33.1's I: the spindle's speed multiple for the way out */
+    double sync_rpm;         /* the commanded spindle speed at the move, rpm */
+    int sync_dir;            /* ... and its direction (1 M3, -1 M4) */
 };
 
 /* The planned program: segments and the velocity profile at knots along them. Interval i
@@ -133,6 +141,38 @@ struct motion_chunk {
                                         * executor went on into the tail) */
     _Atomic int retired;     /* the executor has left it (the planner may free it) */
     struct motion_chunk *newer; /* the planner's list */
+};
+
+/* Where a spindle-synchronised move is (motion_sync.c). */
+enum motion_sync_phase {
+    SYNC_IDLE,               /* not on a synchronised move */
+    SYNC_INDEX,              /* at rest at its start, waiting for the spindle to pass a
+                              * whole revolution (the index), so passes line up */
+    SYNC_FOLLOW,             /* d follows pitch x revolutions (into the hole, or a thread) */
+    SYNC_REVERSING,          /* G33.1 past the bottom: the spindle was told to reverse;
+                              * still following it while it stops and turns back */
+    SYNC_OUT,                /* G33.1 on the way out, following the reversed spindle */
+    SYNC_RESTORING,          /* past the start: the spindle was told its own direction
+                              * again; following it until it turns forward */
+    SYNC_PLACE,              /* not synchronised: back to the start, then rest */
+    SYNC_CHAIN,              /* a G33 ended; the next one, if it follows at once, goes on
+                              * from the same revolutions (no new index) */
+    SYNC_LEFT,               /* a tap ended: the plan's clock goes on from its end */
+};
+/* The executor's state of a synchronised move, servo thread only. d is the path position
+ * along the first move of the run (a G33.1's way in): the way out runs back along it. */
+struct motion_sync {
+    enum motion_sync_phase phase;
+    const struct motion_plan *run; /* the plan and segment being followed */
+    size_t seg;
+    double revs0;            /* revolutions where d is 0 */
+    double k_mm_rev;         /* pitch, mm/rev (signed with the spindle's direction) */
+    double d_mm, v_mm_s;     /* path position and speed along the move */
+    double len_mm;           /* the move's length (G33.1: the hole's depth) */
+    double vmax_mm_s, acc_mm_s2; /* speed and acceleration the follower keeps within */
+    int dir0;                /* the spindle's direction and speed before a tap reversed it */
+    double rpm0;
+    double revs_prev;        /* last period's revolutions (the spindle's speed) */
 };
 
 /* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
@@ -236,6 +276,12 @@ struct motion {
     int probe_halt;          /* enum motion_probe_phase of the move at probe_seg */
     struct motion_probe_result probe_res; /* the last probe move's result ... */
     _Atomic unsigned probe_seq;  /* ... published by counting probe moves answered */
+    /* G33/G33.1 (motion_sync.c), servo thread only but spindle_wired (set from there) */
+    double spindle_revs;     /* spindle.0.revs this period, revolutions */
+    _Atomic bool spindle_wired; /* spindle.0.revs is connected: synchronised moves may run */
+    bool spindle_ideal;      /* no encoder: an ideal spindle (hexcnc check) */
+    double ideal_rps;        /* the ideal spindle's speed, rev/s */
+    struct motion_sync sync;
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];
@@ -244,6 +290,7 @@ struct motion {
     double tool_len_mm;      /* ... with this tool length */
     int seg_kind;            /* it is a line (1), an arc (2), a stop (0) ... */
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM]; /* ... from and to these poses */
+    double path_tol_mm;      /* ... rounded by at most this (motion_out) */
     double joint_cmd[KINS_MAX_JOINTS];
     double joint_vel[KINS_MAX_JOINTS];
     double ferror[KINS_MAX_JOINTS];
@@ -267,6 +314,7 @@ struct motion {
     unsigned note_seq;
     int line;
     const char *file;
+    struct motion_jerk *jerk; /* jerk limiting's moving average (motion_jerk.c), or NULL */
 };
 
 /* Durations of the three phases of an interval of length ds: accelerate from v0 to vp,
@@ -305,6 +353,41 @@ void motion_probe_arm(struct motion *m);
 /* After the pose of the period is evaluated: publishes the result once the probe move has
  * come to rest (tripped) or reached its end (no trip). */
 void motion_probe_settle(struct motion *m);
+
+/* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
+#define MOTION_JERK_MAX_S 1.0
+/* Allocates the moving average when the configuration limits jerk (m->jerk stays NULL when
+ * it does not); MOTION_ERR_NOMEM with a message. */
+int motion_jerk_init(struct motion *m, char *err, size_t errlen);
+void motion_jerk_free(struct motion *m);
+/* After the executor evaluated the period: its pose, legs and rates go into the average and
+ * the motion's values become the average's (the move, line and file of the window's middle). */
+void motion_jerk_follow(struct motion *m);
+/* The evaluation failed: the motion's values go back to the last output. */
+void motion_jerk_restore(struct motion *m);
+/* A period without program motion (manual, idle, paused, done, fault): the average holds
+ * the motion's present values and starts from them when the program moves again. */
+void motion_jerk_hold(struct motion *m);
+/* Whether the average has come to rest on the executor's pose (always without jerk limits):
+ * the machine counts as stopped only then. */
+bool motion_jerk_settled(const struct motion *m);
+/* The period over which a chord's and the average's cut of a curved path is bounded: the
+ * set-point period T_s and the average's window T_j give the same cut as a set-point chord
+ * of sqrt(T_s^2 + T_j^2 / 3) (a chord cuts q d^2 / 8, the average q (v T_j)^2 / 24). */
+double motion_chord_period(const struct motion_config *c);
+/* Spindle-synchronised moves (motion_sync.c). At plan time: whether the machine can follow
+ * the synchronised line sg (spindle feedback, the speed and acceleration the spindle's
+ * speed asks of path and legs, the reach of a tap's run-on); -2 with err naming file and
+ * line if not. On the executor: before the clock advances, drives a synchronised segment
+ * from the spindle (true when it did: the plan clock is left alone); in evaluate, the path
+ * position and speed there (true when on one). */
+int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
+                      size_t errlen);
+bool motion_sync_advance(struct motion *m, double dt);
+bool motion_sync_at(const struct motion *m, double *s, double *v);
+/* Whether the spindle drives the path now (following it, or a tap's own moves between): the
+ * jerk limiter's moving average stands aside, so the tool keeps its place on the thread. */
+bool motion_sync_direct(const struct motion *m);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -346,6 +429,22 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
  * use: 10 % is kept in hand for the terms they leave out. */
 #define KIN_TOL_SHARE 0.9
 
+/* With jerk limits, the share of a G64 tolerance P the rounding of the path by set-point
+ * chords and the moving average may use (the blend arcs keep to the rest of P, so blend and
+ * rounding together stay within P of the programmed path). */
+#define JERK_ROUND_SHARE 0.5
+
+/* How far the set-point chords (and with jerk limits the moving average) may cut a curve of
+ * segment sg, mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE; with jerk limits under G64 P, the
+ * larger JERK_ROUND_SHARE of P (motion_jerk.c). */
+static inline double motion_round_tol_mm(const struct motion *m, const struct motion_seg *sg)
+{
+    double t = KIN_TOL_SHARE * m->cfg.kin_tol_mm;
+    if (m->jerk && sg->blend_tol_mm > 0 && JERK_ROUND_SHARE * sg->blend_tol_mm > t)
+        t = JERK_ROUND_SHARE * sg->blend_tol_mm;
+    return t;
+}
+
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */
 #define JUMP_SHARE 0.5
 /* A joint that could be passed only as fast as full acceleration reaches in this many servo
@@ -377,10 +476,11 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
                      char *err, size_t errlen);
 /* The speed cap of a knot within reach of a set-point chord touching an arc of path
  * curvature k_mm (1/mm) and A B C curvature kabc (deg/mm^2): the chord's cut of the path
- * plus the legs' own deviation stay within KIN_TOL_SHARE of the tolerances. HUGE_VAL when
- * the bound is off; -1 when the pose is singular. */
+ * plus the legs' own deviation stay within tol_mm (motion_round_tol_mm of the arcs), and
+ * KIN_TOL_SHARE of the angular tolerance. HUGE_VAL when the bound is off; -1 when the pose
+ * is singular. */
 double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
-                        const struct motion_sample *S, double k_mm, double kabc);
+                        const struct motion_sample *S, double k_mm, double kabc, double tol_mm);
 
 /* Chords near arcs (motion_chord.c). Marks the path within reach of a set-point chord that
  * touches an arc (chord_mm, chord_k, chord_kabc of every segment) and puts a knot where

@@ -108,7 +108,7 @@ void motion_probe_settle(struct motion *m)
     if (!m->probe_seg || !m->run || m->probe_seg > m->run->nseg)
         return;
     const struct motion_seg *sg = &m->run->segs[m->probe_seg - 1];
-    if (m->probe_halt == PROBE_HALTING && m->rate == 0) {
+    if (m->probe_halt == PROBE_HALTING && m->rate == 0 && motion_jerk_settled(m)) {
         take_pose(m, m->probe_res.stop);
         m->probe_halt = PROBE_PARKED;
         publish(m);

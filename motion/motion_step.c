@@ -152,10 +152,25 @@ static int wait_here(struct motion *m)
     return 1;
 }
 
+/* At the start of a pause or a wait not yet honoured, with jerk limits: held there until the
+ * moving average has come to rest on it (motion_jerk.c), so that the machine stands still
+ * when the pause or the wait begins. */
+static int settle_here(struct motion *m)
+{
+    const struct motion_seg *sg = &m->run->segs[m->cs];
+    bool stop = (sg->kind == SEG_PAUSE && m->paused_at_seg != m->cs + 1) ||
+                (sg->kind == SEG_WAIT && m->waited_at_seg != m->cs + 1 && !m->waiting);
+    if (!stop || m->ci != sg->k0 || motion_jerk_settled(m))
+        return 0;
+    m->tau_s = m->run->kt[m->ci];
+    m->rate = 0;
+    return 1;
+}
+
 /* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
 static int pause_here(struct motion *m)
 {
-    if (wait_here(m))
+    if (settle_here(m) || wait_here(m))
         return 1;
     const struct motion_seg *sg = &m->run->segs[m->cs];
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
@@ -291,7 +306,9 @@ static void advance(struct motion *m, double dt)
             return;
         }
     }
-    if (resting(p, m->ci, sg)) {
+    if (motion_sync_advance(m, dt))
+        ;                               /* the spindle drives the path (motion_sync.c) */
+    else if (resting(p, m->ci, sg)) {
         if (m->state == MOTION_RUNNING && !probe_halt)
             m->tau_s += dt;             /* a rest lasts its time whatever the override */
         else
@@ -318,7 +335,7 @@ static void advance(struct motion *m, double dt)
             /* at rest after an M66: on into the next part once the interpreter, which has
              * the answer now, has planned it */
             struct motion_chunk *c = m->chunk, *n = atomic_load(&c->next);
-            if (n && n != MOTION_TAIL_TAKEN) {
+            if (n && n != MOTION_TAIL_TAKEN && motion_jerk_settled(m)) {
                 pass_marks_to(m, c->plan.nseg);
                 pass_ios_to(m, c->plan.nseg);
                 /* (the part after the wait may hold no move: the program's end) */
@@ -327,7 +344,10 @@ static void advance(struct motion *m, double dt)
                     m->state = MOTION_DONE;
             }
         } else if (m->chunk && !m->chunk->last) {
-            /* the tail of a chunk whose successor never came: stopped on the path */
+            /* the tail of a chunk whose successor never came: stopped on the path (once the
+             * jerk limiter's average has come to rest too) */
+            if (!motion_jerk_settled(m))
+                return;
             const struct motion_seg *e = &p->segs[p->nseg - 1];
             motion_set_msg(m, "%s:%d: the program's next part was not planned in time (the "
                            "planner fell behind the machine, or stopped on an error): the "
@@ -335,13 +355,15 @@ static void advance(struct motion *m, double dt)
                            e->file ? e->file : "program", e->line, e->line);
             m->state = MOTION_FAULT;
             m->fault_status = MOTION_ERR_STARVED;
-        } else {
+        } else if (motion_jerk_settled(m)) {
             m->state = MOTION_DONE;
         }
     }
-    if (m->rate == 0 && m->state == MOTION_PAUSING)
+    /* (with jerk limits the machine has stopped once the moving average has) */
+    bool still = m->rate == 0 && motion_jerk_settled(m);
+    if (still && m->state == MOTION_PAUSING)
         m->state = MOTION_PAUSED;
-    if (m->rate == 0 && m->state == MOTION_STOPPING) {
+    if (still && m->state == MOTION_STOPPING) {
         m->state = MOTION_IDLE;
         m->loaded = 0;
     }
@@ -354,6 +376,7 @@ static int evaluate(struct motion *m)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
     plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+    motion_sync_at(m, &s, &vp);        /* a synchronised move: where the spindle has it */
     if (m->state == MOTION_DONE) {
         s = sg->len;
         vp = 0;
@@ -372,6 +395,9 @@ static int evaluate(struct motion *m)
     m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
     memcpy(m->seg_from, sg->start, sizeof m->seg_from);
     memcpy(m->seg_to, sg->end, sizeof m->seg_to);
+    m->path_tol_mm = m->cfg.kin_tol_mm;
+    if (m->jerk && sg->blend_tol_mm > 0)
+        m->path_tol_mm = fmax(m->path_tol_mm, JERK_ROUND_SHARE * sg->blend_tol_mm);
     if (sg->tcp && vr == 0) {
         kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
@@ -549,8 +575,9 @@ static void stream_watch(struct motion *m)
             wait = MOTION_TAIL_TAKEN;
         else if (m->probe_halt == PROBE_PARKED)  /* stopped on the probe: read on */
             wait = !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
-        else if (c->sync)    /* after the M66 wait: the interpreter reads on */
-            wait = m->tau_s >= c->plan.total_time_s && !m->waiting &&
+        else if (c->sync)    /* after the M66 wait: the interpreter reads on (once the
+                              * jerk limiter's average has come to rest there) */
+            wait = m->tau_s >= c->plan.total_time_s && !m->waiting && motion_jerk_settled(m) &&
                    !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
         else if (!c->last && !m->tail_taken &&
                  !atomic_load_explicit(&c->next, memory_order_acquire) &&
@@ -574,6 +601,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         m->state = MOTION_DONE;  /* a streamed program without a move */
     if (m->state == MOTION_MANUAL) {
         motion_manual_step(m, period_s);
+        motion_jerk_hold(m);
     } else if (moving && m->loaded && stream_ready(m) && m->run->nseg) {
         m->io_age++;
         pass_ios(m);           /* the commands at the present place first: a wait there */
@@ -582,6 +610,10 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         pass_ios(m);
         /* (a streamed end holds no move; at rest on a probe's trip the pose holds) */
         int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m) : KINS_OK;
+        if (st == KINS_OK)
+            motion_jerk_follow(m);
+        else
+            motion_jerk_restore(m);
         motion_probe_settle(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
@@ -600,6 +632,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         m->path_vel = 0;
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         memset(m->joint_vel, 0, sizeof m->joint_vel);
+        motion_jerk_hold(m);
     }
     stream_watch(m);
     memcpy(out->pose, m->pose, sizeof out->pose);
@@ -610,6 +643,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->seg_kind = m->loaded ? m->seg_kind : 0;
     memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
     memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
+    out->path_tol_mm = m->path_tol_mm;
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
     memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
     for (int i = 0; i < m->nj; i++) {

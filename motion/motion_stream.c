@@ -85,6 +85,8 @@ int motion_stream_create(struct motion *m, const double start[KINS_POSE_DIM],
     s->pm->wait_at_speed = m->wait_at_speed;
     s->pm->wait_tool = m->wait_tool;
     s->pm->io = m->io;              /* the spindle as the program finds it */
+    atomic_store(&s->pm->spindle_wired, atomic_load(&m->spindle_wired));
+    s->pm->spindle_ideal = m->spindle_ideal;
     s->pm->cancel = cancel;
     memcpy(s->start, start, sizeof s->start);
     memcpy(s->start0, start, sizeof s->start0);

@@ -1,5 +1,6 @@
 /* sim_spindle.c: HAL component `sim-spindle`: a simulated spindle that takes time to reach
- * the speed it is given, and says when it is there (for spindle.0.at-speed). */
+ * the speed it is given, says when it is there (for spindle.0.at-speed), and has an encoder:
+ * its position in revolutions (for spindle.0.revs, G33 and G33.1). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,12 +11,14 @@
  *   sim-spindle.speed-in   float in    commanded speed, rpm, signed (spindle.0.speed-out)
  *   sim-spindle.speed      float out   the spindle's speed, rpm, signed
  *   sim-spindle.at-speed   bit   out   |speed - speed-in| within tolerance
+ *   sim-spindle.revs       float out   the encoder: revolutions turned, signed (forward
+ *                                      counts up), the speed integrated each period
  *   sim-spindle.accel      float param rpm/s the spindle gains or loses speed at (2000)
  *   sim-spindle.tolerance  float param fraction of the commanded speed that counts as at
  *                                      speed (0.02), and never less than 1 rpm
  */
 struct sim_spindle {
-    double *in, *speed;
+    double *in, *speed, *revs;
     bool *at_speed;
     double accel, tol;
 };
@@ -24,8 +27,9 @@ static void sim_spindle_update(void *arg, long period_ns)
 {
     struct sim_spindle *s = arg;
     double dt = (double)period_ns * 1e-9, step = fabs(s->accel) * dt;
-    double diff = *s->in - *s->speed;
+    double diff = *s->in - *s->speed, rpm0 = *s->speed;
     *s->speed += fabs(diff) <= step ? diff : copysign(step, diff);
+    *s->revs += 0.5 * (rpm0 + *s->speed) / 60.0 * dt;   /* the ramp's mean speed: exact */
     *s->at_speed = fabs(*s->in - *s->speed) <= fmax(fabs(s->tol * *s->in), 1.0);
 }
 
@@ -46,6 +50,7 @@ static int sim_spindle_load(struct hal *h, int argc, char **argv)
     if ((rc = hal_pin_float_newf(h, HAL_IN, &s->in, "sim-spindle.speed-in")) ||
         (rc = hal_pin_float_newf(h, HAL_OUT, &s->speed, "sim-spindle.speed")) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &s->at_speed, "sim-spindle.at-speed")) ||
+        (rc = hal_pin_float_newf(h, HAL_OUT, &s->revs, "sim-spindle.revs")) ||
         (rc = hal_param_float_newf(h, HAL_RW, &s->accel, "sim-spindle.accel")) ||
         (rc = hal_param_float_newf(h, HAL_RW, &s->tol, "sim-spindle.tolerance")))
         return rc;

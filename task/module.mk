@@ -8,4 +8,5 @@ TESTS += test_e2e test_run_faults test_run_settings test_run_startup
 BENCHES += bench_servo bench_session
 SCRIPT_TESTS += tests/e2e/run_cli.sh
 SCRIPT_TESTS += tests/e2e/run_large.sh tests/e2e/machine_session.sh tests/e2e/python_client.sh \
-                tests/e2e/stream_session.sh tests/e2e/machine_probe.sh
+                tests/e2e/stream_session.sh tests/e2e/machine_probe.sh tests/e2e/jerk_session.sh \
+                tests/e2e/machine_sync.sh

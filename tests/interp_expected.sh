@@ -1,6 +1,7 @@
 #!/bin/sh
 # Runs `hexcnc interp` on tests/interp_expected/*.ngc and compares its motion lines
-# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, STRAIGHT_PROBE, ARC_FEED, NURBS_FEED, DWELL), outputs (M62..M68) and active comments
+# (STRAIGHT_TRAVERSE, STRAIGHT_FEED, STRAIGHT_PROBE, ARC_FEED, NURBS_FEED, DWELL, RIGID_TAP and
+# the START_SPEED_FEED_SYNC/STOP_SPEED_FEED_SYNCH around G33), outputs (M62..M68) and active comments
 # (MESSAGE, LOG...) with those in NAME.out, which LinuxCNC's
 # `rs274 -g NAME.ngc` printed (with -t NAME.tbl when that file exists; rs274 alone reads a
 # tool table in inches, so where NAME.rs274.tbl exists, the same tools in inches, rs274 is
@@ -15,7 +16,7 @@ tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 pass=0; fail=0
 # (a zero rs274 prints as -0.0000, about -1e-16 after a last-bit rounding, is the zero it is)
-motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|STRAIGHT_PROBE|ARC_FEED|NURBS_FEED|DWELL|_OUTPUT_(BIT|VALUE)|N\.* (MESSAGE|LOG(OPEN|APPEND|CLOSE)?)\(' |
+motion() { grep -E 'STRAIGHT_TRAVERSE|STRAIGHT_FEED|STRAIGHT_PROBE|ARC_FEED|NURBS_FEED|DWELL|RIGID_TAP|SPEED_FEED_SYNC|_OUTPUT_(BIT|VALUE)|N\.* (MESSAGE|LOG(OPEN|APPEND|CLOSE)?)\(' |
            cut -c7- | sed -E 's/-(0\.0+)([,)])/\1\2/g'; }
 for ngc in "$dir"/*.ngc; do
     name=$(basename "$ngc" .ngc)

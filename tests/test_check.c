@@ -360,6 +360,41 @@ START_TEST(test_config_error_names_the_ini_line)
 }
 END_TEST
 
+/* Problems merge by kind, file, line and leg, the worst value kept and the periods counted;
+ * distinct ones keep their order. 60,000 lines with a warning each (dense code under jerk
+ * limits has one on most lines) merge through the index, not a scan of the list. */
+START_TEST(test_problem_merging)
+{
+    struct check_result r;
+    check_result_init(&r);
+    struct check_problem p = { .kind = CHECK_TIP_DEVIATION, .leg = -1, .count = 1 };
+    snprintf(p.file, sizeof p.file, "a.ngc");
+    for (int pass = 0; pass < 2; pass++)
+        for (int line = 1; line <= 60000; line++) {
+            p.line = line;
+            p.value = pass ? 2.0 * line : line;
+            ck_assert_int_eq(check_add_warning(&r, &p), CHECK_OK);
+        }
+    snprintf(p.file, sizeof p.file, "b.ngc");       /* another file, the same line */
+    p.line = 7, p.value = 1;
+    ck_assert_int_eq(check_add_warning(&r, &p), CHECK_OK);
+    p.kind = CHECK_LEG_JERK, p.leg = 2;               /* a problem: its own list */
+    ck_assert_int_eq(check_add_problem(&r, &p), CHECK_OK);
+    ck_assert_int_eq(check_add_problem(&r, &p), CHECK_OK);
+    ck_assert_uint_eq(r.nwarnings, 60001);
+    for (int line = 1; line <= 60000; line += 997) {
+        ck_assert_int_eq(r.warnings[line - 1].line, line);
+        ck_assert_int_eq(r.warnings[line - 1].count, 2);
+        ck_assert_double_eq(r.warnings[line - 1].value, 2.0 * line);
+    }
+    ck_assert_str_eq(r.warnings[60000].file, "b.ngc");
+    ck_assert_int_eq(r.warnings[60000].count, 1);
+    ck_assert_uint_eq(r.nproblems, 1);
+    ck_assert_int_eq(r.problems[0].count, 2);
+    check_result_free(&r);
+}
+END_TEST
+
 START_TEST(test_strip_compensation)
 {
     const char in[] = "G141 X50 Y-80 Z630 A0 B-4 W10 F2;\ng142 x1 D3\nG1 X1 (G1410)\n";
@@ -389,6 +424,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_plots_written);
     tcase_add_test(tc, test_plot_file_replaced_atomically);
     tcase_add_test(tc, test_strip_compensation);
+    tcase_add_test(tc, test_problem_merging);
     tcase_add_test(tc, test_config_error_names_the_ini_line);
     suite_add_tcase(s, tc);
     return s;

@@ -1,6 +1,6 @@
 /* test_interp_feed.c: G95, feed per revolution: the feed moves carry F x S (mm/min), what
- * this machine (no spindle feedback) runs them at; rs274's printed form is compared in
- * tests/interp_expected/g95_per_rev.ngc. */
+ * this machine runs them at (G95 does not follow the encoder: only G33, G33.1 do); rs274's
+ * printed form is compared in tests/interp_expected/g95_per_rev.ngc. */
 #include <check.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,5 +1,6 @@
 /* test_motion_stream.c: a program planned window by window while it runs (motion_stream.c)
- * against the same program planned whole (motion_load). */
+ * against the same program planned whole (motion_load), trapezoidal (loop 0) and with jerk
+ * limits (loop 1: every leg's jerk within MAX_JERK, streamed as whole). */
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
@@ -8,6 +9,23 @@
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
+#define LEG_JERK 50000.0       /* mm/s^3, loop 1 */
+
+/* The TMU hexapod, with jerk limits when jerk (the test's loop index) is 1. */
+static struct tk_cfg *stream_cfg(int jerk)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    if (!c || !jerk)
+        return c;
+    tk_setf(c, "TRAJ", "MAX_LINEAR_JERK", 50000);
+    tk_setf(c, "TRAJ", "MAX_ANGULAR_JERK", 30000);
+    for (int j = 0; j < 6; j++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", j);
+        tk_setf(c, sec, "MAX_JERK", LEG_JERK);
+    }
+    return c;
+}
 
 /* A long program on the TMU hexapod: short G64 P0.01 moves around a 20 mm circle while A
  * rocks by 2 deg, with spindle commands, settings and a dwell along the way. */
@@ -91,7 +109,7 @@ static struct motion_stream *stream_open(struct tm_machine *mc, const struct can
 START_TEST(stream_matches_whole_plan)
 {
     struct tm_machine whole, st;
-    struct tk_cfg *c1 = tm_hexapod_cfg(), *c2 = tm_hexapod_cfg();
+    struct tk_cfg *c1 = stream_cfg(_i), *c2 = stream_cfg(_i);
     ck_assert_ptr_nonnull(c1);
     ck_assert_int_eq(tm_open(&whole, c1, &kins_hexapod_ops), 0);
     ck_assert_int_eq(tm_open(&st, c2, &kins_hexapod_ops), 0);
@@ -123,6 +141,8 @@ START_TEST(stream_matches_whole_plan)
     for (int j = 0; j < 6; j++) {
         ck_assert_double_le(ss.max_leg_v[j], 100 * 1.001);
         ck_assert_double_le(ss.max_leg_a[j], fmax(1000, sw.max_leg_a[j]) * 1.01);
+        if (_i)
+            ck_assert_double_le(ss.max_leg_j[j], LEG_JERK * (1 + 1e-9));
     }
     ck_assert_uint_eq(ss.last.settings_done, 6);           /* 9000 / 1500 */
     ck_assert_uint_eq(sw.last.settings_done, 6);
@@ -143,7 +163,7 @@ END_TEST
 START_TEST(stream_starved_stops_on_path)
 {
     struct tm_machine mc;
-    struct tk_cfg *c = tm_hexapod_cfg();
+    struct tk_cfg *c = stream_cfg(_i);
     ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
     struct canon_prog p;
     long_program(&p, 9000);
@@ -191,7 +211,7 @@ static int pause_then_abort(struct motion *m, const struct motion_out *o, int st
 START_TEST(stream_pause_resume_abort)
 {
     struct tm_machine mc;
-    struct tk_cfg *c = tm_hexapod_cfg();
+    struct tk_cfg *c = stream_cfg(_i);
     ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
     struct canon_prog p;
     long_program(&p, 9000);
@@ -217,7 +237,7 @@ END_TEST
 START_TEST(stream_check_reports_line)
 {
     struct tm_machine mc;
-    struct tk_cfg *c = tm_hexapod_cfg();
+    struct tk_cfg *c = stream_cfg(_i);
     ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
     struct canon_prog p;
     long_program(&p, 9000);
@@ -252,8 +272,8 @@ END_TEST
 START_TEST(stream_sync_on_input_wait)
 {
     struct tm_machine whole, st;
-    ck_assert_int_eq(tm_open(&whole, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
-    ck_assert_int_eq(tm_open(&st, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    ck_assert_int_eq(tm_open(&whole, stream_cfg(_i), &kins_hexapod_ops), 0);
+    ck_assert_int_eq(tm_open(&st, stream_cfg(_i), &kins_hexapod_ops), 0);
     struct canon_prog p;
     canon_prog_init(&p);
     double home[6] = {0, 0, 645, 0, 0, 0}, a[6] = {5, 0, 645, 0, 0, 0}, b[6] = {5, 5, 645, 0, 0, 0};
@@ -317,11 +337,11 @@ int main(void)
     Suite *s = suite_create("motion_stream");
     TCase *tc = tcase_create("stream");
     tcase_set_timeout(tc, 120);
-    tcase_add_test(tc, stream_matches_whole_plan);
-    tcase_add_test(tc, stream_starved_stops_on_path);
-    tcase_add_test(tc, stream_pause_resume_abort);
-    tcase_add_test(tc, stream_check_reports_line);
-    tcase_add_test(tc, stream_sync_on_input_wait);
+    tcase_add_loop_test(tc, stream_matches_whole_plan, 0, 2);
+    tcase_add_loop_test(tc, stream_starved_stops_on_path, 0, 2);
+    tcase_add_loop_test(tc, stream_pause_resume_abort, 0, 2);
+    tcase_add_loop_test(tc, stream_check_reports_line, 0, 2);
+    tcase_add_loop_test(tc, stream_sync_on_input_wait, 0, 2);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

@@ -152,6 +152,8 @@ struct tm_stats {
     double max_leg_v[KINS_MAX_JOINTS];/* leg speed from successive leg commands */
     double max_leg_a[KINS_MAX_JOINTS];/* leg acceleration from successive leg speeds */
     double max_cmd_leg_v[KINS_MAX_JOINTS]; /* leg rate commands (joint_vel) */
+    double max_j_mm_s3;               /* XYZ jerk from successive accelerations */
+    double max_leg_j[KINS_MAX_JOINTS];/* leg jerk from successive leg accelerations */
     struct motion_out last;
 };
 
@@ -163,7 +165,8 @@ static inline void tm_run(struct motion *m, double dt, int max_steps, struct tm_
                           tm_hook hook, void *ctx)
 {
     struct motion_out o, prev;
-    double pv[3] = {0, 0, 0}, plv[KINS_MAX_JOINTS] = {0};
+    double pv[3] = {0, 0, 0}, plv[KINS_MAX_JOINTS] = {0}, pa[3] = {0, 0, 0};
+    double pla[KINS_MAX_JOINTS] = {0};
     memset(s, 0, sizeof *s);
     motion_step(m, dt, &prev);          /* the first period leaves the start */
     s->steps = 1;
@@ -179,12 +182,22 @@ static inline void tm_run(struct motion *m, double dt, int max_steps, struct tm_
         s->max_v_mm_s = fmax(s->max_v_mm_s, vn);
         if (k > 1)
             s->max_a_mm_s2 = fmax(s->max_a_mm_s2, an);
+        double a[3], jn = 0;
+        for (int i = 0; i < 3; i++)
+            a[i] = (v[i] - pv[i]) / dt, jn += (a[i] - pa[i]) * (a[i] - pa[i]);
+        if (k > 2)
+            s->max_j_mm_s3 = fmax(s->max_j_mm_s3, sqrt(jn) / dt);
+        memcpy(pa, a, sizeof pa);
         memcpy(pv, v, sizeof pv);
         for (int j = 0; j < o.njoints; j++) {
             double lv = (o.joint_pos[j] - prev.joint_pos[j]) / dt;
             s->max_leg_v[j] = fmax(s->max_leg_v[j], fabs(lv));
+            double la = (lv - plv[j]) / dt;
             if (k > 1)
-                s->max_leg_a[j] = fmax(s->max_leg_a[j], fabs(lv - plv[j]) / dt);
+                s->max_leg_a[j] = fmax(s->max_leg_a[j], fabs(la));
+            if (k > 2)
+                s->max_leg_j[j] = fmax(s->max_leg_j[j], fabs(la - pla[j]) / dt);
+            pla[j] = la;
             s->max_cmd_leg_v[j] = fmax(s->max_cmd_leg_v[j], fabs(o.joint_vel[j]));
             plv[j] = lv;
         }

@@ -65,6 +65,9 @@ struct motion_comp {
     bool *din[MOTION_MAX_DIO];               /* in: motion.digital-in-NN (M66 P) */
     double *ain[MOTION_MAX_AIO];             /* in: motion.analog-in-NN (M66 E) */
     bool *probe_in;                          /* in: motion.probe-input (G38.2..G38.5) */
+    double *sp_revs;                         /* in: spindle.0.revs, the spindle's position,
+                                              * revolutions (G33, G33.1) */
+    double *sp_revs_own;                     /* its own storage (see sp_at_speed_own) */
     /* the tool changer's handshake, LinuxCNC's iocontrol pins */
     int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
     bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
@@ -228,6 +231,7 @@ static void motion_comp_update(void *arg, long period_ns)
         ain[i] = *c->ain[i];
     motion_set_inputs(c->m, din, c->ndio, ain, c->naio);
     motion_set_probe_input(c->m, *c->probe_in);
+    motion_set_spindle_revs(c->m, *c->sp_revs, c->sp_revs != c->sp_revs_own);
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
@@ -327,6 +331,7 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
     for (int i = 0; st == HAL_OK && i < c->naio; i++)
         st = hal_pin_float_newf(h, HAL_IN, &c->ain[i], "motion.analog-in-%02d", i);
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->probe_in, "motion.probe-input");
+    if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_IN, &c->sp_revs, "spindle.0.revs");
     if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");
@@ -396,6 +401,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     c->h = h;
     *c->sp_at_speed = true;   /* unwired: the spindle is taken to be at speed */
     c->sp_at_speed_own = c->sp_at_speed;
+    c->sp_revs_own = c->sp_revs;
     c->tc_prepared_own = c->tc_prepared;
     c->tc_changed_own = c->tc_changed;
     c->autostart = true;
@@ -432,6 +438,7 @@ static int motion_comp_prepare(struct motion_comp *c, struct hal *h,
         }
     }
     motion_set_wait_at_speed(c->m, c->sp_at_speed != c->sp_at_speed_own);
+    motion_set_spindle_revs(c->m, *c->sp_revs, c->sp_revs != c->sp_revs_own);
     motion_set_wait_tool(c->m, c->tc_changed != c->tc_changed_own || c->manual_tc);
     return MOTION_OK;
 }

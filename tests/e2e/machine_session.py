@@ -16,7 +16,7 @@ import time
 
 ROOT = os.environ.get("HEXCNC_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("HEXCNC_BIN", os.path.join(ROOT, "bin", "hexcnc"))
-SIM = os.path.join(ROOT, "configs", "sim")
+SIM = os.environ.get("HEXCNC_SIM_DIR", os.path.join(ROOT, "configs", "sim"))
 FAILS = []
 
 
@@ -30,9 +30,19 @@ class Conn:
     """One client: requests by id, notifications kept aside."""
 
     def __init__(self, path):
-        self.s = socket.socket(socket.AF_UNIX)
-        self.s.settimeout(30)
-        self.s.connect(path)
+        # (the socket's file appears at bind(), a moment before listen(): on a loaded
+        # machine a client may come in between; it tries again for up to 5 s)
+        for attempt in range(500):
+            self.s = socket.socket(socket.AF_UNIX)
+            self.s.settimeout(30)
+            try:
+                self.s.connect(path)
+                break
+            except ConnectionRefusedError:
+                self.s.close()
+                if attempt == 499:
+                    raise
+                time.sleep(0.01)
         self.buf = b""
         self.notes = []
         self.id = 0
@@ -564,11 +574,8 @@ def homing_ini(tmp):
                 "net leg-%d-fb => sim-home.%d.motor-pos" % (i, i),
                 "net home-sw-%d sim-home.%d.home-sw => motion.joint-home-sw-in-%d" % (i, i, i)]
     hal.append("addf sim-home.update servo-thread")
-    # a spindle that takes 0.5 s to reach 1000 rpm, its at-speed wired back to motion
-    hal += ["loadrt sim-spindle",
-            "net spindle-cmd spindle.0.speed-out => sim-spindle.speed-in",
-            "net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed",
-            "addf sim-spindle.update servo-thread"]
+    # the sim config's spindle (0.5 s to reach 1000 rpm), its at-speed wired back to motion
+    hal += ["net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed"]
     # a tool changer that takes 0.5 s to prepare and 2 s to change
     hal += ["loadrt sim-toolchanger",
             "net tool-prepare iocontrol.0.tool-prepare => sim-toolchanger.prepare",

@@ -1,0 +1,124 @@
+/* bench_jerk.c: what jerk limiting costs in machining time, and the peak leg speed,
+ * acceleration and jerk against their limits, trapezoidal beside jerk-limited, on the paper's
+ * programs, the TMU demo and the dense five-axis hour, through `hexcnc check`'s servo pass
+ * (the legs differenced every servo period). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bench/bench_dense.h"
+#include "check/check.h"
+#include "check/check_priv.h"
+
+#define LEG_JERK 50000.0       /* mm/s^3, [JOINT_n] MAX_JERK */
+#define LIN_JERK 50000.0       /* mm/s^3, [TRAJ] MAX_LINEAR_JERK */
+#define ANG_JERK 30000.0       /* deg/s^3, [TRAJ] MAX_ANGULAR_JERK */
+
+/* One check of prog on ini, trapezoidal (scale 0) or with the jerk limits above times
+ * scale. */
+static int check_one(const char *ini, const char *prog, double jerk, struct check_result *r,
+                     double *window_s)
+{
+    char err[1024];
+    struct check_machine *mc;
+    if (check_machine_open(ini, &mc, err, sizeof err) != CHECK_OK) {
+        fprintf(stderr, "bench_jerk: %s\n", err);
+        return -1;
+    }
+    if (jerk) {       /* the same machine with jerk limits: a new motion on the same limits */
+        mc->mcfg.max_lin_jerk_mm_s3 = jerk * LIN_JERK;
+        mc->mcfg.max_ang_jerk_deg_s3 = jerk * ANG_JERK;
+        for (int i = 0; i < mc->mcfg.njoints; i++)
+            mc->mcfg.joint[i].max_jerk_mm_s3 = jerk * LEG_JERK;
+        motion_destroy(mc->motion);
+        mc->motion = NULL;
+        if (motion_create(&mc->mcfg, mc->kins, &mc->motion, err, sizeof err) != MOTION_OK) {
+            fprintf(stderr, "bench_jerk: %s\n", err);
+            check_machine_close(mc);
+            return -1;
+        }
+    }
+    *window_s = motion_jerk_window_s(&mc->mcfg);
+    check_result_init(r);
+    int st = check_program(mc, prog, NULL, r);
+    if (st != CHECK_OK || r->nproblems)
+        fprintf(stderr, "bench_jerk: %s: %s\n", prog,
+                r->nproblems ? r->problems[0].message : "the check did not run");
+    check_machine_close(mc);
+    return st == CHECK_OK && !r->nproblems ? 0 : -1;
+}
+
+/* The largest ratio to its limit over the legs: speed, acceleration, jerk (to jerk_mm_s3). */
+static void peaks(const struct check_result *r, double jerk_mm_s3, double out[3])
+{
+    out[0] = out[1] = out[2] = 0;
+    for (int i = 0; i < r->njoints; i++) {
+        const struct check_leg *l = &r->leg[i];
+        out[0] = fmax(out[0], l->peak_vel_mm_s / l->limit_vel_mm_s);
+        out[1] = fmax(out[1], l->peak_acc_mm_s2 / l->limit_acc_mm_s2);
+        out[2] = fmax(out[2], l->peak_jerk_mm_s3 / jerk_mm_s3);
+    }
+}
+
+/* Both checks of one program (the jerk limits times scale), one row. */
+static int row(const char *label, const char *ini, const char *prog, double scale)
+{
+    struct check_result t, j;
+    double w0, w1, pt[3], pj[3];
+    if (check_one(ini, prog, 0, &t, &w0) || check_one(ini, prog, scale, &j, &w1))
+        return -1;
+    peaks(&t, scale * LEG_JERK, pt);
+    peaks(&j, scale * LEG_JERK, pj);
+    printf("%-22s %9.3f s %9.3f s %6.3fx   %4.2f %4.2f %7.2f   %4.2f %4.2f %5.2f\n", label,
+           t.machining_time_s, j.machining_time_s, j.machining_time_s / t.machining_time_s,
+           pt[0], pt[1], pt[2], pj[0], pj[1], pj[2]);
+    check_result_free(&t);
+    check_result_free(&j);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    int blocks = argc > 1 ? atoi(argv[1]) : 240000;
+    static const struct { const char *label, *ini, *prog; } progs[] = {
+        { "paper run 1 (G141)", "examples/paper/experiment/tmu-path1.ini",
+          "examples/paper/experiment/run1_g141.ngc" },
+        { "paper run 1 (G142)", "examples/paper/experiment/tmu-path1.ini",
+          "examples/paper/experiment/run1_g142.ngc" },
+        { "paper run 2 (G141)", "examples/paper/experiment/tmu-path1.ini",
+          "examples/paper/experiment/run2_g141.ngc" },
+        { "paper run 3 (G141)", "examples/paper/experiment/tmu-path2.ini",
+          "examples/paper/experiment/run3_g141.ngc" },
+        { "paper run 4 (G141)", "examples/paper/experiment/tmu-path2.ini",
+          "examples/paper/experiment/run4_g141.ngc" },
+        { "TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc" },
+    };
+    char dense[] = "/tmp/hexcnc-bench-jerk-XXXXXX.ngc";
+    int fd = mkstemps(dense, 4);
+    if (fd < 0 || close(fd) != 0 || bench_dense_write(dense, blocks) != 0) {
+        fprintf(stderr, "bench_jerk: cannot write %s\n", dense);
+        return 1;
+    }
+    printf("jerk limiting: [JOINT_n] MAX_JERK %.0f mm/s^3, [TRAJ] MAX_LINEAR_JERK %.0f mm/s^3, "
+           "MAX_ANGULAR_JERK %.0f deg/s^3 on the TMU's limits (a 40 ms moving average);\n"
+           "peaks: the largest over the legs, differenced every servo period, as a ratio to "
+           "the leg's limit (jerk: to %.0f mm/s^3 in both columns)\n\n", LEG_JERK, LIN_JERK,
+           ANG_JERK, LEG_JERK);
+    printf("%-22s %11s %11s %7s   %-16s   %-16s\n", "program", "trapezoidal", "jerk-limited",
+           "ratio", "trap. v a j", "jerk-lim. v a j");
+    int fail = 0;
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
+        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1);
+    char label[64];
+    snprintf(label, sizeof label, "dense, %d blocks", blocks);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1);
+    printf("\nthe same with 4 x the jerk limits (a 10 ms moving average; jerk to 200000 "
+           "mm/s^3):\n");
+    fail |= row("TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc",
+                4);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4);
+    unlink(dense);
+    return fail ? 1 : 0;
+}

@@ -1,0 +1,325 @@
+/* test_motion_jerk.c: jerk limiting ([TRAJ] MAX_LINEAR_JERK, MAX_ANGULAR_JERK, [JOINT_n]
+ * MAX_JERK): the configuration (all or none, named when missing), and on the TMU hexapod no
+ * leg over its speed, acceleration or jerk in any servo period (differencing the commanded
+ * legs) through exact stops, small arcs, feed holds, overrides and aborts, the tool within
+ * KINEMATIC_TOLERANCE of the programmed path, and what it costs in time. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kins/hexapod.h"
+#include "tests/test_motion_util.h"
+
+#define DT 0.001
+#define LEG_JERK 50000.0       /* mm/s^3: 2 x 1000 / 50000 = a 40 ms average */
+#define LIN_JERK 50000.0       /* mm/s^3 */
+#define ANG_JERK 30000.0       /* deg/s^3 */
+
+/* The TMU hexapod, with jerk limits or without. */
+static struct tk_cfg *jerk_cfg(int jerk)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c);
+    if (!jerk)
+        return c;
+    char v[32];
+    snprintf(v, sizeof v, "%g", LIN_JERK);
+    tk_set(c, "TRAJ", "MAX_LINEAR_JERK", v);
+    snprintf(v, sizeof v, "%g", ANG_JERK);
+    tk_set(c, "TRAJ", "MAX_ANGULAR_JERK", v);
+    snprintf(v, sizeof v, "%g", LEG_JERK);
+    for (int j = 0; j < 6; j++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", j);
+        tk_set(c, sec, "MAX_JERK", v);
+    }
+    return c;
+}
+
+/* A G61 program of five-axis feeds at F6000 round a 60 mm square at Z645 (the legs bind). */
+static void square(struct canon_prog *p)
+{
+    static const double pts[][6] = {
+        { 60, 0, 645, 0, 0, 0 }, { 60, 60, 650, 5, -5, 10 }, { 0, 60, 645, 0, 0, 0 },
+        { 0, 0, 645, 0, 0, 0 }, { 30, 30, 648, -4, 3, -8 },
+    };
+    canon_prog_init(p);
+    double start[6] = { 0, 0, 645, 0, 0, 0 };
+    memcpy(p->start, start, sizeof start);
+    p->start_path_mode = 610;
+    for (size_t i = 0; i < sizeof pts / sizeof pts[0]; i++)
+        tm_add(p, CANON_FEED, (int)i + 1, pts[i], 6000, 0);
+}
+
+/* Distance from q (X Y Z) to the program's path of lines and XY arcs turning either way
+ * (tm_dist_path takes arcs counter-clockwise only). */
+static double path_dist(const double *q, const struct canon_prog *p)
+{
+    double at[6], best = HUGE_VAL;
+    memcpy(at, p->start, sizeof at);
+    for (size_t i = 0; i < p->count; i++) {
+        const struct canon_cmd *c = &p->cmds[i];
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE) {
+            best = fmin(best, tm_dist_seg(q, at, c->end));
+        } else if (c->type == CANON_ARC) {
+            const double *o = c->arc.center;
+            double r = hypot(at[0] - o[0], at[1] - o[1]), dir = c->arc.rotation > 0 ? 1 : -1;
+            double a0 = atan2(at[1] - o[1], at[0] - o[0]);
+            double sweep = dir * (atan2(c->end[1] - o[1], c->end[0] - o[0]) - a0);
+            sweep -= 2 * M_PI * floor(sweep / (2 * M_PI));      /* 0 .. 2 pi, turning dir */
+            double aq = dir * (atan2(q[1] - o[1], q[0] - o[0]) - a0);
+            aq -= 2 * M_PI * floor(aq / (2 * M_PI));
+            double d = aq <= sweep ? hypot(hypot(q[0] - o[0], q[1] - o[1]) - r, q[2] - at[2])
+                                   : fmin(tm_dist_seg(q, at, at), tm_dist_seg(q, c->end, c->end));
+            best = fmin(best, d);
+        }
+        if (c->type == CANON_FEED || c->type == CANON_TRAVERSE || c->type == CANON_ARC)
+            memcpy(at, c->end, sizeof at);
+    }
+    return best;
+}
+
+/* What a hook watches: the farthest the tool (forward kinematics of the commanded legs)
+ * strays from the program's path, commands at given periods, and that a stopped state is
+ * reported only once the legs stand still. */
+struct watch {
+    const struct canon_prog *prog;
+    struct kins *kins;
+    double guess[6];
+    double dev_mm;
+    int pause_at, resume_at, abort_at, ovr_at[2];
+    double ovr[2];
+    double prev_L[KINS_MAX_JOINTS];
+    int moved_when_stopped;
+    int paused_periods;
+};
+
+static int watch_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct watch *w = ctx;
+    double P[6];
+    memcpy(P, w->guess, sizeof P);
+    ck_assert_int_eq(kins_forward(w->kins, o->joint_pos, P, NULL), KINS_OK);
+    memcpy(w->guess, P, sizeof P);
+    if (w->prog)
+        w->dev_mm = fmax(w->dev_mm, path_dist(P, w->prog));
+    if (o->state == MOTION_PAUSED || o->state == MOTION_DONE || o->state == MOTION_IDLE) {
+        for (int j = 0; j < o->njoints; j++)
+            if (o->joint_pos[j] != w->prev_L[j])
+                w->moved_when_stopped++;
+    }
+    w->paused_periods += o->state == MOTION_PAUSED;
+    memcpy(w->prev_L, o->joint_pos, sizeof w->prev_L);
+    if (step == w->pause_at)
+        ck_assert_int_eq(motion_pause(m), MOTION_OK);
+    if (step == w->resume_at)
+        ck_assert_int_eq(motion_resume(m), MOTION_OK);
+    if (step == w->abort_at)
+        ck_assert_int_eq(motion_abort(m), MOTION_OK);
+    for (int i = 0; i < 2; i++)
+        if (step == w->ovr_at[i])
+            ck_assert_int_eq(motion_set_feed_override(m, w->ovr[i]), MOTION_OK);
+    return 0;
+}
+
+/* Runs prog on the machine (jerk limits or not) with the watch; returns the figures. */
+static struct tm_stats run(int jerk, const struct canon_prog *prog, struct watch *w,
+                           int deviation)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, prog, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+    w->prog = deviation ? prog : NULL;
+    w->kins = mc.kins;
+    memcpy(w->guess, prog->start, sizeof w->guess);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 400000, &st, watch_hook, w);
+    tm_close(&mc);
+    return st;
+}
+
+/* Every leg within speed, acceleration and jerk in every period; the worst jerk ratio. */
+static double assert_limits(const struct tm_stats *st, const char *what)
+{
+    double worst = 0;
+    for (int j = 0; j < 6; j++) {
+        ck_assert_msg(st->max_leg_v[j] <= 100 * (1 + 1e-9), "%s: leg %d at %.3f mm/s", what, j,
+                      st->max_leg_v[j]);
+        ck_assert_msg(st->max_leg_a[j] <= 1000 * (1 + 1e-9), "%s: leg %d at %.3f mm/s^2",
+                      what, j, st->max_leg_a[j]);
+        ck_assert_msg(st->max_leg_j[j] <= LEG_JERK * (1 + 1e-9), "%s: leg %d at %.0f mm/s^3",
+                      what, j, st->max_leg_j[j]);
+        worst = fmax(worst, st->max_leg_j[j] / LEG_JERK);
+    }
+    return worst;
+}
+
+START_TEST(test_config)
+{
+    struct kins *k;
+    struct motion_config c;
+    char err[400];
+    struct tk_cfg *t = jerk_cfg(1);
+    struct kins_config kc = tk_config(t);
+    ck_assert_int_eq(kins_create(&kins_hexapod_ops, &kc, &k, err, sizeof err), 0);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    /* the longest of 2 a / j: the legs' 2 x 1000 / 50000 */
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.040, 1e-12);
+    tk_set(t, "JOINT_4", "MAX_JERK", NULL);     /* JOINT_4's MAX_JERK gone */
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_msg(strstr(err, "[JOINT_4] MAX_JERK: missing"), "%s", err);
+    free(t);
+    /* a jerk so low that the average would be longer than a second */
+    t = jerk_cfg(1);
+    tk_set(t, "JOINT_2", "MAX_JERK", "1000");
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_msg(strstr(err, "2.000 s moving average"), "%s", err);
+    free(t);
+    /* none: trapezoidal, no average */
+    t = jerk_cfg(0);
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq(motion_jerk_window_s(&c), 0);
+    free(t);
+    kins_free(k);
+}
+END_TEST
+
+/* Exact stops where the legs bind: every limit kept, the corners reached at rest, and the
+ * trapezoidal profile's leg jerk shown to be far over the limit (what the test measures). */
+START_TEST(test_exact_stops)
+{
+    struct canon_prog p;
+    square(&p);
+    struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
+    struct watch wt = wj;
+    struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
+    ck_assert_int_eq(sj.last.state, MOTION_DONE);
+    double r = assert_limits(&sj, "jerk-limited");
+    double rt = 0;
+    for (int j = 0; j < 6; j++)
+        rt = fmax(rt, st.max_leg_j[j] / LEG_JERK);
+    ck_assert_msg(rt > 5, "the trapezoidal profile's leg jerk is only %.2f of the limit", rt);
+    ck_assert_msg(wj.dev_mm <= 0.001, "the tool strays %.5f mm from the path", wj.dev_mm);
+    ck_assert_int_eq(wj.moved_when_stopped, 0);
+    printf("G61 square, TMU hexapod: jerk-limited %.3f s (peak leg jerk %.3f of the limit, "
+           "path %.5f mm) against trapezoidal %.3f s (peak leg jerk %.1f x the limit, path "
+           "%.5f mm): %.3f x the time\n", sj.t_s, r, wj.dev_mm, st.t_s, rt, wt.dev_mm,
+           sj.t_s / st.t_s);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* A feed hold, a resume, overrides up and down, and an abort mid-move: jerk-limited on the
+ * path; paused and idle only once the legs stand still. */
+START_TEST(test_hold_override_abort)
+{
+    struct canon_prog p;
+    square(&p);
+    struct watch w = { .pause_at = 400, .resume_at = 900, .abort_at = -1,
+                       .ovr_at = { 1100, 1500 }, .ovr = { 2.0, 0.3 } };
+    struct tm_stats s = run(1, &p, &w, 1);
+    ck_assert_int_eq(s.last.state, MOTION_DONE);
+    ck_assert_int_gt(w.paused_periods, 100);
+    double r1 = assert_limits(&s, "hold and overrides");
+    ck_assert_int_eq(w.moved_when_stopped, 0);
+    ck_assert_msg(w.dev_mm <= 0.001, "the tool strays %.5f mm from the path", w.dev_mm);
+    struct watch wa = { .pause_at = -1, .resume_at = -1, .abort_at = 700,
+                        .ovr_at = { -1, -1 } };
+    s = run(1, &p, &wa, 1);
+    ck_assert_int_eq(s.last.state, MOTION_IDLE);
+    double r2 = assert_limits(&s, "abort");
+    ck_assert_int_eq(wa.moved_when_stopped, 0);
+    printf("hold, overrides 2.0 and 0.3, abort: peak leg jerk %.3f and %.3f of the limit\n",
+           r1, r2);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* LinuxCNC's issue 3773: small arcs of radius 4 mm under G64, tangent joints and 5 degree
+ * kinks: every limit kept in every period, the tool within the tolerance of the path. */
+START_TEST(test_small_arcs)
+{
+    static const struct { double kink_deg, tol_mm; } cases[] = {
+        { 0, 0.01 }, { 5, 0.01 }, { 5, 0.1 },
+    };
+    struct canon_prog p;
+    tm_small_arcs(&p, 40, 4.0, 30, cases[_i].kink_deg, 6000, 645, cases[_i].tol_mm);
+    struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
+    struct watch wt = wj;
+    struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
+    ck_assert_int_eq(sj.last.state, MOTION_DONE);
+    double r = assert_limits(&sj, "small arcs");
+    double rt = 0;
+    for (int j = 0; j < 6; j++)
+        rt = fmax(rt, st.max_leg_j[j] / LEG_JERK);
+    /* blend arcs within half of P, the chords' and the average's rounding within the other
+     * half: the tool stays within P of the programmed arcs */
+    ck_assert_msg(wj.dev_mm <= cases[_i].tol_mm, "the tool strays %.5f mm from the path",
+                  wj.dev_mm);
+    printf("small arcs, kinks %.0f deg, G64 P%.2f: jerk-limited %.3f s (peak leg jerk %.3f of "
+           "the limit, %.4f mm from the path) against trapezoidal %.3f s (%.1f x the limit, "
+           "%.4f mm): %.3f x the time\n", cases[_i].kink_deg, cases[_i].tol_mm, sj.t_s, r,
+           wj.dev_mm, st.t_s, rt, wt.dev_mm, sj.t_s / st.t_s);
+    canon_prog_free(&p);
+}
+END_TEST
+
+/* G64 corners between straight feeds (a zigzag of 10 mm lines turning 60 and 120 degrees):
+ * the blend arcs take half of P, the rounding the other half; the tool stays within P of the
+ * programmed corners, every limit kept. */
+START_TEST(test_blended_corners)
+{
+    static const double tols[] = { 0.01, 0.05 };
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double at[6] = { -40, 0, 645, 0, 0, 0 };
+    memcpy(p.start, at, sizeof at);
+    p.start_path_mode = 640;
+    p.start_path_tol_mm = tols[_i];
+    for (int i = 0; i < 10; i++) {
+        double a = (i % 2 ? -1 : 1) * (i % 4 < 2 ? 60 : 30) * M_PI / 180;
+        at[0] += 10 * cos(a), at[1] += 10 * sin(a);
+        tm_add(&p, CANON_FEED, i + 1, at, 6000, 0);
+    }
+    struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
+    struct watch wt = wj;
+    struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
+    ck_assert_int_eq(sj.last.state, MOTION_DONE);
+    double r = assert_limits(&sj, "blended corners");
+    ck_assert_msg(wj.dev_mm <= tols[_i], "the tool strays %.5f mm from the corners",
+                  wj.dev_mm);
+    printf("zigzag, G64 P%.2f: jerk-limited %.3f s (peak leg jerk %.3f of the limit, %.4f mm "
+           "from the programmed corners) against trapezoidal %.3f s (%.4f mm): %.3f x the "
+           "time\n", tols[_i], sj.t_s, r, wj.dev_mm, st.t_s, wt.dev_mm, sj.t_s / st.t_s);
+    canon_prog_free(&p);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("motion_jerk");
+    TCase *tc = tcase_create("jerk");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_config);
+    tcase_add_test(tc, test_exact_stops);
+    tcase_add_test(tc, test_hold_override_abort);
+    tcase_add_loop_test(tc, test_small_arcs, 0, 3);
+    tcase_add_loop_test(tc, test_blended_corners, 0, 2);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
