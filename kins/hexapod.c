@@ -39,18 +39,28 @@ static int hexapod_lengths_of(const struct kins *k, const struct hexapod_legs *l
     return st;
 }
 
+/* The platform's frame at pose and the legs through it; KINS_ERR_ARG for a pose that is not
+ * a number. */
+static inline int hexapod_pose_legs(const struct hexapod *h, const double *pose,
+                                    struct hexapod_rot *o, struct hexapod_legs *lg)
+{
+    double t[3];
+    if (hexapod_pose_frame(pose, t, o) != KINS_OK)
+        return KINS_ERR_ARG;
+    hexapod_legs_eval(h, t, o, lg);
+    return KINS_OK;
+}
+
 /* Every workspace limit for the inverse, the legs evaluated afresh (out of line: the
  * inverse's own evaluation then need not compute the unit vectors it does not use). Callers
  * that have them (inverse_rates, check) call hexapod_workspace() with their own. */
 static __attribute__((noinline)) int hexapod_ws_full(const struct hexapod *h,
                                                      const double *pose)
 {
-    double t[3];
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    hexapod_legs_eval(h, t, &o, &lg);
     return hexapod_workspace(h, pose, &o, &lg, NULL, 0);
 }
 
@@ -85,12 +95,10 @@ static inline int joints_checked(struct kins *k, const double *pose, const struc
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3];
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    hexapod_legs_eval(h, t, &o, &lg);
     int st = hexapod_lengths_of(k, &lg, joints);
     if (st != KINS_OK || hexapod_ws_plain(h, pose, &o, &lg))
         return st;
@@ -164,12 +172,11 @@ static int hexapod_inverse_path(struct kins *k, const double pose[KINS_POSE_DIM]
 static int hexapod_jacobian(struct kins *k, const double pose[KINS_POSE_DIM], double *jac)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3], joints[HEXAPOD_LEGS];
+    double joints[HEXAPOD_LEGS];
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    hexapod_legs_eval(h, t, &o, &lg);
     for (int i = 0; i < HEXAPOD_LEGS; i++)
         hexapod_jac_row(&o, &lg, i, HEXAPOD_RAD_PER_DEG, &jac[i * KINS_POSE_DIM]);
     return joints_checked(k, pose, &o, &lg, joints);
@@ -180,12 +187,11 @@ static int hexapod_describe(struct kins *k, const double pose[KINS_POSE_DIM], ch
                             size_t len)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3], joints[HEXAPOD_LEGS];
+    double joints[HEXAPOD_LEGS];
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    hexapod_legs_eval(h, t, &o, &lg);
     if (hexapod_lengths_of(k, &lg, joints) != KINS_OK) {
         for (int i = 0; i < HEXAPOD_LEGS; i++) {
             double over = joints[i] - k->joint_max[i], under = k->joint_min[i] - joints[i];
@@ -240,12 +246,10 @@ static int hexapod_inverse_rates(struct kins *k, const double pose[KINS_POSE_DIM
                                  double *rates)
 {
     const struct hexapod *h = (const struct hexapod *)k;
-    double t[3];
     struct hexapod_rot o;
     struct hexapod_legs lg;
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    hexapod_legs_eval(h, t, &o, &lg);
     int st = joints_checked(k, pose, &o, &lg, joints);
     if (st != KINS_OK)
         return st;

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench/bench_dense.h"
 #include "check/check.h"
 #include "check/plot.h"
 #include "tests/test_check_util.h"
@@ -33,25 +34,7 @@ static const char *dense_program(int n, const char *last)
 {
     static char path[64];
     snprintf(path, sizeof path, "/tmp/hexcnc_dense_%d.ngc", (int)getpid());
-    FILE *f = fopen(path, "w");
-    ck_assert(f);
-    fprintf(f, "G21 G90 G64 P0.01\nG1 X0 Y0 Z645 A0 B0 C0 F2000\n");
-    double x = 0, y = 0, ang = 0;
-    unsigned long long seed = 7;
-    for (int i = 0; i < n; i++) {
-        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-        ang += 0.6 * ((double)(seed >> 11) / 9007199254740992.0 - 0.5);
-        double dx = 0.5 * cos(ang), dy = 0.5 * sin(ang);
-        if (fabs(x + dx) > 90 || fabs(y + dy) > 90)
-            ang += M_PI, dx = -dx, dy = -dy;
-        x += dx, y += dy;
-        fprintf(f, "X%.3f Y%.3f Z%.3f A%.3f B%.3f C%.3f\n", x, y, 645 + 10 * sin(i * 1e-3),
-                6 * sin(i * 7e-4), 6 * cos(i * 9e-4), 8 * sin(i * 5e-4));
-    }
-    if (last)
-        fprintf(f, "%s\n", last);
-    fprintf(f, "M2\n");
-    fclose(f);
+    ck_assert_int_eq(bench_dense_write_seed(path, n, 7, last), 0);
     return path;
 }
 

@@ -31,14 +31,20 @@ static void add_sync(struct canon_prog *p, int line, const double *end, int kind
         abort();
 }
 
-/* M3 S rpm, then a tap from top to bottom and back (as the interpreter makes G33.1). */
-static void tap_prog(struct canon_prog *p, const double *top, const double *bottom,
-                     double rpm, double k_mm, double i_factor)
+/* A program starting at top with M3 S rpm. */
+static void spindle_prog(struct canon_prog *p, const double *top, double rpm)
 {
     canon_prog_init(p);
     memcpy(p->start, top, sizeof p->start);
     tm_add(p, CANON_SPINDLE_SPEED, 1, NULL, 0, rpm);
     tm_add(p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+}
+
+/* M3 S rpm, then a tap from top to bottom and back (as the interpreter makes G33.1). */
+static void tap_prog(struct canon_prog *p, const double *top, const double *bottom,
+                     double rpm, double k_mm, double i_factor)
+{
+    spindle_prog(p, top, rpm);
     add_sync(p, 2, bottom, CANON_SYNC_TAP_IN, k_mm, i_factor);
     add_sync(p, 2, top, CANON_SYNC_TAP_OUT, k_mm, i_factor);
     tm_add(p, CANON_PROGRAM_END, 3, NULL, 0, 2);
@@ -252,10 +258,7 @@ START_TEST(test_passes_in_phase)
     open_trivial(&mc);
     const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
     struct canon_prog p;
-    canon_prog_init(&p);
-    memcpy(p.start, top, sizeof top);
-    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
-    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    spindle_prog(&p, top, 600);
     add_sync(&p, 2, bottom, CANON_SYNC_THREAD, 1.5, 1);
     tm_add(&p, CANON_TRAVERSE, 3, top, 0, 0);
     tm_add(&p, CANON_DWELL, 4, NULL, 0, 0.123);  /* the spindle goes on meanwhile */
@@ -445,10 +448,7 @@ START_TEST(test_streamed_taps)
     open_trivial(&mc);
     const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 9, 0, 0, 0 };
     struct canon_prog p;
-    canon_prog_init(&p);
-    memcpy(p.start, top, sizeof top);
-    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
-    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    spindle_prog(&p, top, 600);
     enum { TAPS = 4000 };
     for (int i = 0; i < TAPS; i++) {
         add_sync(&p, 2 + i, bottom, CANON_SYNC_TAP_IN, 0.5, 1.0);
@@ -496,10 +496,7 @@ START_TEST(test_pause_after_chain)
     const double top[6] = { 0, 0, 10, 0, 0, 0 }, mid[6] = { 0, 0, 5, 0, 0, 0 };
     const double out[6] = { 2, 0, 3, 0, 0, 0 }, aside[6] = { 5, 0, 10, 0, 0, 0 };
     struct canon_prog p;
-    canon_prog_init(&p);
-    memcpy(p.start, top, sizeof top);
-    tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 600);
-    tm_add(&p, CANON_SPINDLE_ON, 1, NULL, 0, 1);
+    spindle_prog(&p, top, 600);
     add_sync(&p, 2, mid, CANON_SYNC_THREAD, 1.5, 1);
     add_sync(&p, 3, out, CANON_SYNC_THREAD, 1.5 * sqrt(2), 1);
     tm_add(&p, CANON_TRAVERSE, 4, aside, 0, 0);
