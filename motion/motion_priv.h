@@ -434,15 +434,20 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
  * rounding together stay within P of the programmed path). */
 #define JERK_ROUND_SHARE 0.5
 
+/* The part of segment sg's G64 P that jerk limiting's rounding may use, mm (0 without jerk
+ * limits or under G61): the one place of that rule. */
+static inline double motion_jerk_round_mm(const struct motion *m, const struct motion_seg *sg)
+{
+    return m->jerk && sg->blend_tol_mm > 0 ? JERK_ROUND_SHARE * sg->blend_tol_mm : 0;
+}
+
 /* How far the set-point chords (and with jerk limits the moving average) may cut a curve of
- * segment sg, mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE; with jerk limits under G64 P, the
- * larger JERK_ROUND_SHARE of P (motion_jerk.c). */
+ * segment sg, mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE, or motion_jerk_round_mm when that is
+ * larger (motion_jerk.c). */
 static inline double motion_round_tol_mm(const struct motion *m, const struct motion_seg *sg)
 {
-    double t = KIN_TOL_SHARE * m->cfg.kin_tol_mm;
-    if (m->jerk && sg->blend_tol_mm > 0 && JERK_ROUND_SHARE * sg->blend_tol_mm > t)
-        t = JERK_ROUND_SHARE * sg->blend_tol_mm;
-    return t;
+    double t = KIN_TOL_SHARE * m->cfg.kin_tol_mm, j = motion_jerk_round_mm(m, sg);
+    return j > t ? j : t;
 }
 
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */

@@ -395,9 +395,7 @@ static int evaluate(struct motion *m)
     m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
     memcpy(m->seg_from, sg->start, sizeof m->seg_from);
     memcpy(m->seg_to, sg->end, sizeof m->seg_to);
-    m->path_tol_mm = m->cfg.kin_tol_mm;
-    if (m->jerk && sg->blend_tol_mm > 0)
-        m->path_tol_mm = fmax(m->path_tol_mm, JERK_ROUND_SHARE * sg->blend_tol_mm);
+    m->path_tol_mm = fmax(m->cfg.kin_tol_mm, motion_jerk_round_mm(m, sg));
     if (sg->tcp && vr == 0) {
         kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
