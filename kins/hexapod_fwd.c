@@ -183,8 +183,7 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
     q[3] = pose[KINS_A] * HEXAPOD_RAD_PER_DEG;
     q[4] = pose[KINS_B] * HEXAPOD_RAD_PER_DEG;
     q[5] = pose[KINS_C] * HEXAPOD_RAD_PER_DEG;
-    for (int j = 0; j < 3; j++)
-        sincos(q[3 + j], &sn[j], &cs[j]);
+    sincos3(q + 3, sn, cs);
 
     for (;;) {
         resid = hexapod_residual(h, q, sn, cs, centre_mm, &o, &lg, rhs);

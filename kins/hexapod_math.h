@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "common/sincos3.h"
 #include "kins/hexapod.h"
 
 #define HEXAPOD_DEG_PER_RAD (180.0 / M_PI)
@@ -50,11 +51,9 @@ static inline void hexapod_rot_from_sc(struct hexapod_rot *o, double sa, double 
 static inline void hexapod_rot_from_rad(struct hexapod_rot *o, double a_rad, double b_rad,
                                         double c_rad)
 {
-    double sa, ca, sb, cb, sc, cc;
-    sincos(a_rad, &sa, &ca);
-    sincos(b_rad, &sb, &cb);
-    sincos(c_rad, &sc, &cc);
-    hexapod_rot_from_sc(o, sa, ca, sb, cb, sc, cc);
+    double x[3] = { a_rad, b_rad, c_rad }, s[3], c[3];
+    sincos3(x, s, c);
+    hexapod_rot_from_sc(o, s[0], c[0], s[1], c[1], s[2], c[2]);
 }
 
 /* Leg vectors for platform origin t (mm) and orientation o: v_i = t + R·p_i - b_i. */

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "common/sincos3.h"
 #include "kins/kins.h"
 
 #define DEG (M_PI / 180.0)
@@ -9,10 +10,9 @@
 /* R = Rz(C) Ry(B) Rx(A), row-major. */
 static void rot(const double abc[3], double r[3][3])
 {
-    double ca, sa, cb, sb, cc, sc;     /* (sincos: the values of sin() and cos(), one call) */
-    sincos(abc[0] * DEG, &sa, &ca);
-    sincos(abc[1] * DEG, &sb, &cb);
-    sincos(abc[2] * DEG, &sc, &cc);
+    double x[3] = { abc[0] * DEG, abc[1] * DEG, abc[2] * DEG }, s[3], c[3];
+    sincos3(x, s, c);
+    double sa = s[0], ca = c[0], sb = s[1], cb = c[1], sc = s[2], cc = c[2];
     r[0][0] = cc * cb, r[0][1] = cc * sb * sa - sc * ca, r[0][2] = cc * sb * ca + sc * sa;
     r[1][0] = sc * cb, r[1][1] = sc * sb * sa + cc * ca, r[1][2] = sc * sb * ca - cc * sa;
     r[2][0] = -sb, r[2][1] = cb * sa, r[2][2] = cb * ca;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/sincos3.h"
 #include "motion/motion_blend.h"
 #include "motion/motion_priv.h"
 
@@ -57,7 +58,7 @@ void motion_seg_pose(const struct motion_plan *p, const struct motion_seg *sg, d
     const struct motion_arc *a = &p->arcs[sg->arc];
     double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, h = a->h0_mm + a->dh_mm * u;
     double c, sn;
-    sincos(ang, &sn, &c);      /* one call, the same values as sin() and cos() */
+    sincos1(ang, &sn, &c);
     for (int i = 0; i < 3; i++)
         pose[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
     if (a->abc_cubic)
@@ -75,7 +76,7 @@ void motion_seg_tangent(const struct motion_plan *p, const struct motion_seg *sg
         return;
     const struct motion_arc *a = &p->arcs[sg->arc];
     double ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, c, sn;
-    sincos(ang, &sn, &c);
+    sincos1(ang, &sn, &c);
     for (int i = 0; i < 3; i++)
         dp[i] = il * (a->dr_mm * (c * a->e1[i] + sn * a->e2[i])
                       + r * a->sweep_rad * (-sn * a->e1[i] + c * a->e2[i]) + a->dh_mm * a->n[i]);
@@ -103,7 +104,7 @@ void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg,
     const struct motion_arc *a = &p->arcs[sg->arc];
     double th = a->sweep_rad, ang = th * u, r = a->r0_mm + a->dr_mm * u;
     double h = a->h0_mm + a->dh_mm * u, c, sn;
-    sincos(ang, &sn, &c);
+    sincos1(ang, &sn, &c);
     for (int i = 0; i < 3; i++) {
         double radial = c * a->e1[i] + sn * a->e2[i], along = -sn * a->e1[i] + c * a->e2[i];
         pose[i] = a->center[i] + r * radial + h * a->n[i];

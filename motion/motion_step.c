@@ -316,10 +316,16 @@ static void advance(struct motion *m, double dt)
     } else {
         double ovr = sg->kind == SEG_LINE && sg->feed == 0 ? m->rapid_cmd : m->override_cmd;
         double target = m->state == MOTION_RUNNING && !probe_halt ? ovr : 0;
-        plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
-        double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
-        m->tau_s += 0.5 * (m->rate + rn) * dt;
-        m->rate = rn;
+        if (target == 1 && m->rate == 1) {
+            /* at the plan's own pace, which next_rate keeps: the ceiling is at least 1
+             * (motion_plan.c) and the plan accelerates within its interval's limit */
+            m->tau_s += dt;
+        } else {
+            plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+            double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
+            m->tau_s += 0.5 * (m->rate + rn) * dt;
+            m->rate = rn;
+        }
     }
     follow_knots(m);
     p = m->run;                  /* a streamed program may have gone on into the next chunk */

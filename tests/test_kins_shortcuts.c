@@ -1,11 +1,13 @@
 /* test_kins_shortcuts.c: the kinematics' fast paths against the plain computations: the
- * condition number from the Gram matrix, the legs' exact derivatives along a path. */
+ * condition number from the Gram matrix, the legs' exact derivatives along a path, the
+ * series for the sines and cosines of a pose's angles. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/sincos3.h"
 #include "kins/hexapod.h"
 #include "kins/kins.h"
 #include "kins/kins_svd.h"
@@ -164,6 +166,49 @@ START_TEST(test_condition_number)
 }
 END_TEST
 
+/* Distance from the C library's value in units in the last place of it. */
+static double ulps(double got, double want)
+{
+    if (got == want)
+        return 0;
+    return fabs(got - want) / fabs(nextafter(want, INFINITY) - want);
+}
+
+/* sincos3 and sincos1 against sincos(): within 1 ulp over +-pi/4 (the series), equal beyond
+ * it (the C library's own), and an angle past pi/4 sends all three to the library. */
+START_TEST(test_sincos3)
+{
+    double worst = 0;
+    srand48(7);
+    for (int n = 0; n < 300000; n++) {
+        double x[3], s[3], c[3];
+        for (int i = 0; i < 3; i++)          /* the whole range, and near 0 on every third */
+            x[i] = (2 * drand48() - 1) * SINCOS3_FAST_RAD * (n % 3 ? 1 : 1e-3 * drand48());
+        if (n == 0)
+            x[0] = SINCOS3_FAST_RAD, x[1] = -SINCOS3_FAST_RAD, x[2] = 0;
+        sincos3(x, s, c);
+        for (int i = 0; i < 3; i++) {
+            double ws, wc, s1, c1;
+            sincos(x[i], &ws, &wc);
+            sincos1(x[i], &s1, &c1);
+            ck_assert(s1 == s[i] && c1 == c[i]);
+            worst = fmax(worst, fmax(ulps(s[i], ws), ulps(c[i], wc)));
+        }
+    }
+    ck_assert_msg(worst <= 1.0, "%.2f ulp from sincos()", worst);
+    double far[3] = { 0.1, 2.5, -40.0 }, s[3], c[3];
+    sincos3(far, s, c);
+    for (int i = 0; i < 3; i++) {
+        double ws, wc;
+        sincos(far[i], &ws, &wc);
+        ck_assert(s[i] == ws && c[i] == wc);
+    }
+    double nan3[3] = { NAN, 0, 0 };
+    sincos3(nan3, s, c);
+    ck_assert(isnan(s[0]) && isnan(c[0]));
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("kins_shortcuts");
@@ -171,6 +216,7 @@ int main(void)
     tcase_add_test(tc, test_condition_number);
     tcase_add_test(tc, test_inverse_path);
     tcase_add_test(tc, test_jacobian);
+    tcase_add_test(tc, test_sincos3);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
