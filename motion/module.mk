@@ -10,4 +10,4 @@ TESTS += test_motion test_motion_run test_motion_legs test_motion_hal test_motio
 # The HAL component `motion` (loadrt motion) and the runner's entry points (motion_hal.h).
 LIB_SRCS += hal/components/motion.c
 HAL_COMPS += motion
-BENCHES += bench_motion bench_topp bench_jerk
+BENCHES += bench_motion bench_topp bench_topp_blend bench_jerk
