@@ -174,18 +174,22 @@ static double ulps(double got, double want)
     return fabs(got - want) / fabs(nextafter(want, INFINITY) - want);
 }
 
-/* sincos3 and sincos1 against sincos(): within 1 ulp over +-pi/4 (the series), equal beyond
- * it (the C library's own), and an angle past pi/4 sends all three to the library. */
+/* sincos3 and sincos1 against sincos(): within 1 ulp over +-pi/4 (the two series), equal beyond
+ * it (the C library's own). */
 START_TEST(test_sincos3)
 {
     double worst = 0;
     srand48(7);
     for (int n = 0; n < 300000; n++) {
         double x[3], s[3], c[3];
-        for (int i = 0; i < 3; i++)          /* the whole range, and near 0 on every third */
-            x[i] = (2 * drand48() - 1) * SINCOS3_FAST_RAD * (n % 3 ? 1 : 1e-3 * drand48());
+        /* the whole range; within the short series' on every third; near 0 on every fifth */
+        double range = n % 3 ? SINCOS3_FAST_RAD : SINCOS3_SHORT_RAD;
+        for (int i = 0; i < 3; i++)
+            x[i] = (2 * drand48() - 1) * range * (n % 5 ? 1 : 1e-3 * drand48());
         if (n == 0)
             x[0] = SINCOS3_FAST_RAD, x[1] = -SINCOS3_FAST_RAD, x[2] = 0;
+        if (n == 1)
+            x[0] = SINCOS3_SHORT_RAD, x[1] = -SINCOS3_SHORT_RAD, x[2] = 1e-300;
         sincos3(x, s, c);
         for (int i = 0; i < 3; i++) {
             double ws, wc, s1, c1;
@@ -196,7 +200,7 @@ START_TEST(test_sincos3)
         }
     }
     ck_assert_msg(worst <= 1.0, "%.2f ulp from sincos()", worst);
-    double far[3] = { 0.1, 2.5, -40.0 }, s[3], c[3];
+    double far[3] = { 0.8, 2.5, -40.0 }, s[3], c[3];
     sincos3(far, s, c);
     for (int i = 0; i < 3; i++) {
         double ws, wc;
