@@ -26,6 +26,11 @@ struct sim {
     double jerk_thr[KINS_MAX_JOINTS];  /* jerk beyond which a leg is over (HUGE_VAL: none) */
     double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
     double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
+    double jerk[KINS_MAX_JOINTS];      /* leg jerk of this period, mm/s^3 */
+    double len_lo[KINS_MAX_JOINTS];    /* the legs' length range */
+    double len_hi[KINS_MAX_JOINTS];
+    double min_mm[KINS_MAX_JOINTS], max_mm[KINS_MAX_JOINTS];     /* the legs' figures so far */
+    double peak_vel[KINS_MAX_JOINTS], peak_acc[KINS_MAX_JOINTS], peak_jerk[KINS_MAX_JOINTS];
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
     int line;                          /* program line of the previous period */
     const char *file;
@@ -84,30 +89,56 @@ static void leg_out_of_range(struct sim *s, const struct motion_out *out, int i,
     check_add_problem(s->r, &p);
 }
 
-/* Leg lengths, rates from successive set points and accelerations from successive rates.
- * This runs every period: comparisons only, the reports are out of line. */
-static void legs_period(struct sim *s, const struct motion_out *out)
+/* The limit problems of one period, leg by leg (out of line: the period had one). */
+static __attribute__((noinline)) void legs_report(struct sim *s, const struct motion_out *out)
 {
     for (int i = 0; i < s->nj; i++) {
-        struct check_leg *lg = &s->r->leg[i];
-        double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
-        double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
-        double aj = fabs(a - s->a0[i]) * s->inv_T;
-        lg->min_mm = L < lg->min_mm ? L : lg->min_mm;
-        lg->max_mm = L > lg->max_mm ? L : lg->max_mm;
-        lg->peak_vel_mm_s = av > lg->peak_vel_mm_s ? av : lg->peak_vel_mm_s;
-        lg->peak_acc_mm_s2 = aa > lg->peak_acc_mm_s2 ? aa : lg->peak_acc_mm_s2;
+        const struct check_leg *lg = &s->r->leg[i];
+        double L = out->joint_pos[i], av = fabs(s->v0[i]), aa = fabs(s->a0[i]);
         if (L > lg->limit_max_mm || L < lg->limit_min_mm)
             leg_out_of_range(s, out, i, L);
         if (av > s->vel_thr[i])
             leg_limit(s, out, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
         if (aa > s->acc_thr[i])
             leg_limit(s, out, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
-        lg->peak_jerk_mm_s3 = aj > lg->peak_jerk_mm_s3 ? aj : lg->peak_jerk_mm_s3;
-        if (aj > s->jerk_thr[i])
-            leg_limit(s, out, CHECK_LEG_JERK, i, aj, lg->limit_jerk_mm_s3);
+        if (s->jerk[i] > s->jerk_thr[i])
+            leg_limit(s, out, CHECK_LEG_JERK, i, s->jerk[i], lg->limit_jerk_mm_s3);
+    }
+}
+
+/* Leg lengths, rates from successive set points and accelerations from successive rates.
+ * This runs every period: arithmetic and comparisons on the pass's own arrays (the figures
+ * go into the result at the end, check_simulate), the reports out of line. */
+static void legs_period(struct sim *s, const struct motion_out *out)
+{
+    int over = 0;
+    for (int i = 0; i < s->nj; i++) {
+        double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
+        double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
+        double aj = fabs(a - s->a0[i]) * s->inv_T;
+        s->min_mm[i] = L < s->min_mm[i] ? L : s->min_mm[i];
+        s->max_mm[i] = L > s->max_mm[i] ? L : s->max_mm[i];
+        s->peak_vel[i] = av > s->peak_vel[i] ? av : s->peak_vel[i];
+        s->peak_acc[i] = aa > s->peak_acc[i] ? aa : s->peak_acc[i];
+        s->peak_jerk[i] = aj > s->peak_jerk[i] ? aj : s->peak_jerk[i];
+        over |= (L > s->len_hi[i]) | (L < s->len_lo[i]) | (av > s->vel_thr[i]) |
+                (aa > s->acc_thr[i]) | (aj > s->jerk_thr[i]);
         s->v0[i] = v;
         s->a0[i] = a;
+        s->jerk[i] = aj;
+    }
+    if (over)
+        legs_report(s, out);
+}
+
+/* The pass's leg figures into the result. */
+static void legs_figures(const struct sim *s)
+{
+    for (int i = 0; i < s->nj; i++) {
+        struct check_leg *lg = &s->r->leg[i];
+        lg->min_mm = s->min_mm[i], lg->max_mm = s->max_mm[i];
+        lg->peak_vel_mm_s = s->peak_vel[i], lg->peak_acc_mm_s2 = s->peak_acc[i];
+        lg->peak_jerk_mm_s3 = s->peak_jerk[i];
     }
 }
 
@@ -361,6 +392,10 @@ static void leg_limits(struct sim *s)
         s->jerk_thr[i] = lg->limit_jerk_mm_s3 > 0 ? lg->limit_jerk_mm_s3 * (1 + LIMIT_SLACK)
                                                   : HUGE_VAL;
         lg->min_mm = HUGE_VAL, lg->max_mm = -HUGE_VAL;
+        s->len_lo[i] = lg->limit_min_mm, s->len_hi[i] = lg->limit_max_mm;
+        s->min_mm[i] = HUGE_VAL, s->max_mm[i] = -HUGE_VAL;
+        s->peak_vel[i] = lg->peak_vel_mm_s, s->peak_acc[i] = lg->peak_acc_mm_s2;
+        s->peak_jerk[i] = lg->peak_jerk_mm_s3;
     }
 }
 
@@ -433,6 +468,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
             motion_resume(mc->motion);
     }
     motion_set_rates(mc->motion, true);
+    legs_figures(&s);
     if (s.tip_line) {
         slot_for(&s, CHECK_DEFER_FLUSH, &out);
         check_defer_commit(s.dq);
