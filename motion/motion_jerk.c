@@ -29,7 +29,8 @@
  * Where the path changes direction at a stop the leader rests T (motion_plan.c), so the mean
  * comes to rest exactly on the corner. The machine counts as stopped (paused, done, idle,
  * parked on a probe trip) only once the mean has settled on the leader. Spindle-synchronised
- * moves (G33, G33.1) bypass the mean: their jerk is the spindle's.
+ * moves (G33, G33.1) bypass the mean: their jerk is the spindle's. The outputs M62..M68
+ * switch with the mean too, where the tool reaches them on the path, not T/2 ahead of it.
  */
 
 /* Values averaged, in this order: pose, pose rate, path pose, legs, leg rates, path speed,
@@ -43,6 +44,7 @@ struct motion_jerk_meta {
     const char *file;
     double tool_len_mm, path_tol_mm;
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM];
+    struct motion_outputs outputs;     /* M62..M68: switched where the tool is */
 };
 
 struct motion_jerk {
@@ -99,6 +101,7 @@ static void gather(const struct motion *m, double *x, struct motion_jerk_meta *m
     mt->path_tol_mm = m->path_tol_mm;
     memcpy(mt->seg_from, m->seg_from, sizeof mt->seg_from);
     memcpy(mt->seg_to, m->seg_to, sizeof mt->seg_to);
+    mt->outputs = m->outputs;
 }
 
 /* x and meta into the motion's values. */
@@ -117,6 +120,7 @@ static void scatter(struct motion *m, const double *x, const struct motion_jerk_
     m->path_tol_mm = mt->path_tol_mm;
     memcpy(m->seg_from, mt->seg_from, sizeof m->seg_from);
     memcpy(m->seg_to, mt->seg_to, sizeof m->seg_to);
+    m->outputs_out = mt->outputs;
 }
 
 int motion_jerk_init(struct motion *m, char *err, size_t errlen)
@@ -235,4 +239,5 @@ void motion_jerk_hold(struct motion *m)
         return;
     gather(m, j->last, &j->last_meta);
     j->primed = 0;
+    m->outputs_out = m->outputs;
 }

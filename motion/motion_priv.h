@@ -266,6 +266,9 @@ struct motion {
     _Atomic double input_result; /* the last M66's answer: the value, or -1 (time-out) */
     _Atomic unsigned input_seq;  /* M66 waits answered since the program started */
     struct motion_outputs outputs; /* M62..M68 in force */
+    struct motion_outputs outputs_out; /* what the outputs show: with jerk limits, those in
+                                        * force where the mean is on the path (T/2 behind
+                                        * the executor, motion_jerk.c); else outputs */
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     /* G38 probing (motion_probe.c), servo thread only but the result and its counter */

@@ -670,7 +670,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->spindle = m->io;
     out->waiting = m->waiting;
     out->tool = m->tool;
-    out->outputs = m->outputs;
+    out->outputs = m->jerk ? m->outputs_out : m->outputs;
     out->probe_input = m->probe_in;
     return ret;
 }

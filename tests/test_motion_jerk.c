@@ -306,6 +306,60 @@ START_TEST(test_blended_corners)
 }
 END_TEST
 
+/* Where an output switches on the path (M62/M63 between moves): the X of the commanded
+ * pose in the period it switches. */
+struct switches { double on_x, off_x; int was_on; };
+
+static int switch_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct switches *w = ctx;
+    int on = (int)(o->outputs.dout & 1);
+    if (on && !w->was_on)
+        w->on_x = o->pose[0];
+    if (!on && w->was_on)
+        w->off_x = o->pose[0];
+    w->was_on = on;
+    return 0;
+}
+
+/* M62 and M63 between straight feeds at 50 mm/s blended on through them: the output switches
+ * where the tool is at the blocks' ends, with jerk limits as without (the executor reaches
+ * those ends T/2 = 20 ms, 1 mm, ahead of the tool). */
+START_TEST(test_synced_outputs)
+{
+    for (int jerk = 0; jerk < 2; jerk++) {
+        struct canon_prog p;
+        canon_prog_init(&p);
+        double at[6] = { -30, 0, 645, 0, 0, 0 };
+        memcpy(p.start, at, sizeof at);
+        p.start_path_mode = 640;
+        p.start_path_tol_mm = 0.01;
+        for (int i = 1; i <= 3; i++) {
+            at[0] += 20;
+            tm_add(&p, CANON_FEED, 2 * i, at, 3000, 0);
+            if (i < 3)
+                tm_add(&p, CANON_DIGITAL_OUT, 2 * i + 1, NULL, 0, i == 1 ? 1 : 0);
+        }
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
+        char err[400];
+        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+        ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+        struct switches w = { .on_x = NAN, .off_x = NAN };
+        struct tm_stats st;
+        tm_run(mc.m, DT, 100000, &st, switch_hook, &w);
+        ck_assert_int_eq(st.last.state, MOTION_DONE);
+        printf("M62 at X-10, M63 at X10, %s: switched at X%.3f and X%.3f\n",
+               jerk ? "jerk-limited" : "trapezoidal", w.on_x, w.off_x);
+        /* within a period's travel (0.05 mm) of the blocks' ends */
+        ck_assert_msg(fabs(w.on_x + 10) <= 0.06 && fabs(w.off_x - 10) <= 0.06,
+                      "switched at X%.3f and X%.3f", w.on_x, w.off_x);
+        tm_close(&mc);
+        canon_prog_free(&p);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("motion_jerk");
@@ -316,6 +370,7 @@ int main(void)
     tcase_add_test(tc, test_hold_override_abort);
     tcase_add_loop_test(tc, test_small_arcs, 0, 3);
     tcase_add_loop_test(tc, test_blended_corners, 0, 2);
+    tcase_add_test(tc, test_synced_outputs);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
