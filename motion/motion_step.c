@@ -53,18 +53,40 @@ static double ceiling_at(const struct motion_plan *p, size_t ci, double tau)
     return fmin(r, p->irho[ci]);
 }
 
-/* New rate after dt: toward the target, within the acceleration budget and the ceiling. */
-static double next_rate(const struct motion *m, double target, double vp, double ap,
-                        double ceiling, double dt)
+/* The phases of interval i that plan time [t0, t1] passes: each ramp's or cruise's path
+ * acceleration (+-iacc or 0) into a[] (returns how many, at most 3). Joints and rests, where
+ * the path does not move, have none. */
+static int interval_phases(const struct motion_plan *p, size_t i, double t0, double t1,
+                           double a[3])
 {
-    double r = m->rate, acc = m->run->iacc[m->ci];
-    if (target > ceiling)
-        target = ceiling;
-    double lo = 0, hi = 2;
-    if (vp > 1e-9) {
-        lo = r + dt * (-acc - r * r * ap) / vp;
-        hi = r + dt * (acc - r * r * ap) / vp;
-    }
+    double ds = p->ks[i + 1] - p->ks[i], a0 = fmax(t0, p->kt[i]) - p->kt[i];
+    double a1 = fmin(t1, p->kt[i + 1]) - p->kt[i], ta, tc, td;
+    int n = 0;
+    if (!(ds > 0) || !(p->kt[i + 1] > p->kt[i]) || a1 < a0)
+        return 0;
+    motion_phases(p->kv[i], p->kv[i + 1], p->ivp[i], p->iacc[i], ds, &ta, &tc, &td);
+    if (ta > 0 && a0 <= ta)
+        a[n++] = p->iacc[i];
+    if (tc > 0 && a0 <= ta + tc && a1 >= ta)
+        a[n++] = 0;
+    if (td > 0 && a1 >= ta + tc)
+        a[n++] = -p->iacc[i];
+    return n;
+}
+
+/* The last interval plan time t1 reaches from interval ci on, within the current chunk of a
+ * streamed program. */
+static size_t interval_at(const struct motion_plan *p, size_t ci, double t1)
+{
+    size_t i = ci;
+    while (i + 2 < p->nknot && p->kt[i + 1] < t1)
+        i++;
+    return i;
+}
+
+/* The rate within [lo, hi] nearest the target, at most the ceiling, at least 0. */
+static double clamp_rate(double target, double lo, double hi, double ceiling)
+{
     double rn = target < lo ? lo : target > hi ? hi : target;
     if (rn > ceiling)
         rn = ceiling;
@@ -73,6 +95,59 @@ static double next_rate(const struct motion *m, double target, double vp, double
     if (fabs(rn - target) < 1e-9)
         rn = target;
     return rn;
+}
+
+/* The positive root of a x^2 + K x = C (a > 0, K > 0): the rate at which the path
+ * acceleration a x^2 + K (x - r) reaches its bound; C / K (<= 0) when there is none. */
+static double rate_root(double a, double K, double C)
+{
+    return C > 0 ? 2 * C / (K + sqrt(K * K + 4 * a * C)) : C / K;
+}
+
+/* New rate after dt: toward the target, within the acceleration budget and the ceiling. The
+ * path acceleration r^2 a_plan + v_plan dr/dt must stay within the limit all through the
+ * period, not only at its start: for every phase of the plan the period passes (the plan
+ * time advances by at most max(r, ceiling) dt) against its own interval's limit, with r
+ * anywhere between the old rate and the new (r^2 a_plan is worst at the new rate where the
+ * two pull apart: a quadratic), and v_plan as fast (or as slow) as it gets within the
+ * period. Taken at the period's start alone, a ramp beginning within the period passed the
+ * legs' limit by half for a period, and a rate moving fast on a slow plan (a move leaving
+ * rest) by 4 % while it moved (bench_topp, under a changing override). */
+static double next_rate(const struct motion *m, double target, double vp, double ceiling,
+                        double dt)
+{
+    const struct motion_plan *p = m->run;
+    double r = m->rate, t0 = m->tau_s, span = fmax(r, ceiling) * dt, a[3];
+    double amin = 0, amax = 0, lo = -HUGE_VAL, hi = HUGE_VAL;
+    size_t last = interval_at(p, m->ci, t0 + span);
+    if (target > ceiling)
+        target = ceiling;
+    if (!(vp > 1e-9))
+        return clamp_rate(target, 0, 2, ceiling);
+    for (size_t i = m->ci; i <= last; i++)      /* how fast v_plan may change */
+        for (int k = interval_phases(p, i, t0, t0 + span, a); k-- > 0;)
+            amin = fmin(amin, a[k]), amax = fmax(amax, a[k]);
+    double vhi = vp + amax * span, vlo = fmax(vp + amin * span, 1e-9);
+    for (size_t i = m->ci; i <= last; i++)
+        for (int k = interval_phases(p, i, t0, t0 + span, a); k-- > 0;) {
+            double acc = p->iacc[i], c = acc - r * r * a[k];
+            if (c < 0)         /* faster than the plan's ramp allows: the rate must fall */
+                hi = fmin(hi, r + dt * c / vlo);
+            else if (a[k] > 0) /* rising: r^2 a grows with it */
+                hi = fmin(hi, rate_root(a[k], vhi / dt, acc + vhi * r / dt));
+            else
+                hi = fmin(hi, r + dt * c / vhi);
+            c = -acc - r * r * a[k];
+            if (c > 0)         /* above 1 on a braking plan: the rate must rise */
+                lo = fmax(lo, r + dt * c / vlo);
+            else if (a[k] > 0) /* falling on an accelerating plan: r^2 a shrinks with it */
+                lo = fmax(lo, rate_root(a[k], vhi / dt, vhi * r / dt - acc));
+            else
+                lo = fmax(lo, r + dt * c / vhi);
+        }
+    if (lo == -HUGE_VAL)       /* no phase: the plan holds still (a joint, a rest) */
+        lo = 0, hi = 2;
+    return clamp_rate(target, lo, hi, ceiling);
 }
 
 /* Periods a spindle command must have been out before an at-speed report counts: one for
@@ -318,11 +393,12 @@ static void advance(struct motion *m, double dt)
         double target = m->state == MOTION_RUNNING && !probe_halt ? ovr : 0;
         if (target == 1 && m->rate == 1) {
             /* at the plan's own pace, which next_rate keeps: the ceiling is at least 1
-             * (motion_plan.c) and the plan accelerates within its interval's limit */
+             * (motion_plan.c), and every phase's acceleration is within its interval's
+             * limit, so 1 lies within every bound next_rate takes */
             m->tau_s += dt;
         } else {
             plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
-            double rn = next_rate(m, target, vp, ap, ceiling_at(p, m->ci, m->tau_s), dt);
+            double rn = next_rate(m, target, vp, ceiling_at(p, m->ci, m->tau_s), dt);
             m->tau_s += 0.5 * (m->rate + rn) * dt;
             m->rate = rn;
         }

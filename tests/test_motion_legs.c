@@ -94,6 +94,100 @@ START_TEST(test_leg_limits_not_needless)
 }
 END_TEST
 
+/* Where the legs bind (bench_topp's machine and G61 programs), the planned time is within
+ * 4.5 % of the time-optimal one: the TOPP-RA reference bench_topp computes for the same
+ * path and limits, 11.5910 s and 6.0341 s (4000 grid intervals per move). Run at the
+ * servo rate, no leg passes its limits and the busiest leg uses its acceleration. With
+ * the legs lending the path only their fixed 60 % share of acceleration (not what the
+ * curvature term leaves at the knot's speed cap, motion_caps.c) the first takes 1.062x. */
+START_TEST(test_leg_bound_time_near_optimal)
+{
+    static const double topp_s[2] = { 11.5910, 6.0341 };
+    for (int k = 0; k < 2; k++) {
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, tm_leg_bound_hexapod_cfg(), &kins_hexapod_ops), 0);
+        const double (*pts)[6];
+        int n = tm_leg_bound_points(k, &pts);
+        struct canon_prog p;
+        tm_g61_points(&p, pts, n, 30000);
+        char err[512] = "";
+        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "load: %s", err);
+        struct motion_plan_info info;
+        motion_plan_info(mc.m, &info);
+        printf("leg-bound G61 program %d: planned %.4f s, %.4fx the time-optimal %.4f s\n",
+               k + 1, info.time_s, info.time_s / topp_s[k], topp_s[k]);
+        ck_assert_msg(info.time_s <= 1.045 * topp_s[k], "program %d: %.4f s, %.4fx", k + 1,
+                      info.time_s, info.time_s / topp_s[k]);
+        ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+        struct tm_stats s;
+        tm_run(mc.m, DT, 1000000, &s, NULL, NULL);
+        ck_assert_int_eq(s.last.state, MOTION_DONE);
+        double busiest = 0;
+        for (int i = 0; i < 6; i++) {
+            ck_assert_msg(s.max_leg_v[i] <= 40, "leg %d at %.4f mm/s", i + 1, s.max_leg_v[i]);
+            ck_assert_msg(s.max_leg_a[i] <= 200 * 1.001, "leg %d at %.2f mm/s^2", i + 1,
+                          s.max_leg_a[i]);
+            busiest = fmax(busiest, s.max_leg_a[i]);
+            ck_assert_double_eq_tol(s.last.pose[i], pts[n - 1][i], 1e-9);
+        }
+        ck_assert_msg(busiest > 0.95 * 200, "legs held below their acceleration: %.2f mm/s^2",
+                      busiest);
+        canon_prog_free(&p);
+        tm_close(&mc);
+    }
+}
+END_TEST
+
+/* Feed override switched every `every` periods between 2 and `low`. */
+struct ovr_walk { int every; double low; };
+
+static int ovr_walk_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    const struct ovr_walk *w = ctx;
+    (void)o;
+    if (step % w->every == 0)
+        motion_set_feed_override(m, step % (2 * w->every) ? 2 : w->low);
+    return 0;
+}
+
+/* The feed override switched up and down while the legs bind: the rate rises to the plan's
+ * ceiling and falls again on ramps, cruises, across knots and on moves leaving rest, and no
+ * leg passes its limits in any servo period. The rate was set from the plan at each period's
+ * start: a ramp beginning within the period added to a rate change that had already taken
+ * the whole acceleration, and on a slow plan the rate moved so far within one period that
+ * r^2 a_plan left its start value behind (up to 1.48x the legs' acceleration). */
+START_TEST(test_leg_limits_under_changing_override)
+{
+    static const struct ovr_walk walks[] = { { 700, 0.6 }, { 37, 0 }, { 250, 0.3 } };
+    for (int k = 0; k < 2; k++)
+        for (size_t w = 0; w < sizeof walks / sizeof walks[0]; w++) {
+            struct tm_machine mc;
+            ck_assert_int_eq(tm_open(&mc, tm_leg_bound_hexapod_cfg(), &kins_hexapod_ops), 0);
+            const double (*pts)[6];
+            int n = tm_leg_bound_points(k, &pts);
+            struct canon_prog p;
+            tm_g61_points(&p, pts, n, 30000);
+            char err[512] = "";
+            ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "load: %s",
+                          err);
+            ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+            struct tm_stats s;
+            tm_run(mc.m, DT, 1000000, &s, ovr_walk_hook, (void *)&walks[w]);
+            ck_assert_int_eq(s.last.state, MOTION_DONE);
+            for (int i = 0; i < 6; i++) {
+                ck_assert_msg(s.max_leg_v[i] <= 40, "program %d, walk %zu: leg %d at %.4f mm/s",
+                              k + 1, w, i + 1, s.max_leg_v[i]);
+                ck_assert_msg(s.max_leg_a[i] <= 200 * 1.001,
+                              "program %d, walk %zu: leg %d at %.2f mm/s^2", k + 1, w, i + 1,
+                              s.max_leg_a[i]);
+                ck_assert_double_eq_tol(s.last.pose[i], pts[n - 1][i], 1e-9);
+            }
+            canon_prog_free(&p);
+            tm_close(&mc);
+        }
+}
+END_TEST
+
 /* Runs S -> E at a fast feed with set points every T; returns the measured deviation. */
 static struct tm_dev deviation(const double *S, const double *E, double T, double tol_mm)
 {
@@ -280,6 +374,8 @@ static Suite *legs_suite(void)
     TCase *tc = tcase_create("legs");
     tcase_add_test(tc, test_leg_limits_hold);
     tcase_add_test(tc, test_leg_limits_not_needless);
+    tcase_add_test(tc, test_leg_bound_time_near_optimal);
+    tcase_add_test(tc, test_leg_limits_under_changing_override);
     tcase_add_test(tc, test_kinematic_deviation);
     tcase_add_test(tc, test_kinematic_deviation_helix);
     tcase_add_test(tc, test_long_helix_is_reachable);

@@ -277,6 +277,54 @@ static inline struct tk_cfg *tm_fast_hexapod_cfg(double period_s, double tol_mm)
     return c;
 }
 
+/* The TMU hexapod where the legs bind (bench_topp and test_motion_legs): legs 40 mm/s and
+ * 200 mm/s^2 under path limits of 500 mm/s, 5000 mm/s^2, 200 deg/s and 2000 deg/s^2. */
+static inline struct tk_cfg *tm_leg_bound_hexapod_cfg(void)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    if (!c)
+        return NULL;
+    tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "500");
+    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "5000");
+    tk_set(c, "TRAJ", "MAX_ANGULAR_VELOCITY", "200");
+    tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "2000");
+    for (int j = 0; j < 6; j++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", j);
+        tk_set(c, sec, "MAX_VELOCITY", "40");
+        tk_set(c, sec, "MAX_ACCELERATION", "200");
+    }
+    return c;
+}
+
+/* bench_topp's two G61 programs for that machine, as X Y Z A B C points (the first the
+ * start): 0, five moves through the workspace; 1, turns in place, then a short move. Returns
+ * the number of points. */
+static inline int tm_leg_bound_points(int which, const double (**pts)[6])
+{
+    static const double five[][6] = {
+        { 0, 0, 645, 0, 0, 0 }, { 100, 0, 645, 0, 0, 0 }, { 100, 80, 660, 5, -5, 10 },
+        { -60, 40, 630, -8, 6, -12 }, { -60, -90, 640, 0, 0, 0 }, { 0, 0, 645, 0, 0, 0 },
+    };
+    static const double turns[][6] = {
+        { 0, 0, 645, 0, 0, 0 }, { 0, 0, 645, 10, 0, 0 }, { 0, 0, 645, 0, 10, 15 },
+        { 20, 10, 650, 0, 0, 0 },
+    };
+    *pts = which ? turns : five;
+    return which ? 4 : 6;
+}
+
+/* The G61 program of straight feeds through pts[1..n-1] from pts[0] at feed_mm_min. */
+static inline void tm_g61_points(struct canon_prog *p, const double (*pts)[6], int n,
+                                 double feed_mm_min)
+{
+    canon_prog_init(p);
+    p->start_path_mode = 610;
+    memcpy(p->start, pts[0], sizeof pts[0]);
+    for (int i = 1; i < n; i++)
+        tm_add(p, CANON_FEED, i + 1, pts[i], feed_mm_min, 0);
+}
+
 /* Distance from p to the segment a-b (X Y Z). */
 static inline double tm_dist_seg(const double *p, const double *a, const double *b)
 {
