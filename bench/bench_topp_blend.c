@@ -313,24 +313,12 @@ out:
     return rc;
 }
 
-/* The TMU hexapod where the legs bind: legs 40 mm/s and 200 mm/s^2, path 500 mm/s and
- * 5000 mm/s^2 (bench_topp's machine), no kinematic-error bound. */
+/* The TMU hexapod where the legs bind (bench_topp's machine), no kinematic-error bound. */
 static struct tk_cfg *leg_bound_cfg(void)
 {
-    struct tk_cfg *c = tm_hexapod_cfg();
-    if (!c)
-        return NULL;
-    tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "500");
-    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "5000");
-    tk_set(c, "TRAJ", "MAX_ANGULAR_VELOCITY", "200");
-    tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "2000");
-    tk_set(c, "TRAJ", "KINEMATIC_TOLERANCE", "0");
-    for (int j = 0; j < 6; j++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        tk_set(c, sec, "MAX_VELOCITY", "40");
-        tk_set(c, sec, "MAX_ACCELERATION", "200");
-    }
+    struct tk_cfg *c = tm_leg_bound_hexapod_cfg();
+    if (c)
+        tk_set(c, "TRAJ", "KINEMATIC_TOLERANCE", "0");
     return c;
 }
 
@@ -361,21 +349,19 @@ int main(void)
                fabs(ref - exact) / exact);
         bad |= !(fabs(ref - exact) < 2e-3 * exact);
     }
-    static const double prog1[][6] = {
-        { 0, 0, 645, 0, 0, 0 }, { 100, 0, 645, 0, 0, 0 }, { 100, 80, 660, 5, -5, 10 },
-        { -60, 40, 630, -8, 6, -12 }, { -60, -90, 640, 0, 0, 0 }, { 0, 0, 645, 0, 0, 0 },
-    };
+    const double (*prog1)[6];
+    int n1 = tm_leg_bound_points(0, &prog1);
     printf("the TMU hexapod, legs 40 mm/s and 200 mm/s^2, path 500 mm/s and 5000 mm/s^2 (the "
            "legs bind), KINEMATIC_TOLERANCE 0:\n");
     double g61 = 0, g64[3] = { 0 }, ref;
-    if (compare("five moves, G61 (bench_topp's program)", leg_bound_cfg(), prog1, 6, 30000,
+    if (compare("five moves, G61 (bench_topp's program)", leg_bound_cfg(), prog1, n1, 30000,
                 610, 0, 0.05, &ref, &g61))
         return 1;
     static const double tols[3] = { 0.01, 0.1, 1.0 };
     for (int k = 0; k < 3; k++) {
         char name[96];
         snprintf(name, sizeof name, "five moves, G64 P%g", tols[k]);
-        if (compare(name, leg_bound_cfg(), prog1, 6, 30000, 640, tols[k], 0.05, &ref, &g64[k]))
+        if (compare(name, leg_bound_cfg(), prog1, n1, 30000, 640, tols[k], 0.05, &ref, &g64[k]))
             return 1;
     }
     /* a tilted polygon round a circle, five axes, blended: 120 chords of 1 mm (kinks of 3
