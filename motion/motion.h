@@ -185,6 +185,12 @@ void motion_set_probe_input(struct motion *m, bool on);
  * its pitch times the revolutions since it began (motion_sync.c); without feedback such a
  * program is refused when it is planned. */
 void motion_set_spindle_revs(struct motion *m, double revs, bool wired);
+/* The encoder's index handshake (spindle.0.index-enable, LinuxCNC's): whether the pin is
+ * connected, and its value this period. Connected, a synchronised move that needs the
+ * spindle's angle sets it (motion_out.spindle_index) and starts once the encoder has cleared
+ * it, having reset its count to 0 at the index; not connected, the move starts at the first
+ * whole revolution the count passes. */
+void motion_set_spindle_index(struct motion *m, bool enabled, bool wired);
 /* `hexcnc check`: no spindle, an ideal one instead: it turns at the commanded speed, reached
  * at [SPINDLE_SYNC] ACCELERATION, and synchronised moves follow it. */
 void motion_set_spindle_ideal(struct motion *m, bool on);
@@ -260,6 +266,9 @@ struct motion_out {
     double distance_total_mm;          /* XYZ path length of the program, mm */
     double feed_override;              /* override in effect now (ramps to the requested) */
     struct motion_spindle spindle;     /* spindle and coolant commands in force */
+    int spindle_index;                 /* 1: set spindle.0.index-enable (a synchronised move
+                                        * waits for the index), -1: clear it (that wait was
+                                        * given up), 0: leave it */
     int waiting;                       /* holding on the path: 1 for the spindle to be at
                                         * speed, 2 for a tool change, 3 for an input (M66) */
     struct motion_tool tool;           /* tool change requests, the tool in the spindle */

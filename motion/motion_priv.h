@@ -173,6 +173,7 @@ struct motion_sync {
     int dir0;                /* the spindle's direction and speed before a tap reversed it */
     double rpm0;
     double revs_prev;        /* last period's revolutions (the spindle's speed) */
+    int index_asked;         /* spindle.0.index-enable set for this move's start */
 };
 
 /* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
@@ -284,6 +285,9 @@ struct motion {
     _Atomic bool spindle_wired; /* spindle.0.revs is connected: synchronised moves may run */
     bool spindle_ideal;      /* no encoder: an ideal spindle (hexcnc check) */
     double ideal_rps;        /* the ideal spindle's speed, rev/s */
+    bool index_wired;        /* spindle.0.index-enable is connected */
+    bool index_enabled;      /* its value this period */
+    int index_out;           /* motion_out.spindle_index of this period */
     struct motion_sync sync;
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */

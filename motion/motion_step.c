@@ -744,6 +744,8 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->feed_override = m->rate;
     out->settings_done = m->marks_base + m->marks_done;
     out->spindle = m->io;
+    out->spindle_index = m->index_out;
+    m->index_out = 0;
     out->waiting = m->waiting;
     out->tool = m->tool;
     out->outputs = m->jerk ? m->outputs_out : m->outputs;

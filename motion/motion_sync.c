@@ -45,6 +45,14 @@ void motion_set_spindle_revs(struct motion *m, double revs, bool wired)
     atomic_store_explicit(&m->spindle_wired, wired, memory_order_relaxed);
 }
 
+void motion_set_spindle_index(struct motion *m, bool enabled, bool wired)
+{
+    if (!m)
+        return;
+    m->index_enabled = enabled;
+    m->index_wired = wired;
+}
+
 void motion_set_spindle_ideal(struct motion *m, bool on)
 {
     if (m)
@@ -254,6 +262,30 @@ static bool sync_index(struct motion_sync *y, double revs)
     return true;
 }
 
+/* With the encoder's index wired: asks for the index once the move may start, and whether
+ * the encoder has met it since (it clears the pin, its count reset to 0 there). A pause or an
+ * abort meanwhile withdraws the request; a resume asks again. */
+static bool sync_index_pin(struct motion *m, bool ready)
+{
+    struct motion_sync *y = &m->sync;
+    if (!ready) {
+        if (y->index_asked)
+            m->index_out = -1;
+        y->index_asked = 0;
+        return false;
+    }
+    if (!y->index_asked) {
+        y->index_asked = 1;
+        m->index_out = 1;             /* set this period; the encoder sees it from the next */
+        return false;
+    }
+    if (m->index_enabled)
+        return false;
+    y->index_asked = 0;
+    y->revs0 = 0;                     /* the count starts at the index */
+    return true;
+}
+
 /* Leaves segment sg: the plan's clock goes to the next segment's start (past the hold the
  * plan keeps where the path turns back: the executor has turned already), or to the end. */
 static void sync_leave(struct motion *m, const struct motion_seg *sg, enum motion_sync_phase ph)
@@ -340,7 +372,8 @@ bool motion_sync_advance(struct motion *m, double dt)
     if (y->phase == SYNC_INDEX) {
         /* (with jerk limits, once the moving average has come to rest here: the move then
          * follows the spindle without it, motion_jerk.c) */
-        bool go = m->state == MOTION_RUNNING && motion_jerk_settled(m) && sync_index(y, revs);
+        bool ready = m->state == MOTION_RUNNING && motion_jerk_settled(m);
+        bool go = m->index_wired ? sync_index_pin(m, ready) : ready && sync_index(y, revs);
         y->revs_prev = revs;
         if (!go) {
             m->rate = 0;              /* at rest: a pause or an abort may take it here */

@@ -13,13 +13,16 @@
  *   sim-spindle.at-speed   bit   out   |speed - speed-in| within tolerance
  *   sim-spindle.revs       float out   the encoder: revolutions turned, signed (forward
  *                                      counts up), the speed integrated each period
+ *   sim-spindle.index-enable bit io    set: the count goes to 0 at the next index (a whole
+ *                                      revolution, either way), and the pin is cleared
+ *                                      there (LinuxCNC's encoder; spindle.0.index-enable)
  *   sim-spindle.accel      float param rpm/s the spindle gains or loses speed at (2000)
  *   sim-spindle.tolerance  float param fraction of the commanded speed that counts as at
  *                                      speed (0.02), and never less than 1 rpm
  */
 struct sim_spindle {
     double *in, *speed, *revs;
-    bool *at_speed;
+    bool *at_speed, *index_enable;
     double accel, tol;
 };
 
@@ -29,7 +32,12 @@ static void sim_spindle_update(void *arg, long period_ns)
     double dt = (double)period_ns * 1e-9, step = fabs(s->accel) * dt;
     double diff = *s->in - *s->speed, rpm0 = *s->speed;
     *s->speed += fabs(diff) <= step ? diff : copysign(step, diff);
-    *s->revs += 0.5 * (rpm0 + *s->speed) / 60.0 * dt;   /* the ramp's mean speed: exact */
+    double r0 = *s->revs, r1 = r0 + 0.5 * (rpm0 + *s->speed) / 60.0 * dt; /* the ramp's mean */
+    if (*s->index_enable && floor(r0) != floor(r1)) {
+        r1 -= fmax(floor(r0), floor(r1));     /* the index passed: counted from it */
+        *s->index_enable = false;
+    }
+    *s->revs = r1;
     *s->at_speed = fabs(*s->in - *s->speed) <= fmax(fabs(s->tol * *s->in), 1.0);
 }
 
@@ -51,6 +59,7 @@ static int sim_spindle_load(struct hal *h, int argc, char **argv)
         (rc = hal_pin_float_newf(h, HAL_OUT, &s->speed, "sim-spindle.speed")) ||
         (rc = hal_pin_bit_newf(h, HAL_OUT, &s->at_speed, "sim-spindle.at-speed")) ||
         (rc = hal_pin_float_newf(h, HAL_OUT, &s->revs, "sim-spindle.revs")) ||
+        (rc = hal_pin_bit_newf(h, HAL_IO, &s->index_enable, "sim-spindle.index-enable")) ||
         (rc = hal_param_float_newf(h, HAL_RW, &s->accel, "sim-spindle.accel")) ||
         (rc = hal_param_float_newf(h, HAL_RW, &s->tol, "sim-spindle.tolerance")))
         return rc;

@@ -518,12 +518,102 @@ START_TEST(test_pause_after_chain)
 }
 END_TEST
 
+/* The spindle with an encoder that has an index (as sim-spindle with index-enable connected):
+ * a set spindle.0.index-enable resets the count to 0 at the next whole revolution and clears
+ * itself, unless the index is broken (it never comes). */
+struct indexed {
+    double rpm, revs;
+    bool pin, broken;
+    int sets, clears, cancels;
+    double k_mm, c_min, c_max;   /* z + K revs while following (between Z8 and Z0.2) */
+    double z_min;
+};
+
+static int indexed_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct indexed *s = ctx;
+    (void)step;
+    if (o->spindle_index > 0)
+        s->pin = true, s->sets++;
+    if (o->spindle_index < 0)
+        s->pin = false, s->cancels++;
+    double want = o->spindle.dir * o->spindle.rpm, diff = want - s->rpm, st = SPINDLE_ACC * DT;
+    double r0 = s->revs, rpm0 = s->rpm;
+    s->rpm += fabs(diff) <= st ? diff : copysign(st, diff);
+    s->revs += 0.5 * (rpm0 + s->rpm) / 60.0 * DT;
+    if (s->pin && !s->broken && floor(r0) != floor(s->revs)) {
+        s->revs -= fmax(floor(r0), floor(s->revs));
+        s->pin = false;
+        s->clears++;
+    }
+    motion_set_spindle_revs(m, s->revs, true);
+    motion_set_spindle_index(m, s->pin, true);
+    double z = o->pose[2];
+    s->z_min = fmin(s->z_min, z);
+    if (z <= 8 && z >= 0.2 && o->spindle.dir > 0) {
+        double c = z + s->k_mm * (s->revs - (rpm0 + s->rpm) / 120.0 * DT); /* the count read */
+        s->c_min = fmin(s->c_min, c);
+        s->c_max = fmax(s->c_max, c);
+    }
+    return o->state == MOTION_IDLE;
+}
+
+/* With the index handshake wired: the tap sets index-enable once, waits while it stays set,
+ * and starts when the encoder clears it, from its count of 0 (z + K revs = the start, within
+ * 1 um); with a broken index it waits at the start (3 s, 30 revolutions) until the abort,
+ * which clears the pin again. */
+START_TEST(test_index_handshake)
+{
+    const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
+    for (int broken = 0; broken < 2; broken++) {
+        struct tm_machine mc;
+        open_trivial(&mc);
+        struct canon_prog p;
+        tap_prog(&p, top, bottom, 600, 1.25, 1.0);
+        struct indexed s = { .rpm = 600, .revs = 0.37, .broken = broken, .k_mm = 1.25,
+                             .c_min = 1e9, .c_max = -1e9, .z_min = 1e9 };
+        motion_set_spindle_revs(mc.m, s.revs, true);
+        motion_set_spindle_index(mc.m, false, true);
+        char err[400];
+        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+        motion_start(mc.m);
+        struct tm_stats st;
+        if (!broken) {
+            tm_run(mc.m, DT, 20000, &st, indexed_hook, &s);
+            ck_assert_int_eq(st.last.state, MOTION_DONE);
+            ck_assert_int_eq(s.sets, 1);
+            ck_assert_int_eq(s.clears, 1);
+            ck_assert_int_eq(s.cancels, 0);
+            ck_assert_msg(s.c_max - s.c_min < 0.001 && fabs(s.c_min - 10) < 0.001,
+                          "z + K revs from %.6f to %.6f", s.c_min, s.c_max);
+        } else {
+            tm_run(mc.m, DT, 3000, &st, indexed_hook, &s);
+            ck_assert_int_eq(st.last.state, MOTION_RUNNING);
+            ck_assert_double_eq_tol(s.z_min, 10, 1e-12);
+            ck_assert(s.pin && s.sets == 1 && s.clears == 0);
+            ck_assert_int_eq(motion_abort(mc.m), MOTION_OK);
+            struct motion_out o;
+            int k = 0;
+            do {                        /* every period's output to the encoder */
+                motion_step(mc.m, DT, &o);
+                indexed_hook(mc.m, &o, k, &s);
+            } while (o.state != MOTION_IDLE && ++k < 100);
+            ck_assert_int_eq(o.state, MOTION_IDLE);
+            ck_assert(!s.pin && s.cancels == 1);
+        }
+        canon_prog_free(&p);
+        tm_close(&mc);
+    }
+}
+END_TEST
+
 static Suite *sync_suite(void)
 {
     Suite *s = suite_create("motion_sync");
     TCase *tc = tcase_create("core");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_tap_follows_spindle);
+    tcase_add_test(tc, test_index_handshake);
     tcase_add_test(tc, test_tap_m4);
     tcase_add_test(tc, test_no_feedback_refused);
     tcase_add_test(tc, test_too_fast_refused);

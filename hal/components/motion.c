@@ -68,6 +68,9 @@ struct motion_comp {
     double *sp_revs;                         /* in: spindle.0.revs, the spindle's position,
                                               * revolutions (G33, G33.1) */
     double *sp_revs_own;                     /* its own storage (see sp_at_speed_own) */
+    bool *sp_index;                          /* io: spindle.0.index-enable, the encoder's
+                                              * index handshake (G33, G33.1) */
+    bool *sp_index_own;                      /* its own storage (see sp_at_speed_own) */
     /* the tool changer's handshake, LinuxCNC's iocontrol pins */
     int32_t *tc_prep_number, *tc_number;     /* out: tool-prep-number, tool-number */
     bool *tc_prepare, *tc_change;            /* out: tool-prepare, tool-change */
@@ -232,6 +235,7 @@ static void motion_comp_update(void *arg, long period_ns)
     motion_set_inputs(c->m, din, c->ndio, ain, c->naio);
     motion_set_probe_input(c->m, *c->probe_in);
     motion_set_spindle_revs(c->m, *c->sp_revs, c->sp_revs != c->sp_revs_own);
+    motion_set_spindle_index(c->m, *c->sp_index, c->sp_index != c->sp_index_own);
     motion_feedback(c->m, fb);
     motion_comp_commands(c);
     motion_step(c->m, (double)period_ns * 1e-9, &o);
@@ -254,6 +258,8 @@ static void motion_comp_update(void *arg, long period_ns)
     *c->fault = o.state == MOTION_FAULT;
     *c->amp_enable = *c->enable && o.state != MOTION_FAULT;
     motion_comp_spindle(c, &o);
+    if (o.spindle_index)
+        *c->sp_index = o.spindle_index > 0;
     for (int i = 0; i < c->ndio; i++)
         *c->dout[i] = (o.outputs.dout >> i) & 1u;
     for (int i = 0; i < c->naio; i++)
@@ -332,6 +338,7 @@ static int motion_comp_state_pins(struct hal *h, struct motion_comp *c)
         st = hal_pin_float_newf(h, HAL_IN, &c->ain[i], "motion.analog-in-%02d", i);
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->probe_in, "motion.probe-input");
     if (st == HAL_OK) st = hal_pin_float_newf(h, HAL_IN, &c->sp_revs, "spindle.0.revs");
+    if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IO, &c->sp_index, "spindle.0.index-enable");
     if (st == HAL_OK) st = hal_pin_s32_newf(h, HAL_OUT, &c->tc_prep_number, "iocontrol.0.tool-prep-number");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_OUT, &c->tc_prepare, "iocontrol.0.tool-prepare");
     if (st == HAL_OK) st = hal_pin_bit_newf(h, HAL_IN, &c->tc_prepared, "iocontrol.0.tool-prepared");
@@ -402,6 +409,7 @@ static int motion_comp_load(struct hal *h, int argc, char **argv)
     *c->sp_at_speed = true;   /* unwired: the spindle is taken to be at speed */
     c->sp_at_speed_own = c->sp_at_speed;
     c->sp_revs_own = c->sp_revs;
+    c->sp_index_own = c->sp_index;
     c->tc_prepared_own = c->tc_prepared;
     c->tc_changed_own = c->tc_changed;
     c->autostart = true;

@@ -5,10 +5,12 @@ the legs' Z (kins.pose-fb-z, forward kinematics of the stepgens' feedback), the 
 (sim-spindle.revs) and the spindle command. From that record: into the hole and out again Z
 is the start less K x (revolutions since a whole one), the spindle is reversed at the bottom
 and set forward again at the top, the tool runs on past the bottom by the revolutions the
-spindle takes to stop and no further, and it ends where it started. Two G33 passes of one
-thread, a dwell apart, are in phase (a whole number of revolutions between them at one
-height). Without spindle.0.revs connected the same program is refused before anything
-moves. Standard library only; run by
+spindle takes to stop and no further, and it ends where it started. Each synchronised move
+sets spindle.0.index-enable and starts once the encoder has met its index (its count reset
+to 0 there, the pin cleared), so two G33 passes of one thread, a dwell apart, cross one
+height at the same count. With index-enable not connected they start at whole revolutions
+of the count instead (a whole number of revolutions between them). Without spindle.0.revs
+connected the same program is refused before anything moves. Standard library only; run by
 machine_sync.sh."""
 import os
 import shutil
@@ -93,11 +95,12 @@ def spread(values):
 def tap_run(tmp):
     trace = os.path.join(tmp, "trace.out")
     ini = config(tmp, ["net spindle-at-speed sim-spindle.at-speed => spindle.0.at-speed",
-                       "loadrt sampler cfg=ffff file=%s" % trace,
+                       "loadrt sampler cfg=ffffb file=%s" % trace,
                        "net zc motion.pose-cmd-z => sampler.0.pin.0",
                        "net pose-fb-z => sampler.0.pin.1",
                        "net spindle-revs => sampler.0.pin.2",
                        "net spindle-cmd => sampler.0.pin.3",
+                       "net spindle-index => sampler.0.pin.4",
                        "addf sampler.0 servo-thread"])
     st, msgs = run(tmp, ini, "tap.ngc", TAP, mdi_tap)
     check("the tap program ran to its end", st["motion"] == "done", (st["motion"], msgs))
@@ -109,6 +112,16 @@ def tap_run(tmp):
     zf = [r[1] for r in rows]
     revs = [r[2] for r in rows]
     cmd = [r[3] for r in rows]
+    index = [r[4] for r in rows]
+    # the index handshake: set before each synchronised move, cleared by the encoder in the
+    # period it met its index, its count then within a period's turn (0.01 rev) of 0 (four
+    # moves: the tap, two G33 passes, the MDI tap; the count may already stand at 0 there)
+    cleared = [i for i in range(1, len(rows)) if index[i - 1] == 1 and index[i] == 0]
+    print("     index-enable cleared at periods %s, the count there %s" % (
+        cleared, ["%.4f" % revs[i] for i in cleared]))
+    check("spindle.0.index-enable was set before each synchronised move and cleared by the "
+          "encoder at its index, its count reset to 0 there",
+          len(cleared) == 4 and all(abs(revs[i]) <= 0.0101 for i in cleared), cleared)
     i_rev = next((i for i, c in enumerate(cmd) if c < 0), None)
     check("the spindle is reversed (speed-out -%g rpm) once the tap is at the bottom" % S,
           i_rev is not None and abs(cmd[i_rev] + S) < 1e-9 and zc[i_rev - 1] <= BOTTOM + 1e-9,
@@ -166,18 +179,45 @@ def tap_run(tmp):
           abs(st["machine_pose"]["commanded"][2] - TOP) < 1e-9 and
           abs(st["machine_pose"]["commanded"][0] - 2) < 1e-9, st["machine_pose"])
     # two G33 passes of one thread (K1.5 from Z650), a dwell of 0.37 s between them: each
-    # starts at a whole revolution, so where they cross Z645 the spindle's revolutions differ
-    # by a whole number
+    # starts at the index, so they cross Z645 at the same count since it
+    at = crossings(zc, revs, cmd, i_fwd)
+    print("     two G33 passes cross Z645 at %s revolutions since their index" %
+          " and ".join("%.4f" % a for a in at))
+    check("two G33 passes of a thread cross Z645 at the same count since their index (in "
+          "phase, within 0.001 rev)", len(at) == 2 and abs(at[1] - at[0]) < 0.001, at)
+
+
+def crossings(zc, revs, cmd, i0):
+    """The encoder's count where the G33 passes after period i0 cross Z645 going down."""
     at = []
-    for i in range(max(i_fwd, 2), len(zc)):
+    for i in range(max(i0, 2), len(zc)):
         if zc[i - 1] > 645 >= zc[i] and cmd[i] > 0:
             f = (zc[i - 1] - 645) / (zc[i - 1] - zc[i])
             at.append(revs[i - 2] + f * (revs[i - 1] - revs[i - 2]))
+    return at
+
+
+def passes_without_index(tmp):
+    """index-enable not connected: each pass starts at a whole revolution of the count."""
+    trace = os.path.join(tmp, "trace2.out")
+    ini = config(tmp, ["unlinkp spindle.0.index-enable",
+                       "loadrt sampler cfg=fff file=%s" % trace,
+                       "net zc motion.pose-cmd-z => sampler.0.pin.0",
+                       "net spindle-revs => sampler.0.pin.1",
+                       "net spindle-cmd => sampler.0.pin.2",
+                       "addf sampler.0 servo-thread"])
+    st, msgs = run(tmp, ini, "passes.ngc", TAP)
+    rows = [[float(v) for v in l.split()] for l in open(trace)]
+    zc, revs, cmd = [r[0] for r in rows], [r[1] for r in rows], [r[2] for r in rows]
+    i_fwd = max(i for i in range(1, len(cmd)) if cmd[i] > 0 and cmd[i - 1] < 0)
+    at = crossings(zc, revs, cmd, i_fwd)
     dn = at[1] - at[0] if len(at) == 2 else 0.5
-    print("     two G33 passes cross Z645 %.4f revolutions apart" % dn)
-    check("two G33 passes of a thread cross Z645 a whole number of revolutions apart (in "
-          "phase, within 0.001 rev)", len(at) == 2 and dn > 1 and abs(dn - round(dn)) < 0.001,
-          at)
+    print("     without the index: two G33 passes cross Z645 %.4f revolutions apart" % dn)
+    check("without index-enable connected, the program runs and two G33 passes cross Z645 a "
+          "whole number of revolutions apart (in phase, within 0.001 rev)",
+          st["motion"] == "done" and len(at) == 2 and dn > 1 and
+          abs(dn - round(dn)) < 0.001 and
+          all(abs(revs[i] - revs[i - 1]) < 0.1 for i in range(1, len(revs))), (at, msgs))
 
 
 def refused_without_encoder(tmp):
@@ -193,6 +233,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="hexcnc-sync.")
     try:
         tap_run(tmp)
+        passes_without_index(tmp)
         refused_without_encoder(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
