@@ -290,6 +290,8 @@ static void passes(struct motion *m)
                 dt = sg->dwell_s;
             else if (sg->kind <= SEG_ARC && v0 == 0 && i + 1 == sg->k0 + sg->nk)
                 dt = stop_rest_s(m, j);  /* a stop between moves: held (motion_step.c) */
+            if (sg->sync && i + 1 == sg->k0 + sg->nk)
+                dt += motion_sync_extra_s(m, p, j);  /* (the executor's clock skips it) */
             p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
         }
         p->irho[i] = fmax(rho, 1.0);

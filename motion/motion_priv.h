@@ -391,6 +391,10 @@ double motion_chord_period(const struct motion_config *c);
 int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
                       size_t errlen);
 bool motion_sync_advance(struct motion *m, double dt);
+/* The time synchronised segment j of p takes beyond its travel at S x K, for the plan's
+ * time: the wait for the index at a run's first move, and a tap's spindle reversals with
+ * the run-on travelled back (the executor's clock skips it, motion_step.c). */
+double motion_sync_extra_s(const struct motion *m, const struct motion_plan *p, size_t j);
 bool motion_sync_at(const struct motion *m, double *s, double *v);
 /* Whether the spindle drives the path now (following it, or a tap's own moves between): the
  * jerk limiter's moving average stands aside, so the tool keeps its place on the thread. */

@@ -160,6 +160,40 @@ int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
     return sg->sync == CANON_SYNC_THREAD ? 0 : sync_check_run_on(m, sg, err, errlen);
 }
 
+/* Time to travel d mm at pitch k while the spindle speeds up from rest at acc (rev/s^2) to
+ * w (rev/s), then turns at w. */
+static double climb_s(double d, double k, double acc, double w)
+{
+    if (!(d > 0) || !(k > 0) || !(acc > 0) || !(w > 0))
+        return 0;
+    double d_ramp = k * w * w / (2 * acc);
+    return d <= d_ramp ? sqrt(2 * d / (k * acc)) : w / acc + (d - d_ramp) / (k * w);
+}
+
+double motion_sync_extra_s(const struct motion *m, const struct motion_plan *p, size_t j)
+{
+    const struct motion_seg *sg = &p->segs[j];
+    double rps = sg->sync_rpm / 60.0, acc = m->cfg.spindle_acc_rpm_s / 60.0;
+    double k = sg->pitch_mm_rev, out = rps * sg->retract_factor, t = 0;
+    if (!sg->sync || !(rps > 0) || !(acc > 0))
+        return 0;
+    if (!(j > 0 && p->segs[j - 1].sync))
+        t += 0.5 / rps;         /* the index comes within a turn: half of one on average */
+    if (sg->sync == CANON_SYNC_TAP_IN) {        /* the spindle stops at the bottom, and the */
+        t += rps / acc + climb_s(k * rps * rps / (2 * acc), k, acc, out); /* run-on back */
+    } else if (sg->sync == CANON_SYNC_TAP_OUT) {
+        /* it stops above the start; the tool comes back unsynchronised, from rest to rest at
+         * the share of the move's acceleration the follower brakes with */
+        double a = HUGE_VAL;
+        for (size_t i = sg->k0; i + 1 < sg->k0 + sg->nk; i++)
+            a = fmin(a, p->iacc[i]);
+        if (!(a < HUGE_VAL))
+            a = m->cfg.max_lin_acc_mm_s2;
+        t += out / acc + 2 * sqrt(k * out * out / (2 * acc) / (SYNC_BRAKE_SHARE * a));
+    }
+    return t;
+}
+
 /* The ideal spindle of a check: it reaches the commanded speed at [SPINDLE_SYNC]
  * ACCELERATION (at once when that is not given) and turns. */
 static void ideal_spindle(struct motion *m, double dt)
