@@ -7,6 +7,9 @@
 
 #define FD_H 0.05              /* finite-difference step along the path, mm (deg) */
 #define LEG_ACC_SPLIT 0.6      /* share of a leg's acceleration for the path acceleration term */
+#define LEG_CURV_HAND 1.2      /* the curvature term's margin: 20 % in hand */
+#define BLEND_CURV_SHARE 0.95  /* on blend arcs: the curvature term's share ... */
+#define BLEND_CURV_HAND 1.05   /* ... and its margin (see leg_share) */
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
 #define FINE_SLACK 1e-9        /* relative: knots this much wider than fine_h are as close */
 
@@ -271,11 +274,38 @@ static int reach_check(struct motion *m, const struct motion_seg *sg, struct mot
     return st == KINS_OK ? MOTION_OK : unreachable(m, sg, S, st, err, errlen);
 }
 
+/* How a leg's acceleration is shared between the curvature term L'' v^2 (curv, with its
+ * margin: |L''| v^2 hand <= curv aL) and the path term L' a (the rest). */
+struct leg_share { double curv, hand; };
+
+/* The share on move sg. A share of the legs' acceleration holds either the speed on a bend
+ * down or the path acceleration there. 40 % for the curvature (LEG_ACC_SPLIT for the path),
+ * with 20 % in hand, suits moves that must speed up or slow down along their bends
+ * (programmed arcs: with 95 % on every arc, a chain of kinked arcs took twice as long and a
+ * full circle 24 % longer, docs/motion.md). A G64 blend arc is a different case: it joins
+ * its two lines tangentially, and they keep their legs' whole acceleration for the speed
+ * changes (motion_junction_share), while the time-optimal profile crosses the arc at the
+ * speed its curvature allows with next to no path acceleration. With 40 % the arc was
+ * crossed at sqrt(1/3) of that speed, and on a polygon whose blends are short the planned
+ * time was 1.25x the time-optimal one (bench_topp_blend). So on blend arcs the curvature
+ * takes BLEND_CURV_SHARE and the path the rest of what the knot's speed leaves
+ * (leg_acc_at_speed). Its margin is 5 %: the knots of an arc lie at most 0.05 rad of its
+ * turn apart, the speed between two knots stays within both their caps, and between knots
+ * |L''| rose at most 0.31 % above its larger end value on the blend arcs of
+ * bench_topp_blend's programs (P0.01 to P5, 20 samples an interval). The share depends on
+ * the move alone, so streamed windows that share a move give it the same caps. */
+static struct leg_share leg_share(const struct motion *m, const struct motion_seg *sg)
+{
+    if (sg->kind == SEG_ARC && m->plan.arcs[sg->arc].abc_cubic)
+        return (struct leg_share){ BLEND_CURV_SHARE, BLEND_CURV_HAND };
+    return (struct leg_share){ 1 - LEG_ACC_SPLIT, LEG_CURV_HAND };
+}
+
 /* Leg caps at a knot: path speed into *vl, path acceleration into *am (lowered). The leg's
  * rate is L' v and its acceleration L'' v^2 + L' a; L' may grow by L'' hs before the next
- * knot. Half the leg's acceleration goes to each term, the curvature term with 20 % in hand. */
+ * knot. The shares of the leg's acceleration are sh's. */
 static void leg_caps(const struct motion *m, const struct motion_sample *S, double hs,
-                     double *vl, double *am)
+                     struct leg_share sh, double *vl, double *am)
 {
     const struct motion_config *c = &m->cfg;
     double v2 = HUGE_VAL;      /* the curvature terms' speed, squared: one square root for
@@ -285,10 +315,10 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
         if (d1 > 1e-12) {
             *vl = min2(*vl, c->joint[i].max_vel_mm_s / d1);
-            *am = min2(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
+            *am = min2(*am, (1 - sh.curv) * c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
-            v2 = min2(v2, (1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2));
+            v2 = min2(v2, sh.curv * c->joint[i].max_acc_mm_s2 / (sh.hand * d2));
     }
     if (v2 < HUGE_VAL)
         *vl = min2(*vl, sqrt(v2));
@@ -296,20 +326,20 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
 
 /* The path acceleration the legs allow at a knot once its speed is known to stay within vh
  * (its hard cap, which no feed override exceeds): each leg's curvature term takes
- * 1.2 |L''| vh^2 of its acceleration (20 % in hand, as the speed cap) and the path term the
- * rest, at least the LEG_ACC_SPLIT share leg_caps gives (the speed cap keeps the curvature
- * term within the other share). Where the speed is capped well below the legs' curvature
+ * hand |L''| vh^2 of its acceleration (with the speed cap's margin) and the path term the
+ * rest, at least the 1 - curv share leg_caps gives (the speed cap keeps the curvature
+ * term within curv). Where the speed is capped well below the legs' curvature
  * limit (by the feed, the machine or another leg), the legs lend the path most of their
  * acceleration instead of half: bench_topp measures the gain against the time-optimal. */
 static double leg_acc_at_speed(const struct motion *m, const struct motion_sample *S,
-                               double hs, double vh)
+                               double hs, double vh, struct leg_share sh)
 {
     const struct motion_config *c = &m->cfg;
     double am = HUGE_VAL;
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, aL = c->joint[i].max_acc_mm_s2;
         if (d1 > 1e-12)
-            am = min2(am, max2(LEG_ACC_SPLIT * aL, aL - 1.2 * fabs(S->d2L[i]) * vh * vh) / d1);
+            am = min2(am, max2((1 - sh.curv) * aL, aL - sh.hand * fabs(S->d2L[i]) * vh * vh) / d1);
     }
     return am;
 }
@@ -354,7 +384,7 @@ bool motion_cancelled(const struct motion *m, const char *file, int line, char *
  * knot is then sampled at no more than fine_h: every sample is checked for reach and
  * lowers the knot's leg caps, each with the error term of the fine spacing. */
 static int between_knots(struct motion *m, const struct motion_seg *sg, double s, double hs,
-                         double *vl, double *am, char *err, size_t errlen)
+                         struct leg_share sh, double *vl, double *am, char *err, size_t errlen)
 {
     double n = ceil(hs / sg->fine_h), h = hs / n;
     for (double j = 1; j < n && s + j * h < sg->len; j++) {
@@ -365,7 +395,7 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
         int st = reach_check(m, sg, &T, h, sample_at(m, sg, s + j * h, &T), err, errlen);
         if (st)
             return st;
-        leg_caps(m, &T, h, &v, am);
+        leg_caps(m, &T, h, sh, &v, am);
         *vl = min2(*vl, v);
     }
     return MOTION_OK;
@@ -399,8 +429,9 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
             am = min2(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
     }
     double am_machine = am;
-    leg_caps(m, S, h, &vl, &am);
-    if (h < hs && (st = between_knots(m, sg, s, hs, &vl, &am, err, errlen)))
+    struct leg_share sh = leg_share(m, sg);
+    leg_caps(m, S, h, sh, &vl, &am);
+    if (h < hs && (st = between_knots(m, sg, s, hs, sh, &vl, &am, err, errlen)))
         return st;
     double vk = kin_tol_cap(m, sg, S);
     if (vk < 0) {
@@ -419,7 +450,7 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     *hard = min2(min2(vm, vl), vk);
     *cap = min2(*hard, feed);
     if (h >= hs)               /* the legs' share for the path, now the speed is known */
-        am = min2(am_machine, leg_acc_at_speed(m, S, h, *hard));
+        am = min2(am_machine, leg_acc_at_speed(m, S, h, *hard, sh));
     *acc = am;
     return MOTION_OK;
 }

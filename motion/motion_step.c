@@ -53,6 +53,16 @@ static double ceiling_at(const struct motion_plan *p, size_t ci, double tau)
     return fmin(r, p->irho[ci]);
 }
 
+/* The override ceiling at tau, which may lie past interval ci (a period ahead): the
+ * ceiling is continuous along the plan's clock, so the rate that follows it a period ahead
+ * changes no faster than it does. */
+static double ceiling_ahead(const struct motion_plan *p, size_t ci, double tau)
+{
+    while (ci + 2 < p->nknot && tau > p->kt[ci + 1])
+        ci++;
+    return ceiling_at(p, ci, tau);
+}
+
 /* The phases of interval i that plan time [t0, t1] passes: each ramp's or cruise's path
  * acceleration (+-iacc or 0) into a[] (returns how many, at most 3). Joints and rests, where
  * the path does not move, have none. */
@@ -398,7 +408,13 @@ static void advance(struct motion *m, double dt)
             m->tau_s += dt;
         } else {
             plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
-            double rn = next_rate(m, target, vp, ceiling_at(p, m->ci, m->tau_s), dt);
+            /* the ceiling where this period ends: the rate is down to it by then, not a
+             * period late, when the plan's own ramp begins at the next knot (with the
+             * ceiling where the period began, the last step down came on top of the ramp's
+             * full deceleration: a leg 5 % over its limit at override 2 on a blended
+             * 12-gon, test_blend_legs_time_optimal) */
+            double rn = next_rate(m, target, vp,
+                                  ceiling_ahead(p, m->ci, m->tau_s + m->rate * dt), dt);
             m->tau_s += 0.5 * (m->rate + rn) * dt;
             m->rate = rn;
         }
