@@ -4,7 +4,8 @@ LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/m
             motion/motion_step.c motion/motion_manual.c motion/motion_home.c \
             motion/motion_stream.c motion/motion_merge.c motion/motion_probe.c \
             motion/motion_jerk.c motion/motion_sync.c
-TESTS += test_motion test_motion_run test_motion_legs test_motion_hal test_motion_blend \
+TESTS += test_motion test_motion_run test_motion_legs test_motion_override test_motion_hal \
+         test_motion_blend \
          test_motion_stop test_motion_manual test_motion_spindle test_motion_stream test_motion_merge \
          test_motion_small_arcs test_motion_probe test_motion_jerk test_motion_sync
 # The HAL component `motion` (loadrt motion) and the runner's entry points (motion_hal.h).
