@@ -19,7 +19,8 @@
  * speed cap of the paper's own, which the reference would only copy.
  *
  * Validated against closed-form trapezoids, and against bench_topp's move-by-move reference
- * on a G61 program (the same path: the two implementations must agree).
+ * on a G61 program (the same path: the two implementations must agree). Programmed arcs
+ * (G2/G3) are measured the same way.
  */
 #include <math.h>
 #include <stdio.h>
@@ -388,8 +389,48 @@ int main(void)
                     &circ[1 + k]))
             return 1;
     }
+    /* programmed arcs (G2/G3) where the legs bind: a tilted S of four arcs, G61 and G64 */
+    double arcs[2] = { 0 };
+    for (int k = 0; k < 2; k++) {
+        struct tk_cfg *c = leg_bound_cfg();
+        struct tm_machine tm;
+        if (!c || tm_open(&tm, c, &kins_hexapod_ops))
+            return 1;
+        struct canon_prog p;
+        canon_prog_init(&p);
+        p.start_path_mode = k ? 640 : 610;
+        p.start_path_tol_mm = 0.05;
+        double at[6] = { -40, 0, 645, 0, 0, 0 };
+        memcpy(p.start, at, sizeof at);
+        static const double up[3] = { 0, 0, 1 };
+        for (int i = 0; i < 4; i++) {
+            double c3[3] = { at[0] + 10, at[1], at[2] }, to[6];
+            memcpy(to, at, sizeof to);
+            to[0] += 20;
+            to[3] = i % 2 ? 0 : 6, to[4] = i % 2 ? 0 : -4;
+            tm_arc(&p, i + 2, to, c3, up, i % 2 ? 1 : -1, 30000);
+            memcpy(at, to, sizeof at);
+        }
+        char err[512];
+        struct grid gr = { 0 };
+        struct limits lim;
+        limits_of(&tm, &lim);
+        if (motion_load(tm.m, &p, err, sizeof err) || grid_build(&tm, 0.01, &gr))
+            return 1;
+        struct motion_plan_info info;
+        motion_plan_info(tm.m, &info);
+        ref = topp(&gr, &lim);
+        arcs[k] = info.time_s / ref;
+        printf("  four arcs of 10 mm, A B turning, %s: planner %.4f s, TOPP %.4f s, ratio %.3f\n",
+               k ? "G64 P0.05" : "G61", info.time_s, ref, arcs[k]);
+        free(gr.ds);
+        free(gr.g);
+        canon_prog_free(&p);
+        tm_close(&tm);
+    }
     printf("planned time against the time-optimal one along the blended path: %.3f %.3f %.3f "
-           "(five moves), %.3f %.3f %.3f (the circle); G61 %.3f\n", g64[0], g64[1], g64[2],
-           circ[0], circ[1], circ[2], g61);
+           "(five moves), %.3f %.3f %.3f (the circle); G61 %.3f; programmed arcs %.3f, %.3f "
+           "(G61, G64)\n", g64[0], g64[1], g64[2], circ[0], circ[1], circ[2], g61, arcs[0],
+           arcs[1]);
     return bad;
 }
