@@ -176,6 +176,14 @@ struct motion_sync {
     int index_asked;         /* spindle.0.index-enable set for this move's start */
 };
 
+/* An interval's ramp and cruise times for its speeds, acceleration and length (what
+ * motion_phases gives, and the ramp's length): the executor evaluates one interval for many
+ * periods running, and the divisions are most of the cost of evaluating it. */
+struct motion_phase_memo {
+    double v0, v1, vp, acc, ds;        /* the inputs (never all matched by a fresh memo: ds > 0) */
+    double ta, tc, td, sa;
+};
+
 /* Manual motion (motion_manual.c): a 1-D profile along a line in pose space, or one per leg. */
 enum motion_man_kind { MAN_NONE, MAN_LINE, MAN_JOINTS };
 struct motion_manual {
@@ -289,6 +297,7 @@ struct motion {
     bool index_enabled;      /* its value this period */
     int index_out;           /* motion_out.spindle_index of this period */
     struct motion_sync sync;
+    struct motion_phase_memo phases; /* motion_step.c's plan_at: the last interval's phases */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];

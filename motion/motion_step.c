@@ -14,9 +14,10 @@
  * limit; above 1 it is also held under the plan's ceiling (speed caps of legs and machine).
  */
 
-/* Plan position, speed and acceleration at tau within interval ci. */
+/* Plan position, speed and acceleration at tau within interval ci (the interval's phases
+ * memoised in *mp: a pure function of its inputs, recomputed when they change). */
 static void plan_at(const struct motion_plan *p, size_t ci, double tau, double *s, double *v,
-                    double *a)
+                    double *a, struct motion_phase_memo *mp)
 {
     double d = tau - p->kt[ci], ds = p->ks[ci + 1] - p->ks[ci];
     double v0 = p->kv[ci], v1 = p->kv[ci + 1], vp = p->ivp[ci], acc = p->iacc[ci];
@@ -26,19 +27,23 @@ static void plan_at(const struct motion_plan *p, size_t ci, double tau, double *
         *a = 0;
         return;
     }
-    double ta, tc, td;
-    motion_phases(v0, v1, vp, acc, ds, &ta, &tc, &td);
+    if (mp->v0 != v0 || mp->v1 != v1 || mp->vp != vp || mp->acc != acc || mp->ds != ds) {
+        motion_phases(v0, v1, vp, acc, ds, &mp->ta, &mp->tc, &mp->td);
+        mp->sa = (vp * vp - v0 * v0) / (2 * acc);
+        mp->v0 = v0, mp->v1 = v1, mp->vp = vp, mp->acc = acc, mp->ds = ds;
+    }
+    double ta = mp->ta, tc = mp->tc, td = mp->td;
     d = d < 0 ? 0 : d > ta + tc + td ? ta + tc + td : d;
     if (d < ta) {
         *v = v0 + acc * d, *a = acc;
         *s = v0 * d + 0.5 * acc * d * d;
     } else if (d < ta + tc) {
         *v = vp, *a = 0;
-        *s = (vp * vp - v0 * v0) / (2 * acc) + vp * (d - ta);
+        *s = mp->sa + vp * (d - ta);
     } else {
         double e = d - ta - tc;
         *v = vp - acc * e, *a = -acc;
-        *s = (vp * vp - v0 * v0) / (2 * acc) + vp * tc + vp * e - 0.5 * acc * e * e;
+        *s = mp->sa + vp * tc + vp * e - 0.5 * acc * e * e;
     }
     *s = p->ks[ci] + (*s > ds ? ds : *s);
 }
@@ -407,7 +412,7 @@ static void advance(struct motion *m, double dt)
              * limit, so 1 lies within every bound next_rate takes */
             m->tau_s += dt;
         } else {
-            plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+            plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
             /* the ceiling where this period ends: the rate is down to it by then, not a
              * period late, when the plan's own ramp begins at the next knot (with the
              * ceiling where the period began, the last step down came on top of the ramp's
@@ -473,7 +478,7 @@ static int evaluate(struct motion *m)
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
-    plan_at(p, m->ci, m->tau_s, &s, &vp, &ap);
+    plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
     motion_sync_at(m, &s, &vp);        /* a synchronised move: where the spindle has it */
     if (m->state == MOTION_DONE) {
         s = sg->len;
