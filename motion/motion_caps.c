@@ -315,16 +315,14 @@ static double leg_acc_at_speed(const struct motion *m, const struct motion_sampl
 }
 
 /* Machine caps at a knot: path speed into *vm and acceleration into *am from the linear and
- * angular limits, and the centripetal share on arcs. */
-static void machine_caps(const struct motion *m, const struct motion_seg *sg,
-                         const struct motion_sample *S, double *vm, double *am)
+ * angular limits, and the centripetal share on arcs. w: the largest |d(A B C)/ds| until the
+ * next knot. */
+static void machine_caps(const struct motion *m, const struct motion_seg *sg, double w,
+                         double *vm, double *am)
 {
     const struct motion_config *c = &m->cfg;
-    double w = 0;
     *vm = sg->rotary ? HUGE_VAL : c->max_lin_vel_mm_s;
     *am = sg->rotary ? HUGE_VAL : c->max_lin_acc_mm_s2;
-    for (int i = 3; i < 6; i++)
-        w = max2(w, fabs(S->dp[i]));
     if (w > 1e-12) {
         *vm = min2(*vm, c->max_ang_vel_deg_s / w);
         *am = min2(*am, c->max_ang_acc_deg_s2 / w);
@@ -386,14 +384,16 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     if (st)
         return st;
     double vm, am, vl, kabc = 0;   /* |d2(A B C)/ds2|: the path's, 0 but on blend arcs */
+    double w = 0;                  /* |d(A B C)/ds| */
     for (int i = 3; i < 6; i++)
-        kabc = max2(kabc, fabs(S->d2p[i]));
-    machine_caps(m, sg, S, &vm, &am);
+        kabc = max2(kabc, fabs(S->d2p[i])), w = max2(w, fabs(S->dp[i]));
+    /* On a blend arc the rate changes before the next knot, hs on: by at most kabc hs, the
+     * cubic's |d2(A B C)/ds2| being linear along it (so largest at an interval's end, whose
+     * knot's cap the interval takes) */
+    w += kabc * hs;
+    machine_caps(m, sg, w, &vm, &am);
     if (kabc > 1e-12) {        /* A B C bend along a blend arc: half the angular acceleration
                                 * for the bend (abc'' v^2), half for the path's (abc' a) */
-        double w = 0;
-        for (int i = 3; i < 6; i++)
-            w = max2(w, fabs(S->dp[i]));
         vm = min2(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
         if (w > 1e-12)
             am = min2(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);

@@ -12,6 +12,11 @@
 #define SAMPLE_MM 1.0          /* largest knot spacing along the XYZ path, mm */
 #define SAMPLE_DEG 0.5         /* largest change of any of A B C between knots, deg */
 #define SAMPLE_RAD 0.05        /* largest arc angle between knots, rad */
+/* ... on a G64 blend arc: the knots' caps bound the legs between knots to first order in
+ * the spacing (L' may grow by L'' h), the rest grows with the angle's square; the angle rule
+ * decides only on arcs shorter than SAMPLE_MM per this angle (radius under 4 mm), where the
+ * centripetal cap keeps the speed low (docs/motion.md, *Segments and knots*) */
+#define SAMPLE_BLEND_RAD 0.25
 #define MAX_INTERVALS 4000     /* knots per segment are capped (very long moves) */
 
 
@@ -191,18 +196,19 @@ static struct motion_seg *add_seg(struct motion_plan *p, const struct canon_cmd 
 }
 
 /* Intervals a move needs for the reachability and limit checks to hold between samples
- * (SAMPLE_MM, SAMPLE_DEG, SAMPLE_RAD), at least 1; not capped. */
-static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_rad)
+ * (SAMPLE_MM, SAMPLE_DEG, and arc_steps: the arc's angle over SAMPLE_RAD or
+ * SAMPLE_BLEND_RAD), at least 1; not capped. */
+static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_steps)
 {
-    double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_rad / SAMPLE_RAD);
+    double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_steps);
     return fmax(1.0, ceil(n));
 }
 
 /* Knot intervals for a move: the fine ones, capped at MAX_INTERVALS (the checks then sample
  * between the knots, motion_caps.c). */
-static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
+static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_steps)
 {
-    double n = fine_intervals(xyz_mm, abc_max_deg, arc_rad);
+    double n = fine_intervals(xyz_mm, abc_max_deg, arc_steps);
     return n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
 }
 
@@ -294,9 +300,10 @@ static int arc_geometry(const struct canon_cmd *c, const double *from, struct mo
     return 0;
 }
 
-/* An arc or helix from `from` to c->end. */
+/* An arc or helix from `from` to c->end; blend: a G64 blend arc (its knots' angle rule is
+ * SAMPLE_BLEND_RAD). */
 static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const double *from,
-                   char *err, size_t errlen)
+                   int blend, char *err, size_t errlen)
 {
     struct motion_arc a;
     memset(&a, 0, sizeof a);
@@ -313,7 +320,8 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     double planar = fabs(a.sweep_rad) * rm;
     double xyz = sqrt(planar * planar + a.dh_mm * a.dh_mm + a.dr_mm * a.dr_mm);
     double abc_deg = abc_max(from, c->end);
-    struct motion_seg *sg = add_seg(p, c, SEG_ARC, intervals_for(xyz, abc_deg, fabs(a.sweep_rad)));
+    double steps = fabs(a.sweep_rad) / (blend ? SAMPLE_BLEND_RAD : SAMPLE_RAD);
+    struct motion_seg *sg = add_seg(p, c, SEG_ARC, intervals_for(xyz, abc_deg, steps));
     if (!sg)
         return -1;
     p->arcs[p->narc] = a;
@@ -322,7 +330,7 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     memcpy(sg->end, c->end, sizeof sg->end);
     sg->len = xyz;
     sg->xyz_len_mm = xyz;
-    place_knots(p, sg, fine_intervals(xyz, abc_deg, fabs(a.sweep_rad)));
+    place_knots(p, sg, fine_intervals(xyz, abc_deg, steps));
     return 0;
 }
 
@@ -546,7 +554,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         case CANON_TRAVERSE: rc = add_line(p, c, at); break;
         case CANON_PROBE: rc = add_probe(m, p, c, at); break;
         case CANON_ARC:
-            rc = add_arc(p, c, at, err, errlen);
+            rc = add_arc(p, c, at, abc && abc[i].blend, err, errlen);
             if (rc == 0 && abc && abc[i].blend)
                 blend_abc(p, &abc[i]);
             break;
