@@ -10,10 +10,6 @@
 #define ARC_NORMAL_SHARE 0.5   /* share of the linear acceleration spent on centripetal */
 #define FINE_SLACK 1e-9        /* relative: knots this much wider than fine_h are as close */
 
-/* fmin and fmax as the C library defines them (a NaN argument loses), inline: the caps take
- * a few dozen per knot, and the library's are calls. */
-static inline double min2(double a, double b) { return a < b ? a : b == b ? b : a; }
-static inline double max2(double a, double b) { return a > b ? a : b == b ? b : a; }
 
 /* Samples segment sg at s; returns the inverse kinematics status at s itself. The pose and
  * its derivatives are the path's own; the legs' come from the kinematics' exact ones where
@@ -31,7 +27,7 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     double h = FD_H, pm[KINS_POSE_DIM], pp[KINS_POSE_DIM];
     double Lm[KINS_MAX_JOINTS], Lp[KINS_MAX_JOINTS];
     if (sg->kind == SEG_ARC)
-        h = min2(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
+        h = motion_min2(h, 0.01 * m->plan.arcs[sg->arc].r0_mm);
     motion_seg_pose(&m->plan, sg, s - h, pm);
     motion_seg_pose(&m->plan, sg, s + h, pp);
     int st = motion_path_inverse(m, sg->tcp, sg->tool_len_mm, o->pose, o->L);
@@ -143,7 +139,7 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
     for (int i = 0; i < 3; i++)
         perp2 += (q[i] - shift * S->dp[i]) * (q[i] - shift * S->dp[i]);
     for (int i = 3; i < 6; i++)
-        ang = max2(ang, fabs(q[i] - shift * S->dp[i]));
+        ang = motion_max2(ang, fabs(q[i] - shift * S->dp[i]));
     *perp_mm = sqrt(perp2);
     *ang_deg = ang;
 }
@@ -174,7 +170,7 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
     if (perp > 1e-15)
         dmax = sqrt(8 * motion_round_tol_mm(m, sg) / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
-        dmax = min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
+        dmax = motion_min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
     return dmax / setpoint_period(c);
 }
 
@@ -210,12 +206,12 @@ double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
     }
     double d = HUGE_VAL;
     if (k_mm + perp > 1e-15) {
-        double d0 = sqrt(8 * tol / (k_mm + perp)), x = min2(1.0, k_mm * d0 / 2);
+        double d0 = sqrt(8 * tol / (k_mm + perp)), x = motion_min2(1.0, k_mm * d0 / 2);
         double f = 2 / (1 + sqrt(1 - x * x));
         d = sqrt(8 * tol / (k_mm * f + perp));
     }
     if (c->kin_tol_deg > 0 && kabc + ang > 1e-30)
-        d = min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
+        d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
     return d / setpoint_period(c);
 }
 
@@ -284,14 +280,14 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
         if (d1 > 1e-12) {
-            *vl = min2(*vl, c->joint[i].max_vel_mm_s / d1);
-            *am = min2(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
+            *vl = motion_min2(*vl, c->joint[i].max_vel_mm_s / d1);
+            *am = motion_min2(*am, LEG_ACC_SPLIT * c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
-            v2 = min2(v2, (1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2));
+            v2 = motion_min2(v2, (1 - LEG_ACC_SPLIT) * c->joint[i].max_acc_mm_s2 / (1.2 * d2));
     }
     if (v2 < HUGE_VAL)
-        *vl = min2(*vl, sqrt(v2));
+        *vl = motion_min2(*vl, sqrt(v2));
 }
 
 /* The path acceleration the legs allow at a knot once its speed is known to stay within vh
@@ -309,7 +305,8 @@ static double leg_acc_at_speed(const struct motion *m, const struct motion_sampl
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, aL = c->joint[i].max_acc_mm_s2;
         if (d1 > 1e-12)
-            am = min2(am, max2(LEG_ACC_SPLIT * aL, aL - 1.2 * fabs(S->d2L[i]) * vh * vh) / d1);
+            am = motion_min2(am, motion_max2(LEG_ACC_SPLIT * aL,
+                                             aL - 1.2 * fabs(S->d2L[i]) * vh * vh) / d1);
     }
     return am;
 }
@@ -324,13 +321,13 @@ static void machine_caps(const struct motion *m, const struct motion_seg *sg, do
     *vm = sg->rotary ? HUGE_VAL : c->max_lin_vel_mm_s;
     *am = sg->rotary ? HUGE_VAL : c->max_lin_acc_mm_s2;
     if (w > 1e-12) {
-        *vm = min2(*vm, c->max_ang_vel_deg_s / w);
-        *am = min2(*am, c->max_ang_acc_deg_s2 / w);
+        *vm = motion_min2(*vm, c->max_ang_vel_deg_s / w);
+        *am = motion_min2(*am, c->max_ang_acc_deg_s2 / w);
     }
     if (sg->kind == SEG_ARC) {
         const struct motion_arc *a = &m->plan.arcs[sg->arc];
-        double r = min2(a->r0_mm, a->r0_mm + a->dr_mm);
-        *vm = min2(*vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
+        double r = motion_min2(a->r0_mm, a->r0_mm + a->dr_mm);
+        *vm = motion_min2(*vm, sqrt(ARC_NORMAL_SHARE * c->max_lin_acc_mm_s2 * r));
         *am *= sqrt(1 - ARC_NORMAL_SHARE * ARC_NORMAL_SHARE);
     }
 }
@@ -364,7 +361,7 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
         if (st)
             return st;
         leg_caps(m, &T, h, &v, am);
-        *vl = min2(*vl, v);
+        *vl = motion_min2(*vl, v);
     }
     return MOTION_OK;
 }
@@ -386,7 +383,7 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     double vm, am, vl, kabc = 0;   /* |d2(A B C)/ds2|: the path's, 0 but on blend arcs */
     double w = 0;                  /* |d(A B C)/ds| */
     for (int i = 3; i < 6; i++)
-        kabc = max2(kabc, fabs(S->d2p[i])), w = max2(w, fabs(S->dp[i]));
+        kabc = motion_max2(kabc, fabs(S->d2p[i])), w = motion_max2(w, fabs(S->dp[i]));
     /* On a blend arc the rate changes before the next knot, hs on: by at most kabc hs, the
      * cubic's |d2(A B C)/ds2| being linear along it (so largest at an interval's end, whose
      * knot's cap the interval takes) */
@@ -394,9 +391,9 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     machine_caps(m, sg, w, &vm, &am);
     if (kabc > 1e-12) {        /* A B C bend along a blend arc: half the angular acceleration
                                 * for the bend (abc'' v^2), half for the path's (abc' a) */
-        vm = min2(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
+        vm = motion_min2(vm, sqrt(0.5 * m->cfg.max_ang_acc_deg_s2 / kabc));
         if (w > 1e-12)
-            am = min2(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
+            am = motion_min2(am, 0.5 * m->cfg.max_ang_acc_deg_s2 / w);
     }
     double am_machine = am;
     leg_caps(m, S, h, &vl, &am);
@@ -411,15 +408,15 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
         return MOTION_ERR_KINS;
     }
     double feed = sg->feed > 0 ? sg->feed : HUGE_VAL;
-    double soft = min2(feed, vm);
+    double soft = motion_min2(feed, vm);
     if (vl < soft)
         m->plan.info.limited_by_legs++;
-    if (vk < min2(soft, vl))
+    if (vk < motion_min2(soft, vl))
         m->plan.info.limited_by_kin_tol++;
-    *hard = min2(min2(vm, vl), vk);
-    *cap = min2(*hard, feed);
+    *hard = motion_min2(motion_min2(vm, vl), vk);
+    *cap = motion_min2(*hard, feed);
     if (h >= hs)               /* the legs' share for the path, now the speed is known */
-        am = min2(am_machine, leg_acc_at_speed(m, S, h, *hard));
+        am = motion_min2(am_machine, leg_acc_at_speed(m, S, h, *hard));
     *acc = am;
     return MOTION_OK;
 }
@@ -445,17 +442,17 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);
     for (int i = 3; i < 6; i++)
-        da = max2(da, fabs(B->dp[i] - A->dp[i]));
+        da = motion_max2(da, fabs(B->dp[i] - A->dp[i]));
     if (dx > 1e-12) {
-        v = min2(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
-        v = min2(v, 4 * a->blend_tol_mm / (Ts * dx));
+        v = motion_min2(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
+        v = motion_min2(v, 4 * a->blend_tol_mm / (Ts * dx));
     }
     if (da > 1e-12)
-        v = min2(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
+        v = motion_min2(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);
     for (int i = 0; i < m->nj; i++) {
         double dl = fabs(B->dL[i] - A->dL[i]);
         if (dl > 1e-12)
-            v = min2(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
+            v = motion_min2(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
     }
     return v;
 }
@@ -474,8 +471,8 @@ double motion_junction_share(const struct motion *m, const struct motion_sample 
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     f = v * sqrt(dx) / (c->max_lin_acc_mm_s2 * T);
     for (int i = 3; i < 6; i++)
-        f = max2(f, v * fabs(B->dp[i] - A->dp[i]) / (c->max_ang_acc_deg_s2 * T));
+        f = motion_max2(f, v * fabs(B->dp[i] - A->dp[i]) / (c->max_ang_acc_deg_s2 * T));
     for (int i = 0; i < m->nj; i++)
-        f = max2(f, v * fabs(B->dL[i] - A->dL[i]) / (0.5 * c->joint[i].max_acc_mm_s2 * T));
-    return min2(f, JUMP_SHARE);
+        f = motion_max2(f, v * fabs(B->dL[i] - A->dL[i]) / (0.5 * c->joint[i].max_acc_mm_s2 * T));
+    return motion_min2(f, JUMP_SHARE);
 }

@@ -115,12 +115,16 @@ void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg,
         dp[i] = il * (a->dr_mm * radial + r * th * along + a->dh_mm * a->n[i]);
         d2p[i] = il * il * (2 * a->dr_mm * th * along - r * th * th * radial);
     }
-    if (a->abc_cubic) {
-        abc_cubic(sg, a, u, 0, pose + 3);
-        abc_cubic(sg, a, u, 1, dp + 3);
-        abc_cubic(sg, a, u, 2, d2p + 3);
-        for (int k = 3; k < 6; k++)
-            dp[k] *= il, d2p[k] *= il * il;
+    if (a->abc_cubic) {        /* abc_cubic's three at once: the planner's every arc knot */
+        double u2 = u * u, u3 = u2 * u, scale[3] = {1, il, il * il};
+        double b[3][4] = {{2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, 3 * u2 - 2 * u3, u3 - u2},
+                          {6 * u2 - 6 * u, 3 * u2 - 4 * u + 1, 6 * u - 6 * u2, 3 * u2 - 2 * u},
+                          {12 * u - 6, 6 * u - 4, 6 - 12 * u, 6 * u - 2}};
+        double *out[3] = {pose, dp, d2p};
+        for (int d = 0; d < 3; d++)
+            for (int k = 0; k < 3; k++)
+                out[d][3 + k] = (b[d][0] * sg->start[3 + k] + b[d][1] * a->abc_m0[k] +
+                                 b[d][2] * sg->end[3 + k] + b[d][3] * a->abc_m1[k]) * scale[d];
     }
 }
 

@@ -8,6 +8,11 @@
 
 #include "motion/motion.h"
 
+/* fmin and fmax as the C library defines them (a NaN argument loses), inline: the planner
+ * takes dozens per knot, and the library's are calls. */
+static inline double motion_min2(double a, double b) { return a < b ? a : b == b ? b : a; }
+static inline double motion_max2(double a, double b) { return a > b ? a : b == b ? b : a; }
+
 /* What a segment does. */
 enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE,
                        SEG_WAIT /* stop, then wait until the spindle is at speed */ };
