@@ -107,8 +107,9 @@ void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg,
         return;
     const struct motion_arc *a = &p->arcs[sg->arc];
     double th = a->sweep_rad, ang = th * u, r = a->r0_mm + a->dr_mm * u;
-    double h = a->h0_mm + a->dh_mm * u, c, sn;
-    sincos(ang, &sn, &c);
+    double h = a->h0_mm + a->dh_mm * u, c = 1, sn = 0;
+    if (ang != 0)              /* (every arc's first knot: sincos(0) is exactly 0 and 1) */
+        sincos(ang, &sn, &c);
     for (int i = 0; i < 3; i++) {
         double radial = c * a->e1[i] + sn * a->e2[i], along = -sn * a->e1[i] + c * a->e2[i];
         pose[i] = a->center[i] + r * radial + h * a->n[i];
