@@ -46,7 +46,7 @@ double motion_seg_abc_curvature(const struct motion_plan *p, const struct motion
     double c[3], w = 0;
     abc_cubic(sg, &p->arcs[sg->arc], s / sg->len, 2, c);
     for (int k = 0; k < 3; k++)
-        w = fmax(w, fabs(c[k]));
+        w = motion_max2(w, fabs(c[k]));
     return w / (sg->len * sg->len);
 }
 
@@ -205,8 +205,8 @@ static struct motion_seg *add_seg(struct motion_plan *p, const struct canon_cmd 
  * SAMPLE_BLEND_RAD), at least 1; not capped. */
 static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_steps)
 {
-    double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_steps);
-    return fmax(1.0, ceil(n));
+    double n = motion_max2(motion_max2(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_steps);
+    return motion_max2(1.0, ceil(n));
 }
 
 /* Knot intervals for a move: the fine ones, capped at MAX_INTERVALS (the checks then sample
@@ -231,7 +231,7 @@ static double abc_max(const double *a, const double *b)
 {
     double d = 0;
     for (int i = 3; i < 6; i++)
-        d = fmax(d, fabs(b[i] - a[i]));
+        d = motion_max2(d, fabs(b[i] - a[i]));
     return d;
 }
 
