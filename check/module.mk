@@ -1,7 +1,7 @@
 # check/: verification before cutting (hexcnc check), the cutting simulation and the SVG plots.
 LIB_SRCS += check/check.c check/check_machine.c check/check_scan.c check/check_sim.c check/check_defer.c check/check_stream.c \
             check/check_report.c check/check_plot.c check/svg.c check/cut.c
-BENCHES += bench_check bench_check_dense
+BENCHES += bench_check bench_check_dense bench_plan_dense
 TESTS += test_check test_cut test_check_runner test_tcp test_check_stream test_check_defer
 # `make experiment`: the paper's experiment in the cutting simulation; plots into $(BUILD)/experiment.
 LIB_SRCS += check/experiment.c

@@ -277,7 +277,13 @@ int motion_blend_program_map(const struct motion_config *c, const struct canon_p
     scan(c, in, rec);
     size_t n = find_blends(in, rec);
     struct motion_blend_abc *ab = n ? calloc(in->count + n, sizeof *ab) : NULL;
-    int st = n && !ab ? MOTION_ERR_NOMEM : n ? emit(in, rec, out, ab, ends) : MOTION_OK;
+    if (n && ab) {             /* the blended program's size is known: one allocation, not a
+                                * dozen growing copies per streamed window */
+        out->cmds = malloc((in->count + n) * sizeof *out->cmds);
+        out->cap = out->cmds ? in->count + n : 0;
+    }
+    int st = n && (!ab || !out->cmds) ? MOTION_ERR_NOMEM
+             : n ? emit(in, rec, out, ab, ends) : MOTION_OK;
     free(rec);
     if (st || !abc)
         free(ab);

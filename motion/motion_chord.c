@@ -31,10 +31,11 @@ double motion_arc_curvature(const struct motion_plan *p, const struct motion_seg
                             double *kabc)
 {
     const struct motion_arc *a = &p->arcs[sg->arc];
-    double r = fmin(a->r0_mm, a->r0_mm + a->dr_mm);
+    double r = motion_min2(a->r0_mm, a->r0_mm + a->dr_mm);
     double rp = fabs(a->sweep_rad) > 1e-12 ? a->dr_mm / a->sweep_rad : 0;
     /* the cubic's A B C curvature is linear in u: largest at an end */
-    *kabc = fmax(motion_seg_abc_curvature(p, sg, 0), motion_seg_abc_curvature(p, sg, sg->len));
+    *kabc = motion_max2(motion_seg_abc_curvature(p, sg, 0),
+                        motion_seg_abc_curvature(p, sg, sg->len));
     return (1 + 2 * (rp / r) * (rp / r)) / r;
 }
 
@@ -43,10 +44,10 @@ double motion_arc_curvature(const struct motion_plan *p, const struct motion_seg
 static void mark(struct motion_seg *o, int end, double len_mm, double k, double kabc,
                  double tol)
 {
-    o->chord_mm[end] = fmax(o->chord_mm[end], len_mm);
-    o->chord_k[end] = fmax(o->chord_k[end], k);
-    o->chord_kabc[end] = fmax(o->chord_kabc[end], kabc);
-    o->chord_tol[end] = fmin(o->chord_tol[end], tol);
+    o->chord_mm[end] = motion_max2(o->chord_mm[end], len_mm);
+    o->chord_k[end] = motion_max2(o->chord_k[end], k);
+    o->chord_kabc[end] = motion_max2(o->chord_kabc[end], kabc);
+    o->chord_tol[end] = motion_min2(o->chord_tol[end], tol);
 }
 
 /* Marks the segments before (dir -1) or after (dir +1) arc segment j within d_mm of path.
@@ -62,7 +63,7 @@ static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double 
         struct motion_seg *o = &p->segs[i];
         if (o->kind > SEG_ARC || o->rotary)
             continue;
-        mark(o, dir < 0 ? 1 : 0, fmin(d_mm, o->len), k, kabc, tol);
+        mark(o, dir < 0 ? 1 : 0, motion_min2(d_mm, o->len), k, kabc, tol);
         d_mm -= o->len;
     }
 }
@@ -172,7 +173,7 @@ int motion_chord_zones(struct motion *m)
         double kabc, k = motion_arc_curvature(p, sg, &kabc), tol = motion_round_tol_mm(m, sg);
         double d = sqrt(8 * tol / k);
         if (kabc > 1e-30 && c->kin_tol_deg > 0)
-            d = fmin(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / kabc));
+            d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / kabc));
         d *= CHORD_MARGIN;
         mark(sg, 0, sg->len, k, kabc, tol);
         mark(sg, 1, sg->len, k, kabc, tol);

@@ -13,6 +13,11 @@
 #define SAMPLE_MM 1.0          /* largest knot spacing along the XYZ path, mm */
 #define SAMPLE_DEG 0.5         /* largest change of any of A B C between knots, deg */
 #define SAMPLE_RAD 0.05        /* largest arc angle between knots, rad */
+/* ... on a G64 blend arc: the knots' caps bound the legs between knots to first order in
+ * the spacing (L' may grow by L'' h), the rest grows with the angle's square; the angle rule
+ * decides only on arcs shorter than SAMPLE_MM per this angle (radius under 4 mm), where the
+ * centripetal cap keeps the speed low (docs/motion.md, *Segments and knots*) */
+#define SAMPLE_BLEND_RAD 0.25
 #define MAX_INTERVALS 4000     /* knots per segment are capped (very long moves) */
 
 
@@ -42,7 +47,7 @@ double motion_seg_abc_curvature(const struct motion_plan *p, const struct motion
     double c[3], w = 0;
     abc_cubic(sg, &p->arcs[sg->arc], s / sg->len, 2, c);
     for (int k = 0; k < 3; k++)
-        w = fmax(w, fabs(c[k]));
+        w = motion_max2(w, fabs(c[k]));
     return w / (sg->len * sg->len);
 }
 
@@ -103,20 +108,25 @@ void motion_seg_derivs(const struct motion_plan *p, const struct motion_seg *sg,
         return;
     const struct motion_arc *a = &p->arcs[sg->arc];
     double th = a->sweep_rad, ang = th * u, r = a->r0_mm + a->dr_mm * u;
-    double h = a->h0_mm + a->dh_mm * u, c, sn;
-    sincos1(ang, &sn, &c);
+    double h = a->h0_mm + a->dh_mm * u, c = 1, sn = 0;
+    if (ang != 0)              /* (every arc's first knot: sin and cos of 0 are exactly 0, 1) */
+        sincos1(ang, &sn, &c);
     for (int i = 0; i < 3; i++) {
         double radial = c * a->e1[i] + sn * a->e2[i], along = -sn * a->e1[i] + c * a->e2[i];
         pose[i] = a->center[i] + r * radial + h * a->n[i];
         dp[i] = il * (a->dr_mm * radial + r * th * along + a->dh_mm * a->n[i]);
         d2p[i] = il * il * (2 * a->dr_mm * th * along - r * th * th * radial);
     }
-    if (a->abc_cubic) {
-        abc_cubic(sg, a, u, 0, pose + 3);
-        abc_cubic(sg, a, u, 1, dp + 3);
-        abc_cubic(sg, a, u, 2, d2p + 3);
-        for (int k = 3; k < 6; k++)
-            dp[k] *= il, d2p[k] *= il * il;
+    if (a->abc_cubic) {        /* abc_cubic's three at once: the planner's every arc knot */
+        double u2 = u * u, u3 = u2 * u, scale[3] = {1, il, il * il};
+        double b[3][4] = {{2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, 3 * u2 - 2 * u3, u3 - u2},
+                          {6 * u2 - 6 * u, 3 * u2 - 4 * u + 1, 6 * u - 6 * u2, 3 * u2 - 2 * u},
+                          {12 * u - 6, 6 * u - 4, 6 - 12 * u, 6 * u - 2}};
+        double *out[3] = {pose, dp, d2p};
+        for (int d = 0; d < 3; d++)
+            for (int k = 0; k < 3; k++)
+                out[d][3 + k] = (b[d][0] * sg->start[3 + k] + b[d][1] * a->abc_m0[k] +
+                                 b[d][2] * sg->end[3 + k] + b[d][3] * a->abc_m1[k]) * scale[d];
     }
 }
 
@@ -192,18 +202,19 @@ static struct motion_seg *add_seg(struct motion_plan *p, const struct canon_cmd 
 }
 
 /* Intervals a move needs for the reachability and limit checks to hold between samples
- * (SAMPLE_MM, SAMPLE_DEG, SAMPLE_RAD), at least 1; not capped. */
-static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_rad)
+ * (SAMPLE_MM, SAMPLE_DEG, and arc_steps: the arc's angle over SAMPLE_RAD or
+ * SAMPLE_BLEND_RAD), at least 1; not capped. */
+static double fine_intervals(double xyz_mm, double abc_max_deg, double arc_steps)
 {
-    double n = fmax(fmax(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_rad / SAMPLE_RAD);
-    return fmax(1.0, ceil(n));
+    double n = motion_max2(motion_max2(xyz_mm / SAMPLE_MM, abc_max_deg / SAMPLE_DEG), arc_steps);
+    return motion_max2(1.0, ceil(n));
 }
 
 /* Knot intervals for a move: the fine ones, capped at MAX_INTERVALS (the checks then sample
  * between the knots, motion_caps.c). */
-static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_rad)
+static size_t intervals_for(double xyz_mm, double abc_max_deg, double arc_steps)
 {
-    double n = fine_intervals(xyz_mm, abc_max_deg, arc_rad);
+    double n = fine_intervals(xyz_mm, abc_max_deg, arc_steps);
     return n > MAX_INTERVALS ? MAX_INTERVALS : (size_t)n;
 }
 
@@ -221,7 +232,7 @@ static double abc_max(const double *a, const double *b)
 {
     double d = 0;
     for (int i = 3; i < 6; i++)
-        d = fmax(d, fabs(b[i] - a[i]));
+        d = motion_max2(d, fabs(b[i] - a[i]));
     return d;
 }
 
@@ -295,9 +306,10 @@ static int arc_geometry(const struct canon_cmd *c, const double *from, struct mo
     return 0;
 }
 
-/* An arc or helix from `from` to c->end. */
+/* An arc or helix from `from` to c->end; blend: a G64 blend arc (its knots' angle rule is
+ * SAMPLE_BLEND_RAD). */
 static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const double *from,
-                   char *err, size_t errlen)
+                   int blend, char *err, size_t errlen)
 {
     struct motion_arc a;
     memset(&a, 0, sizeof a);
@@ -314,7 +326,8 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     double planar = fabs(a.sweep_rad) * rm;
     double xyz = sqrt(planar * planar + a.dh_mm * a.dh_mm + a.dr_mm * a.dr_mm);
     double abc_deg = abc_max(from, c->end);
-    struct motion_seg *sg = add_seg(p, c, SEG_ARC, intervals_for(xyz, abc_deg, fabs(a.sweep_rad)));
+    double steps = fabs(a.sweep_rad) / (blend ? SAMPLE_BLEND_RAD : SAMPLE_RAD);
+    struct motion_seg *sg = add_seg(p, c, SEG_ARC, intervals_for(xyz, abc_deg, steps));
     if (!sg)
         return -1;
     p->arcs[p->narc] = a;
@@ -323,7 +336,7 @@ static int add_arc(struct motion_plan *p, const struct canon_cmd *c, const doubl
     memcpy(sg->end, c->end, sizeof sg->end);
     sg->len = xyz;
     sg->xyz_len_mm = xyz;
-    place_knots(p, sg, fine_intervals(xyz, abc_deg, fabs(a.sweep_rad)));
+    place_knots(p, sg, fine_intervals(xyz, abc_deg, steps));
     return 0;
 }
 
@@ -547,7 +560,7 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
         case CANON_TRAVERSE: rc = add_line(p, c, at); break;
         case CANON_PROBE: rc = add_probe(m, p, c, at); break;
         case CANON_ARC:
-            rc = add_arc(p, c, at, err, errlen);
+            rc = add_arc(p, c, at, abc && abc[i].blend, err, errlen);
             if (rc == 0 && abc && abc[i].blend)
                 blend_abc(p, &abc[i]);
             break;

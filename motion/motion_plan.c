@@ -29,7 +29,7 @@ static double knot_spacing(const struct motion_plan *p, const struct motion_seg 
 {
     double h = 0;
     for (size_t k = sg->k0; k + 1 < sg->k0 + sg->nk; k++)
-        h = fmax(h, p->ks[k + 1] - p->ks[k]);
+        h = motion_max2(h, p->ks[k + 1] - p->ks[k]);
     return h;
 }
 
@@ -42,8 +42,8 @@ static double chord_cap(struct motion *m, const struct motion_seg *sg, double s,
     for (int e = 0; e < 2; e++) {
         double from_end = e ? sg->len - s : s;
         if (sg->chord_mm[e] > 0 && from_end <= sg->chord_mm[e] + eps) {
-            k = fmax(k, sg->chord_k[e]), kabc = fmax(kabc, sg->chord_kabc[e]);
-            tol = fmin(tol, sg->chord_tol[e]);
+            k = motion_max2(k, sg->chord_k[e]), kabc = motion_max2(kabc, sg->chord_kabc[e]);
+            tol = motion_min2(tol, sg->chord_tol[e]);
         }
     }
     return k > 0 || kabc > 0 ? motion_chord_cap(m, sg, S, k, kabc, tol) : HUGE_VAL;
@@ -66,11 +66,13 @@ static int segment_caps(struct motion *m, const struct motion_seg *sg, double *g
         if (motion_cancelled(m, sg->file, sg->line, err, errlen))
             return MOTION_ERR_CANCELLED;
         if (sg->kind <= SEG_ARC) {
-            struct motion_sample S;
-            int st = motion_knot_caps(m, sg, p->ks[k], hs, &S, &hard, &cap, &acc, err, errlen);
+            /* the end samples straight into first and last, not copied there (dense code
+             * has two knots a move, both ends) */
+            struct motion_sample mid, *S = i == 0 ? first : i + 1 == sg->nk ? last : &mid;
+            int st = motion_knot_caps(m, sg, p->ks[k], hs, S, &hard, &cap, &acc, err, errlen);
             if (st)
                 return st;
-            zcap[k] = chord_cap(m, sg, p->ks[k], &S);
+            zcap[k] = chord_cap(m, sg, p->ks[k], S);
             if (zcap[k] < 0) {
                 snprintf(err, errlen, "%s:%d: the move passes through a singular pose of the "
                          "machine", sg->file ? sg->file : "program", sg->line);
@@ -79,15 +81,13 @@ static int segment_caps(struct motion *m, const struct motion_seg *sg, double *g
             if (zcap[k] < cap)
                 p->info.limited_by_kin_tol++;
             for (int l = 0; l < m->nj; l++)
-                gain[k * (size_t)m->nj + l] = fabs(S.dL[l]);
-            if (i == 0)
-                *first = S;
-            if (i + 1 == sg->nk)
-                *last = S;
+                gain[k * (size_t)m->nj + l] = fabs(S->dL[l]);
+            if (sg->nk == 1)
+                *last = *first;
         } else {
             memset(&gain[k * (size_t)m->nj], 0, (size_t)m->nj * sizeof *gain);
         }
-        p->kt[k] = hard, p->kv[k] = cap, p->iacc[k] = fmin(acc, 1e30);
+        p->kt[k] = hard, p->kv[k] = cap, p->iacc[k] = motion_min2(acc, 1e30);
     }
     return MOTION_OK;
 }
@@ -100,12 +100,12 @@ static void apply_chord_caps(struct motion_plan *p, const struct motion_seg *sg,
 {
     size_t lk = sg->k0 + sg->nk - 1;
     for (size_t k = sg->k0; k <= lk; k++) {
-        p->kv[k] = fmin(p->kv[k], zcap[k]);
-        p->kt[k] = fmin(p->kt[k], zcap[k]);
+        p->kv[k] = motion_min2(p->kv[k], zcap[k]);
+        p->kt[k] = motion_min2(p->kt[k], zcap[k]);
         if (k < lk && zcap[k] < HUGE_VAL && zcap[k + 1] < HUGE_VAL) {
-            double z = fmin(zcap[k], zcap[k + 1]);
-            p->ivp[k] = fmin(p->ivp[k], z);
-            p->irho[k] = fmin(p->irho[k], z);
+            double z = motion_min2(zcap[k], zcap[k + 1]);
+            p->ivp[k] = motion_min2(p->ivp[k], z);
+            p->irho[k] = motion_min2(p->irho[k], z);
         }
     }
 }
@@ -115,46 +115,49 @@ static void apply_chord_caps(struct motion_plan *p, const struct motion_seg *sg,
 static int all_caps(struct motion *m, double *gain, double *zcap, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
-    struct motion_sample prev_end, first, last;
+    struct motion_sample ends[3], *prev_end = &ends[0], *first = &ends[1], *last = &ends[2];
     for (size_t j = 0; j < p->nseg; j++) {
         struct motion_seg *sg = &p->segs[j];
-        int st = segment_caps(m, sg, gain, zcap, &first, &last, err, errlen);
+        int st = segment_caps(m, sg, gain, zcap, first, last, err, errlen);
         if (st)
             return st;
         size_t lk = sg->k0 + sg->nk - 1;
         for (size_t k = sg->k0; k < lk; k++) {
-            p->ivp[k] = fmin(p->kv[k], p->kv[k + 1]);
-            p->irho[k] = fmin(p->kt[k], p->kt[k + 1]);
+            p->ivp[k] = motion_min2(p->kv[k], p->kv[k + 1]);
+            p->irho[k] = motion_min2(p->kt[k], p->kt[k + 1]);
         }
         p->ivp[lk] = p->irho[lk] = 0;
         for (size_t k = sg->k0; k <= lk; k++) {
             double c = k > sg->k0 ? p->ivp[k - 1] : p->ivp[k];
             double h = k > sg->k0 ? p->irho[k - 1] : p->irho[k];
             if (k < lk)
-                c = fmin(c, p->ivp[k]), h = fmin(h, p->irho[k]);
+                c = motion_min2(c, p->ivp[k]), h = motion_min2(h, p->irho[k]);
             p->kv[k] = c, p->kt[k] = h;
         }
         apply_chord_caps(p, sg, zcap);
-        double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, &prev_end, &first) : 0;
+        double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, prev_end, first) : 0;
         size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
         /* a joint passed no faster than full acceleration reaches in STOP_EQUIV_PERIODS
          * servo periods (a sharp corner) is a stop in all but name, while the jump would
          * take a share of the moves' acceleration on both sides: stop there instead */
         if (vin > 0 && j > 0 && vin < STOP_EQUIV_PERIODS * m->cfg.servo_period_s *
-                                      fmin(p->iacc[sg->k0], p->iacc[pk]))
+                                      motion_min2(p->iacc[sg->k0], p->iacc[pk]))
             vin = 0;
-        p->kv[sg->k0] = fmin(p->kv[sg->k0], vin);
+        p->kv[sg->k0] = motion_min2(p->kv[sg->k0], vin);
         if (j > 0)
-            p->kv[pk] = fmin(p->kv[pk], vin);
+            p->kv[pk] = motion_min2(p->kv[pk], vin);
         if (vin > 0) {                 /* the jump's share of the acceleration, both sides,
                                         * at the fastest the joint may be passed (hard caps) */
-            double vmax = fmin(vin, fmin(p->kt[sg->k0], p->kt[pk]));
-            double share = motion_junction_share(m, &prev_end, &first, vmax);
+            double vmax = motion_min2(vin, motion_min2(p->kt[sg->k0], p->kt[pk]));
+            double share = motion_junction_share(m, prev_end, first, vmax);
             p->iacc[sg->k0] *= 1 - share;
             p->iacc[pk] *= 1 - share;
         }
         p->kv[lk] = j + 1 < p->nseg ? p->kv[lk] : 0;
-        prev_end = last;
+        if (sg->kind <= SEG_ARC) {     /* (a dwell's neighbours never pass it blended) */
+            struct motion_sample *t = prev_end;
+            prev_end = last, last = t;
+        }
         p->info.samples += sg->nk;
     }
     return MOTION_OK;
@@ -173,8 +176,8 @@ static void speed_passes(struct motion_plan *p)
     size_t n = p->nknot, j = 0;
     for (size_t i = 0; i + 1 < n; i++) {              /* interval acceleration: both ends */
         while (i >= p->segs[j].k0 + p->segs[j].nk) j++;
-        p->iacc[i] = i + 1 < p->segs[j].k0 + p->segs[j].nk ? fmin(p->iacc[i], p->iacc[i + 1])
-                                                            : 1e30;
+        p->iacc[i] = i + 1 < p->segs[j].k0 + p->segs[j].nk
+                         ? motion_min2(p->iacc[i], p->iacc[i + 1]) : 1e30;
     }
     /* a streamed window starts at k_enter at the speed the previous window left there;
      * the context knots before it are never followed and keep that speed */
@@ -187,20 +190,20 @@ static void speed_passes(struct motion_plan *p)
     for (size_t i = k0; i + 1 < n; i++) {
         while (i >= p->segs[j].k0 + p->segs[j].nk) j++;
         double ds = interval_ds(p, i, &p->segs[j]);
-        p->kv[i + 1] = fmin(p->kv[i + 1], sqrt(p->kv[i] * p->kv[i] + 2 * p->iacc[i] * ds));
+        p->kv[i + 1] = motion_min2(p->kv[i + 1], sqrt(p->kv[i] * p->kv[i] + 2 * p->iacc[i] * ds));
     }
     j = p->nseg - 1;
     for (size_t i = n - 1; i-- > k0;) {
         while (i < p->segs[j].k0) j--;
         double ds = interval_ds(p, i, &p->segs[j]);
-        p->kv[i] = fmin(p->kv[i], sqrt(p->kv[i + 1] * p->kv[i + 1] + 2 * p->iacc[i] * ds));
+        p->kv[i] = motion_min2(p->kv[i], sqrt(p->kv[i + 1] * p->kv[i + 1] + 2 * p->iacc[i] * ds));
     }
     /* The previous window planned v_enter able to stop within its own tail, which this
      * window holds and extends under the same caps: the backward pass cannot ask for less
      * but by rounding. The entry keeps its speed; the shortfall is recorded. */
     p->enter_deficit = 0;
-    if (p->v_enter > 0 && fmin(cap0, p->kv[k0]) < p->v_enter) {
-        p->enter_deficit = (p->v_enter - fmin(cap0, p->kv[k0])) / p->v_enter;
+    if (p->v_enter > 0 && motion_min2(cap0, p->kv[k0]) < p->v_enter) {
+        p->enter_deficit = (p->v_enter - motion_min2(cap0, p->kv[k0])) / p->v_enter;
         p->kv[k0] = p->v_enter;
     }
 }
@@ -257,7 +260,7 @@ static double stop_rest_s(const struct motion *m, size_t j)
     pose_direction(p, &p->segs[j], p->segs[j].len, u0);
     pose_direction(p, &p->segs[k], 0, u1);
     for (int i = 0; i < KINS_POSE_DIM; i++)
-        du = fmax(du, fabs(u1[i] - u0[i]));
+        du = motion_max2(du, fabs(u1[i] - u0[i]));
     return du > 1e-9 ? T - rested : 0;
 }
 
@@ -275,13 +278,13 @@ static void passes(struct motion *m)
         double ds = interval_ds(p, i, sg), v0 = p->kv[i], v1 = p->kv[i + 1], a = p->iacc[i];
         double rho = 2, dt = 0;
         if (ds > 0) {
-            double peak = sqrt(fmax(0, (2 * a * ds + v0 * v0 + v1 * v1) / 2));
-            double vp = fmax(fmax(v0, v1), fmin(p->ivp[i], peak)), ta, tc, td;
+            double peak = sqrt(motion_max2(0, (2 * a * ds + v0 * v0 + v1 * v1) / 2));
+            double vp = motion_max2(motion_max2(v0, v1), motion_min2(p->ivp[i], peak)), ta, tc, td;
             p->ivp[i] = vp;
             motion_phases(v0, v1, vp, a, ds, &ta, &tc, &td);
             dt = ta + tc + td;
             if (vp > 0)
-                rho = fmin(rho, p->irho[i] / vp);
+                rho = motion_min2(rho, p->irho[i] / vp);
             if (ta > 1e-12 || td > 1e-12)
                 rho = 1;                 /* a ramp already uses the whole acceleration */
         } else {
@@ -294,7 +297,7 @@ static void passes(struct motion *m)
                 dt += motion_sync_extra_s(m, p, j);  /* (the executor's clock skips it) */
             p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
         }
-        p->irho[i] = fmax(rho, 1.0);
+        p->irho[i] = motion_max2(rho, 1.0);
         t += dt;
         p->kt[i + 1] = t;
     }
@@ -311,7 +314,7 @@ static void passes(struct motion *m)
             motion_phases(p->kv[i], p->kv[i + 1], p->ivp[i], p->iacc[i], ds, &ta, &tc, &td);
             credit = p->iacc[i] * tc / (2 * p->ivp[i]);
         }
-        p->krho[i] = fmin(p->irho[i], p->krho[i + 1] + credit);
+        p->krho[i] = motion_min2(p->irho[i], p->krho[i + 1] + credit);
     }
 }
 
@@ -323,11 +326,11 @@ static void leg_rate_report(struct motion *m, const double *gain)
     for (size_t k = 0; k < p->nknot; k++) {
         double v = p->kv[k];
         if (k > 0)
-            v = fmax(v, p->ivp[k - 1]);
+            v = motion_max2(v, p->ivp[k - 1]);
         if (k + 1 < p->nknot)
-            v = fmax(v, p->ivp[k]);
+            v = motion_max2(v, p->ivp[k]);
         for (int l = 0; l < m->nj; l++)
-            p->info.max_leg_vel_mm_s[l] = fmax(p->info.max_leg_vel_mm_s[l],
+            p->info.max_leg_vel_mm_s[l] = motion_max2(p->info.max_leg_vel_mm_s[l],
                                                gain[k * (size_t)m->nj + l] * v);
     }
 }

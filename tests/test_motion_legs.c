@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "motion/motion_priv.h"
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
@@ -368,6 +369,105 @@ START_TEST(test_cancel_stops_planning)
 }
 END_TEST
 
+/* Blend arcs carry few knots (one interval for a turn under 0.25 rad on an arc under 1 mm,
+ * motion_path.c): the caps taken at the knots must hold at every point between them. A
+ * zigzag of five-axis moves with turns from 0.05 to 1.3 rad, rounded by G64 P of 0.005 to
+ * 0.05 mm, on legs of 10 mm/s and 1000 mm/s^2 (so that they, not the path's limits, bind on
+ * the arcs): on every interval of every blend arc, sampled at 200 points, the interval's
+ * speed (the lower hard cap of its two knots) keeps every leg within its speed and within
+ * the curvature's share of its acceleration (on blend arcs 95 %, without the 5 % kept in
+ * hand, motion_caps.c), and
+ * A B C within their speed. Without the spacing term of the leg caps (|L''| h) a leg runs
+ * 0.2 % over its speed here. */
+START_TEST(test_blend_arc_knots_conservative)
+{
+    struct tk_cfg *c = tm_hexapod_cfg();
+    ck_assert_ptr_nonnull(c);
+    for (int i = 0; i < 6; i++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        tk_set(c, sec, "MAX_VELOCITY", "10");
+        tk_set(c, sec, "MAX_ACCELERATION", "1000");
+    }
+    tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "500");
+    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "20000");
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    static const double tols[4] = {0.005, 0.01, 0.02, 0.05};
+    int arcs = 0, multi = 0, wide_single = 0, binding = 0, bending = 0;
+    for (int t = 0; t < 4; t++) {
+        struct canon_prog p;
+        canon_prog_init(&p);
+        double at[6] = {-20, -10, 640, -3, 2, -4}, dir = 0.3;
+        memcpy(p.start, at, sizeof at);
+        tm_add(&p, CANON_PATH_MODE, 1, NULL, 0, tols[t]);
+        p.cmds[p.count - 1].ivalue = 640;
+        for (int k = 0; k < 24; k++) {
+            static const double turns[8] = {0.05, 0.12, 0.2, 0.24, 0.4, 0.7, 1.0, 1.3};
+            double turn = turns[k % 8] * (k % 2 ? 1 : -1);
+            dir += turn;
+            at[0] += 4 * cos(dir), at[1] += 4 * sin(dir), at[2] += 0.3 * (k % 3 - 1);
+            at[3] += 0.08 * (k % 5 - 2), at[4] -= 0.06 * (k % 3 - 1);
+            at[5] += 0.05 * (k % 4 - 1.5);
+            tm_add(&p, CANON_FEED, 2 + k, at, 6000, 0);
+        }
+        char err[512] = "";
+        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "load: %s", err);
+        canon_prog_free(&p);
+        struct motion *m = mc.m;
+        struct motion_plan *pl = &m->plan;
+        for (size_t j = 0; j < pl->nseg; j++) {
+            const struct motion_seg *sg = &pl->segs[j];
+            if (sg->kind != SEG_ARC || !pl->arcs[sg->arc].abc_cubic)
+                continue;
+            arcs++;
+            multi += sg->nk > 2;
+            wide_single += sg->nk == 2 && fabs(pl->arcs[sg->arc].sweep_rad) > 0.2;
+            double hs = 0, hard[8] = {0}, cap, acc;
+            ck_assert_uint_le(sg->nk, 8);
+            for (size_t k = sg->k0; k + 1 < sg->k0 + sg->nk; k++)
+                hs = fmax(hs, pl->ks[k + 1] - pl->ks[k]);
+            for (size_t i = 0; i < sg->nk; i++) {
+                struct motion_sample S;
+                ck_assert_int_eq(motion_knot_caps(m, sg, pl->ks[sg->k0 + i], hs, &S, &hard[i],
+                                                  &cap, &acc, err, sizeof err), MOTION_OK);
+            }
+            for (size_t i = 0; i + 1 < sg->nk; i++) {
+                double v = fmin(hard[i], hard[i + 1]), s0 = pl->ks[sg->k0 + i];
+                double s1 = pl->ks[sg->k0 + i + 1], worst_v = 0, worst_a = 0;
+                for (int q = 0; q <= 200; q++) {
+                    double pose[6], dp[6], d2p[6], L[6], dL[6], d2L[6], w = 0;
+                    motion_seg_derivs(pl, sg, s0 + (s1 - s0) * q / 200.0, pose, dp, d2p);
+                    ck_assert_int_eq(m->kins->ops->inverse_path(m->kins, pose, dp, d2p, L, dL,
+                                                                d2L), KINS_OK);
+                    for (int l = 0; l < 6; l++) {
+                        worst_v = fmax(worst_v, fabs(dL[l]) * v / 10);
+                        worst_a = fmax(worst_a, fabs(d2L[l]) * v * v / (0.95 * 1000));
+                    }
+                    for (int a = 3; a < 6; a++)
+                        w = fmax(w, fabs(dp[a]));
+                    ck_assert_msg(w * v <= m->cfg.max_ang_vel_deg_s * (1 + 1e-12),
+                                  "A B C at %.4f deg/s", w * v);
+                }
+                ck_assert_msg(worst_v <= 1 + 1e-12 && worst_a <= 1 + 1e-12, "P%.2f line %d "
+                              "interval %zu of %zu: leg speed %.5f, curvature acceleration %.5f "
+                              "of the limit", tols[t], sg->line, i, sg->nk - 1, worst_v, worst_a);
+                binding += worst_v > 0.95;
+                bending += worst_a > 0.7;
+            }
+        }
+    }
+    /* the test means something: many arcs, some wide ones on one interval, some on several,
+     * and the legs' caps bind on many intervals */
+    ck_assert_int_ge(arcs, 80);
+    ck_assert_int_gt(multi, 10);
+    ck_assert_int_gt(wide_single, 5);
+    ck_assert_int_gt(binding, 10);
+    ck_assert_int_gt(bending, 20);
+    tm_close(&mc);
+}
+END_TEST
+
 static Suite *legs_suite(void)
 {
     Suite *s = suite_create("motion_legs");
@@ -381,6 +481,7 @@ static Suite *legs_suite(void)
     tcase_add_test(tc, test_long_helix_is_reachable);
     tcase_add_test(tc, test_long_helix_out_of_reach_between_knots);
     tcase_add_test(tc, test_cancel_stops_planning);
+    tcase_add_test(tc, test_blend_arc_knots_conservative);
     suite_add_tcase(s, tc);
     return s;
 }
