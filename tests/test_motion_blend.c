@@ -623,19 +623,9 @@ END_TEST
  * 200 mm/s^2, path 500 mm/s and 5000 mm/s^2, no kinematic-error bound. */
 static struct tk_cfg *leg_bound_cfg(void)
 {
-    struct tk_cfg *c = tm_hexapod_cfg();
+    struct tk_cfg *c = tm_leg_bound_hexapod_cfg();
     ck_assert_ptr_nonnull(c);
-    tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "500");
-    tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "5000");
-    tk_set(c, "TRAJ", "MAX_ANGULAR_VELOCITY", "200");
-    tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "2000");
     tk_set(c, "TRAJ", "KINEMATIC_TOLERANCE", "0");
-    for (int j = 0; j < 6; j++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        tk_set(c, sec, "MAX_VELOCITY", "40");
-        tk_set(c, sec, "MAX_ACCELERATION", "200");
-    }
     return c;
 }
 
