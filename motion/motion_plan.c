@@ -28,8 +28,10 @@
  * limit; b = 0 where the limit does not depend on the speed). Every pass takes the
  * acceleration at the fastest the interval is passed, not at the hard cap: a ramp out of a
  * stop on a leg-bound arc had the acceleration the legs leave at the cap, 0.72 of what they
- * allow at rest, and the arcs took 1.062x the time-optimal time (bench_topp_blend). The override cannot raise the speed on a ramp
- * (passes()), so the acceleration holds at every speed the executor reaches there. */
+ * allow at rest, and the arcs took 1.062x the time-optimal time (bench_topp_blend). The
+ * override cannot raise the speed on a ramp (passes(); acc_line_of's pad, and
+ * keep_hard_after_fast for the ramps it may enter above 1), so the acceleration holds at every
+ * speed the executor reaches there. */
 struct acc_line { double a0, b; };
 
 #define ACC_PAD_E 0.05      /* see acc_line_of */
