@@ -322,7 +322,8 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
 }
 
 /* The path acceleration the legs allow at a knot once its speed is known to stay within vh
- * (its hard cap, which no feed override exceeds): each leg's curvature term takes
+ * (its hard cap, which no feed override exceeds; 0 for the limit at rest, which the planner
+ * takes with it for ramps, motion_plan.c): each leg's curvature term takes
  * hand |L''| vh^2 of its acceleration (with the speed cap's margin) and the path term the
  * rest, at least the 1 - curv share leg_caps gives (the speed cap keeps the curvature
  * term within curv). Where the speed is capped well below the legs' curvature
@@ -398,10 +399,12 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
 }
 
 /* Speed caps of one knot: hard (machine, legs, kinematic error) into *hard, with the feed
- * into *cap, and the path acceleration limit into *acc. */
+ * into *cap, the path acceleration limit at every speed up to *hard into *acc, and (acc0 not
+ * NULL) the limit at rest into *acc0: below *hard the legs' curvature terms take less, and
+ * the limit at speed v is at least acc0 - (acc0 - acc) v^2 / hard^2 (see motion_priv.h). */
 int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
-                     struct motion_sample *S, double *hard, double *cap, double *acc, char *err,
-                     size_t errlen)
+                     struct motion_sample *S, double *hard, double *cap, double *acc,
+                     double *acc0, char *err, size_t errlen)
 {
     /* The error terms' spacing: the knots' own, unless they lie further apart than the
      * checks are made for (a move capped at MAX_INTERVALS). Evenly spread knots come out an
@@ -447,9 +450,14 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
         m->plan.info.limited_by_kin_tol++;
     *hard = motion_min2(motion_min2(vm, vl), vk);
     *cap = motion_min2(*hard, feed);
-    if (h >= hs)               /* the legs' share for the path, now the speed is known */
+    double am0 = am;
+    if (h >= hs) {             /* the legs' share for the path, now the speed is known */
+        am0 = motion_min2(am_machine, leg_acc_at_speed(m, S, h, 0, sh));
         am = motion_min2(am_machine, leg_acc_at_speed(m, S, h, *hard, sh));
+    }
     *acc = am;
+    if (acc0)
+        *acc0 = motion_max2(am0, am);
     return MOTION_OK;
 }
 /* The speed at which the joint from segment a into b may be passed (G64): the velocity

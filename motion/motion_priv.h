@@ -510,11 +510,14 @@ bool motion_cancelled(const struct motion *m, const char *file, int line, char *
                       size_t errlen);
 
 /* Sampling and caps (motion_caps.c). Speed caps of the knot at s of sg (knot spacing hs):
- * hard (machine, legs, kinematic error), with the feed (cap), path acceleration (acc); the
- * sample into S. A leg out of range is an error naming file, line, leg and amount. */
+ * hard (machine, legs, kinematic error), with the feed (cap), path acceleration at every
+ * speed up to hard (acc) and at rest (acc0, unless NULL); the sample into S. A leg out of
+ * range is an error naming file, line, leg and amount. The acceleration limit is concave in
+ * v^2 up to hard (each leg's is (aL - m |L''| v^2) / (|L'| + |L''| hs), the machine's
+ * constant), so the chord acc0 - (acc0 - acc) v^2 / hard^2 lies under it there. */
 int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, double hs,
                      struct motion_sample *S, double *hard, double *cap, double *acc,
-                     char *err, size_t errlen);
+                     double *acc0, char *err, size_t errlen);
 /* The speed cap of a knot within reach of a set-point chord touching an arc of path
  * curvature k_mm (1/mm) and A B C curvature kabc (deg/mm^2): the chord's cut of the path
  * plus the legs' own deviation stay within tol_mm (motion_round_tol_mm of the arcs), and

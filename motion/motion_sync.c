@@ -143,8 +143,8 @@ int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
     for (int i = 0; i <= SYNC_SAMPLES; i++) {
         struct motion_sample S;
         double hard, cap, acc, s = sg->len * i / SYNC_SAMPLES;
-        if (motion_knot_caps(m, sg, s, sg->len / SYNC_SAMPLES, &S, &hard, &cap, &acc, err,
-                             errlen))
+        if (motion_knot_caps(m, sg, s, sg->len / SYNC_SAMPLES, &S, &hard, &cap, &acc, NULL,
+                             err, errlen))
             return -2;
         if (hard < need || acc < acc_need) {
             snprintf(err, errlen, "%s:%d: %s at S%g with K%g needs %.2f mm/s (the spindle "
