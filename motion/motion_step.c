@@ -376,6 +376,7 @@ static void advance(struct motion *m, double dt)
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap;
+    double tau0 = m->tau_s;
     m->elapsed_s += dt;
     if (m->probe_halt == PROBE_PARKED) {
         probe_parked(m);
@@ -458,7 +459,9 @@ static void advance(struct motion *m, double dt)
                            e->file ? e->file : "program", e->line, e->line);
             m->state = MOTION_FAULT;
             m->fault_status = MOTION_ERR_STARVED;
-        } else if (motion_jerk_settled(m)) {
+        } else if (motion_jerk_settled(m) && (!m->jerk || tau0 >= p->total_time_s)) {
+            /* (with jerk limits, not in the period the executor came to the end: the average
+             * settled on where it stood before, and would stop short by what it moved) */
             m->state = MOTION_DONE;
         }
     }
