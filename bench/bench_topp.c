@@ -171,55 +171,6 @@ static double topp_line(struct kins *k, const struct motion_config *mc, const do
     return t;
 }
 
-/* Feed overrides asked for mid-program: every `every` periods the override switches
- * between 2 and `low`, so the rate rises to the plan's ceiling and falls again on every
- * part of the profile (ramps, cruises, knots, moves leaving rest). */
-struct override_walk { int every; double low; };
-
-static int override_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
-{
-    const struct override_walk *w = ctx;
-    (void)o;
-    if (step % w->every == 0)
-        motion_set_feed_override(m, step % (2 * w->every) ? 2 : w->low);
-    return 0;
-}
-
-/* The loaded program run at the servo rate, the legs differenced every period: the peak leg
- * speed and acceleration over all legs as ratios to their limits into pk[0], pk[1] (the
- * largest of the runs at override 1, at 2, and under the walks below); -1 unless every run
- * ends. */
-static int run_peaks(struct tm_machine *m, const struct canon_prog *p, double pk[2])
-{
-    static const struct override_walk walks[] = {
-        { 0, 1 }, { 0, 2 }, { 37, 0 }, { 250, 0.3 }, { 700, 0.6 }, { 1009, 0.95 },
-    };
-    char err[512];
-    pk[0] = pk[1] = 0;
-    for (size_t r = 0; r < sizeof walks / sizeof walks[0]; r++) {
-        struct tm_stats s;
-        if (motion_load(m->m, p, err, sizeof err)) {
-            fprintf(stderr, "bench_topp: %s\n", err);
-            return -1;
-        }
-        motion_set_feed_override(m->m, walks[r].every ? 1 : walks[r].low);
-        motion_start(m->m);
-        tm_run(m->m, m->mc.servo_period_s, 10000000, &s,
-               walks[r].every ? override_hook : NULL, (void *)&walks[r]);
-        if (s.last.state != MOTION_DONE) {
-            fprintf(stderr, "bench_topp: a run did not end (state %d after %.3f s)\n",
-                    s.last.state, s.t_s);
-            return -1;
-        }
-        for (int j = 0; j < m->kins->njoints; j++) {
-            pk[0] = fmax(pk[0], s.max_leg_v[j] / m->mc.joint[j].max_vel_mm_s);
-            pk[1] = fmax(pk[1], s.max_leg_a[j] / m->mc.joint[j].max_acc_mm_s2);
-        }
-    }
-    motion_set_feed_override(m->m, 1);
-    return 0;
-}
-
 /* A G61 program of straight moves: the planner's time and the reference's. */
 static int compare(const char *name, struct tk_cfg *c, const double (*pts)[6], int n,
                    double feed_mm_min, double *ratio, double pk[2])
@@ -240,7 +191,7 @@ static int compare(const char *name, struct tk_cfg *c, const double (*pts)[6], i
     for (int i = 1; i < n; i++)
         ref += topp_line(m.kins, &m.mc, pts[i - 1], pts[i], feed_mm_min / 60.0);
     *ratio = info.time_s / ref;
-    int st = run_peaks(&m, &p, pk);
+    int st = tm_run_peaks(&m, &p, pk);
     printf("  %-44s planner %8.4f s, TOPP %8.4f s: ratio %.3f; legs at the servo rate: "
            "speed %.4f, acceleration %.4f of their limits\n", name, info.time_s, ref, *ratio,
            pk[0], pk[1]);

@@ -315,48 +315,6 @@ out:
     return rc;
 }
 
-/* Feed overrides asked for mid-program: every `every` periods the override switches
- * between 2 and `low` (bench_topp's walks). */
-struct override_walk { int every; double low; };
-
-static int override_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
-{
-    const struct override_walk *w = ctx;
-    (void)o;
-    if (step % w->every == 0)
-        motion_set_feed_override(m, step % (2 * w->every) ? 2 : w->low);
-    return 0;
-}
-
-/* The loaded program p run at the servo rate at overrides 1 and 2 and under the walks, the
- * legs differenced every period: the peak leg speed and acceleration over all legs and runs
- * as ratios to their limits into pk[0], pk[1]; -1 unless every run ends. */
-static int run_peaks(struct tm_machine *tm, const struct canon_prog *p, double pk[2])
-{
-    static const struct override_walk walks[] = {
-        { 0, 1 }, { 0, 2 }, { 37, 0 }, { 250, 0.3 }, { 700, 0.6 }, { 1009, 0.95 },
-    };
-    char err[512];
-    pk[0] = pk[1] = 0;
-    for (size_t r = 0; r < sizeof walks / sizeof walks[0]; r++) {
-        struct tm_stats st;
-        if (motion_load(tm->m, p, err, sizeof err))
-            return -1;
-        motion_set_feed_override(tm->m, walks[r].every ? 1 : walks[r].low);
-        motion_start(tm->m);
-        tm_run(tm->m, tm->mc.servo_period_s, 10000000, &st,
-               walks[r].every ? override_hook : NULL, (void *)&walks[r]);
-        if (st.last.state != MOTION_DONE)
-            return -1;
-        for (int j = 0; j < tm->kins->njoints; j++) {
-            pk[0] = fmax(pk[0], st.max_leg_v[j] / tm->mc.joint[j].max_vel_mm_s);
-            pk[1] = fmax(pk[1], st.max_leg_a[j] / tm->mc.joint[j].max_acc_mm_s2);
-        }
-    }
-    motion_set_feed_override(tm->m, 1);
-    return 0;
-}
-
 /* The TMU hexapod where the legs bind (bench_topp's machine), no kinematic-error bound. */
 static struct tk_cfg *leg_bound_cfg(void)
 {
@@ -465,7 +423,7 @@ int main(void)
         ref = topp(&gr, &lim);
         arcs[k] = info.time_s / ref;
         double pk[2];
-        if (run_peaks(&tm, &p, pk))
+        if (tm_run_peaks(&tm, &p, pk))
             return 1;
         printf("  four arcs of 10 mm, A B turning, %s: planner %.4f s, TOPP %.4f s, ratio %.3f; "
                "legs at most %.3f, %.3f of their speed, acceleration limits (overrides 1, 2 "

@@ -139,18 +139,6 @@ START_TEST(test_leg_bound_time_near_optimal)
 }
 END_TEST
 
-/* Feed override switched every `every` periods between 2 and `low`. */
-struct ovr_walk { int every; double low; };
-
-static int ovr_walk_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
-{
-    const struct ovr_walk *w = ctx;
-    (void)o;
-    if (step % w->every == 0)
-        motion_set_feed_override(m, step % (2 * w->every) ? 2 : w->low);
-    return 0;
-}
-
 /* The feed override switched up and down while the legs bind: the rate rises to the plan's
  * ceiling and falls again on ramps, cruises, across knots and on moves leaving rest, and no
  * leg passes its limits in any servo period. The rate was set from the plan at each period's
@@ -159,7 +147,7 @@ static int ovr_walk_hook(struct motion *m, const struct motion_out *o, int step,
  * r^2 a_plan left its start value behind (up to 1.48x the legs' acceleration). */
 START_TEST(test_leg_limits_under_changing_override)
 {
-    static const struct ovr_walk walks[] = { { 700, 0.6 }, { 37, 0 }, { 250, 0.3 } };
+    static const struct tm_override_walk walks[] = { { 700, 0.6 }, { 37, 0 }, { 250, 0.3 } };
     for (int k = 0; k < 2; k++)
         for (size_t w = 0; w < sizeof walks / sizeof walks[0]; w++) {
             struct tm_machine mc;
@@ -173,7 +161,7 @@ START_TEST(test_leg_limits_under_changing_override)
                           err);
             ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
             struct tm_stats s;
-            tm_run(mc.m, DT, 1000000, &s, ovr_walk_hook, (void *)&walks[w]);
+            tm_run(mc.m, DT, 1000000, &s, tm_override_hook, (void *)&walks[w]);
             ck_assert_int_eq(s.last.state, MOTION_DONE);
             for (int i = 0; i < 6; i++) {
                 ck_assert_msg(s.max_leg_v[i] <= 40, "program %d, walk %zu: leg %d at %.4f mm/s",
@@ -218,7 +206,7 @@ static void four_arcs(struct canon_prog *p, double F)
  * up, so ramps meet cruises that override 2 raises), no leg passes its limits. */
 START_TEST(test_leg_bound_arcs_near_optimal)
 {
-    static const struct ovr_walk walks[] = { { 0, 1 }, { 0, 2 }, { 37, 0 }, { 700, 0.6 } };
+    static const struct tm_override_walk walks[] = { { 0, 1 }, { 0, 2 }, { 37, 0 }, { 700, 0.6 } };
     static const double feeds[2] = { 30000, 1200 };
     for (int f = 0; f < 2; f++) {
         struct tk_cfg *c = tm_leg_bound_hexapod_cfg();
@@ -243,7 +231,7 @@ START_TEST(test_leg_bound_arcs_near_optimal)
             motion_set_feed_override(mc.m, walks[w].every ? 1 : walks[w].low);
             ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
             struct tm_stats s;
-            tm_run(mc.m, DT, 1000000, &s, walks[w].every ? ovr_walk_hook : NULL,
+            tm_run(mc.m, DT, 1000000, &s, walks[w].every ? tm_override_hook : NULL,
                    (void *)&walks[w]);
             ck_assert_int_eq(s.last.state, MOTION_DONE);
             for (int i = 0; i < 6; i++) {

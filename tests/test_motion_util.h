@@ -325,6 +325,56 @@ static inline void tm_g61_points(struct canon_prog *p, const double (*pts)[6], i
         tm_add(p, CANON_FEED, i + 1, pts[i], feed_mm_min, 0);
 }
 
+/* Feed overrides asked for mid-program: every `every` periods the override switches between
+ * 2 and `low` (every 0: held at `low` from the start), so the rate rises to the plan's
+ * ceiling and falls again on every part of the profile (ramps, cruises, knots, moves leaving
+ * rest). A tm_hook. */
+struct tm_override_walk { int every; double low; };
+
+static inline int tm_override_hook(struct motion *m, const struct motion_out *o, int step,
+                                   void *ctx)
+{
+    const struct tm_override_walk *w = ctx;
+    (void)o;
+    if (w->every && step % w->every == 0)
+        motion_set_feed_override(m, step % (2 * w->every) ? 2 : w->low);
+    return 0;
+}
+
+/* Program p run on m at the servo rate at overrides 1 and 2 and under override walks, the
+ * legs differenced every period: the peak leg speed and acceleration over all legs and runs
+ * as ratios to their limits into pk[0], pk[1]; -1 (a message on stderr) unless every run
+ * ends. */
+static inline int tm_run_peaks(struct tm_machine *m, const struct canon_prog *p, double pk[2])
+{
+    static const struct tm_override_walk walks[] = {
+        { 0, 1 }, { 0, 2 }, { 37, 0 }, { 250, 0.3 }, { 700, 0.6 }, { 1009, 0.95 },
+    };
+    char err[512];
+    pk[0] = pk[1] = 0;
+    for (size_t r = 0; r < sizeof walks / sizeof walks[0]; r++) {
+        struct tm_stats s;
+        if (motion_load(m->m, p, err, sizeof err)) {
+            fprintf(stderr, "%s\n", err);
+            return -1;
+        }
+        motion_set_feed_override(m->m, walks[r].every ? 1 : walks[r].low);
+        motion_start(m->m);
+        tm_run(m->m, m->mc.servo_period_s, 10000000, &s, tm_override_hook, (void *)&walks[r]);
+        if (s.last.state != MOTION_DONE) {
+            fprintf(stderr, "a run did not end (state %d after %.3f s)\n", s.last.state,
+                    s.t_s);
+            return -1;
+        }
+        for (int j = 0; j < m->kins->njoints; j++) {
+            pk[0] = fmax(pk[0], s.max_leg_v[j] / m->mc.joint[j].max_vel_mm_s);
+            pk[1] = fmax(pk[1], s.max_leg_a[j] / m->mc.joint[j].max_acc_mm_s2);
+        }
+    }
+    motion_set_feed_override(m->m, 1);
+    return 0;
+}
+
 /* Distance from p to the segment a-b (X Y Z). */
 static inline double tm_dist_seg(const double *p, const double *a, const double *b)
 {
