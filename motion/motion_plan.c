@@ -392,9 +392,9 @@ static void passes(struct motion *m, const struct acc_line *ln)
                 dt = sg->dwell_s;
             else if (sg->kind <= SEG_ARC && v0 == 0 && i + 1 == sg->k0 + sg->nk)
                 dt = stop_rest_s(m, j);  /* a stop between moves: held (motion_step.c) */
+            p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
             if (sg->sync && i + 1 == sg->k0 + sg->nk)
                 dt += motion_sync_extra_s(m, p, j);  /* (the executor's clock skips it) */
-            p->info.stops_held += dt > 0 && sg->kind <= SEG_ARC;
         }
         p->irho[i] = motion_max2(rho, 1.0);
         t += dt;

@@ -160,6 +160,17 @@ int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
     return sg->sync == CANON_SYNC_THREAD ? 0 : sync_check_run_on(m, sg, err, errlen);
 }
 
+/* The path acceleration a synchronised move sg of p keeps to: the least its intervals were
+ * planned with (the machine's linear limit on a move without intervals). */
+static double sync_acc(const struct motion_config *c, const struct motion_plan *p,
+                       const struct motion_seg *sg)
+{
+    double a = HUGE_VAL;
+    for (size_t k = sg->k0; k + 1 < sg->k0 + sg->nk; k++)
+        a = fmin(a, p->iacc[k]);
+    return a < HUGE_VAL ? a : c->max_lin_acc_mm_s2;
+}
+
 /* Time to travel d mm at pitch k while the spindle speeds up from rest at acc (rev/s^2) to
  * w (rev/s), then turns at w. */
 static double climb_s(double d, double k, double acc, double w)
@@ -184,12 +195,8 @@ double motion_sync_extra_s(const struct motion *m, const struct motion_plan *p, 
     } else if (sg->sync == CANON_SYNC_TAP_OUT) {
         /* it stops above the start; the tool comes back unsynchronised, from rest to rest at
          * the share of the move's acceleration the follower brakes with */
-        double a = HUGE_VAL;
-        for (size_t i = sg->k0; i + 1 < sg->k0 + sg->nk; i++)
-            a = fmin(a, p->iacc[i]);
-        if (!(a < HUGE_VAL))
-            a = m->cfg.max_lin_acc_mm_s2;
-        t += out / acc + 2 * sqrt(k * out * out / (2 * acc) / (SYNC_BRAKE_SHARE * a));
+        double a = SYNC_BRAKE_SHARE * sync_acc(&m->cfg, p, sg);
+        t += out / acc + 2 * sqrt(k * out * out / (2 * acc) / a);
     }
     return t;
 }
@@ -247,13 +254,8 @@ static bool follow(struct motion_sync *y, double d_t, double v_t, double dt,
 static void sync_limits(struct motion *m, const struct motion_seg *sg)
 {
     struct motion_sync *y = &m->sync;
-    const struct motion_plan *p = m->run;
     y->vmax_mm_s = sync_speed_need(&m->cfg, sg);
-    y->acc_mm_s2 = HUGE_VAL;
-    for (size_t k = sg->k0; k + 1 < sg->k0 + sg->nk; k++)
-        y->acc_mm_s2 = fmin(y->acc_mm_s2, p->iacc[k]);
-    if (!(y->acc_mm_s2 < HUGE_VAL))
-        y->acc_mm_s2 = m->cfg.max_lin_acc_mm_s2;
+    y->acc_mm_s2 = sync_acc(&m->cfg, m->run, sg);
 }
 
 /* The path came onto synchronised segment sg: a tap's way out goes on in the way in's
