@@ -480,12 +480,7 @@ START_TEST(test_hexapod_zigzag)
     for (int g = 0; g < 2; g++) {
         struct tk_cfg *c = tm_hexapod_cfg();
         ck_assert_ptr_nonnull(c);
-        for (int i = 0; i < 6; i++) {
-            char sec[24];
-            snprintf(sec, sizeof sec, "JOINT_%d", i);
-            tk_set(c, sec, "MAX_VELOCITY", "20");
-            tk_set(c, sec, "MAX_ACCELERATION", "200");
-        }
+        tm_set_legs(c, "20", "200");
         struct tm_machine mc;
         ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
         struct canon_prog p;

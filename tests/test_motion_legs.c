@@ -34,12 +34,7 @@ START_TEST(test_leg_limits_hold)
 {
     struct tk_cfg *c = tm_hexapod_cfg();
     ck_assert_ptr_nonnull(c);
-    for (int i = 0; i < 6; i++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", i);
-        tk_set(c, sec, "MAX_VELOCITY", "20");
-        tk_set(c, sec, "MAX_ACCELERATION", "200");
-    }
+    tm_set_legs(c, "20", "200");
     struct tm_machine mc;
     ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
     /* what the programmed feed would ask of the legs at the middle of the move */
@@ -443,12 +438,7 @@ START_TEST(test_blend_arc_knots_conservative)
 {
     struct tk_cfg *c = tm_hexapod_cfg();
     ck_assert_ptr_nonnull(c);
-    for (int i = 0; i < 6; i++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", i);
-        tk_set(c, sec, "MAX_VELOCITY", "10");
-        tk_set(c, sec, "MAX_ACCELERATION", "1000");
-    }
+    tm_set_legs(c, "10", "1000");
     tk_set(c, "TRAJ", "MAX_LINEAR_VELOCITY", "500");
     tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "20000");
     struct tm_machine mc;

@@ -51,6 +51,17 @@ static inline struct tk_cfg *tm_hexapod_cfg(void)
     return tk_ini("configs/sim/tmu-hexapod.ini");
 }
 
+/* The six legs' MAX_VELOCITY and MAX_ACCELERATION, the same on every leg. */
+static inline void tm_set_legs(struct tk_cfg *c, const char *vel, const char *acc)
+{
+    for (int i = 0; i < 6; i++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        tk_set(c, sec, "MAX_VELOCITY", vel);
+        tk_set(c, sec, "MAX_ACCELERATION", acc);
+    }
+}
+
 /* Builds kinematics and motion from a table; returns 0 or prints why not. */
 static inline int tm_open(struct tm_machine *mc, struct tk_cfg *c, const struct kins_ops *ops)
 {
@@ -268,12 +279,7 @@ static inline struct tk_cfg *tm_fast_hexapod_cfg(double period_s, double tol_mm)
     tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "20000");
     tk_setf(c, "TRAJ", "KINEMATIC_TOLERANCE", tol_mm);
     tk_setf(c, "EMCMOT", "SERVO_PERIOD", period_s * 1e9);
-    for (int i = 0; i < 6; i++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", i);
-        tk_set(c, sec, "MAX_VELOCITY", "1000");
-        tk_set(c, sec, "MAX_ACCELERATION", "20000");
-    }
+    tm_set_legs(c, "1000", "20000");
     return c;
 }
 
@@ -288,12 +294,7 @@ static inline struct tk_cfg *tm_leg_bound_hexapod_cfg(void)
     tk_set(c, "TRAJ", "MAX_LINEAR_ACCELERATION", "5000");
     tk_set(c, "TRAJ", "MAX_ANGULAR_VELOCITY", "200");
     tk_set(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", "2000");
-    for (int j = 0; j < 6; j++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        tk_set(c, sec, "MAX_VELOCITY", "40");
-        tk_set(c, sec, "MAX_ACCELERATION", "200");
-    }
+    tm_set_legs(c, "40", "200");
     return c;
 }
 
