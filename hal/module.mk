@@ -13,11 +13,11 @@ SCRIPT_TESTS += tests/hal/halcmd.sh
 # Plugins for test_hal_plugin (never installed): their hal_* symbols come from the test
 # program, which exports them (-rdynamic).
 HAL_TEST_PLUGINS := $(BUILD)/tests/plugins/hal/demo-plugin.so $(BUILD)/tests/plugins/hal/nosym.so
-$(BUILD)/tests/plugins/hal/demo-plugin.so: tests/hal/plugin_demo.c hal/hal.h
+$(BUILD)/tests/plugins/hal/demo-plugin.so: tests/hal/plugin_demo.c hal/hal.h $(FLAGS_STAMP)
 	@mkdir -p $(@D)
 	$(call say,SO,$@)
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@
-$(BUILD)/tests/plugins/hal/nosym.so: tests/hal/plugin_nosym.c
+$(BUILD)/tests/plugins/hal/nosym.so: tests/hal/plugin_nosym.c $(FLAGS_STAMP)
 	@mkdir -p $(@D)
 	$(call say,SO,$@)
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -shared $< -o $@

@@ -230,7 +230,7 @@ static int read_function(struct interp *in, int *pos, double *out)
  * value. */
 static int read_parameter(struct interp *in, int *pos, double *out)
 {
-    int col = in->normcol[*pos], idx;
+    int col = in->normcol[*pos], idx = 0;
     (*pos)++;
     if (in->norm[*pos] == '<') {
         const char *name;

@@ -14,7 +14,7 @@ $(GENDIR)/lcmtypes/%.c $(GENDIR)/lcmtypes/%.h: lcmtypes/%.lcm
 	$(Q)lcm-gen -c --c-cpath $(@D) --c-hpath $(@D) --cinclude lcmtypes $<
 
 # The generated C, compiled like the rest and archived into the library ($^ of its rule).
-$(BUILD)/lcmtypes/%.o: $(GENDIR)/lcmtypes/%.c $(GENDIR)/lcmtypes/%.h | $(GEN_HDRS)
+$(BUILD)/lcmtypes/%.o: $(GENDIR)/lcmtypes/%.c $(GENDIR)/lcmtypes/%.h $(FLAGS_STAMP) | $(GEN_HDRS)
 	@mkdir -p $(@D)
 	$(call say,CC,$<)
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@

@@ -37,7 +37,7 @@ WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wpoi
 ifneq ($(CI),)
 WARN    += -Werror
 endif
-OPT     ?= -O2
+OPT     ?= -O3 -fno-math-errno
 SANFLAGS :=
 ifeq ($(SAN),1)
 SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -75,6 +75,16 @@ UI_FILES :=
 GEN_HDRS :=
 HAL_COMPS :=
 
+# The compiler and its flags, kept in a stamp that changes only when they do: every object
+# depends on it, so `make OPT=-O1` (or a new default here) rebuilds what it compiles instead
+# of linking objects compiled with different flags.
+FLAGS_STAMP := $(BUILD)/flags.stamp
+FLAGS_NOW   := $(CC) $(CXX) $(CPPFLAGS) $(CFLAGS) $(CXXFLAGS) $(LDFLAGS)
+.PHONY: FORCE
+$(FLAGS_STAMP): FORCE
+	@mkdir -p $(@D)
+	@echo '$(FLAGS_NOW)' | cmp -s - $@ || echo '$(FLAGS_NOW)' > $@
+
 include $(sort $(wildcard */module.mk */*/module.mk))
 # The built-in HAL component types, generated from HAL_COMPS.
 $(GENDIR)/hal_comps.h: $(wildcard */module.mk */*/module.mk) mk/build.mk
@@ -94,11 +104,11 @@ BENCH_BINS := $(BENCHES:%=$(BUILD)/bench/%)
 .DEFAULT_GOAL := all
 all: $(HEXCNC) $(PLUGINS) $(EXTRA_BINS) $(UI_FILES)
 
-$(BUILD)/%.o: %.c | $(GEN_HDRS)
+$(BUILD)/%.o: %.c $(FLAGS_STAMP) | $(GEN_HDRS)
 	@mkdir -p $(@D)
 	$(call say,CC,$<)
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
-$(BUILD)/%.o: %.cpp | $(GEN_HDRS)
+$(BUILD)/%.o: %.cpp $(FLAGS_STAMP) | $(GEN_HDRS)
 	@mkdir -p $(@D)
 	$(call say,CXX,$<)
 	$(Q)$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@

@@ -370,7 +370,7 @@ static int m_tooltable_set(struct session *s, struct session_client *c, json_t *
                            json_t **r, char *err, size_t len)
 {
     struct session_tool_edit e = { 0 };
-    long tool, pocket;
+    long tool = 0, pocket = 0;
     bool hp, hc = json_object_get(p, "comment") != NULL;
     int rc;
     if ((rc = get_int(p, "tool", true, 1, TOOLTABLE_WEAR_BASE - 1, &tool, NULL, err, len)) ||

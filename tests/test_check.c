@@ -169,8 +169,9 @@ static int run_binary(const char *args, const char *out_path)
     char cmd[2048], root[1024];
     if (!bin)
         bin = "bin/hexcnc";
-    snprintf(cmd, sizeof cmd, "cd %s && %s check %s > %s 2>&1", tc_path("", root, sizeof root),
-             bin, args, out_path);
+    int n = snprintf(cmd, sizeof cmd, "cd %s && %s check %s > %s 2>&1",
+                     tc_path("", root, sizeof root), bin, args, out_path);
+    ck_assert_msg(n > 0 && (size_t)n < sizeof cmd, "the command line is too long");
     int st = system(cmd);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }

@@ -94,17 +94,27 @@ static int ctl_send(struct ctl_conn *c, const char *method, json_t *params, int 
     return w == (ssize_t)(n + 1) ? 0 : -1;
 }
 
-/* One call: the response with this id (notifications skipped). */
-static json_t *ctl_call(struct ctl_conn *c, const char *method, json_t *params, int id)
+/* How long to wait for a method's answer, ms (-1: while the session is there).
+ * program.check (and a run or step that checks first) answers when the check of the whole
+ * file ends, a minute for ten million lines. */
+static int ctl_timeout_ms(const char *method)
+{
+    static const char *const checking[] = { "program.check", "program.run", "program.step" };
+    for (size_t i = 0; i < sizeof checking / sizeof *checking; i++)
+        if (!strcmp(method, checking[i]))
+            return -1;
+    return 30000;
+}
+
+/* One call: the response with this id (notifications skipped), waiting timeout_ms for it
+ * (ctl_timeout_ms). */
+static json_t *ctl_call(struct ctl_conn *c, const char *method, json_t *params, int id,
+                        int timeout_ms)
 {
     if (ctl_send(c, method, params, id) != 0)
         return NULL;
-    /* program.check (and a run or step that checks first) answers when the check of the
-     * whole file ends, a minute for ten million lines: wait for it while the session is */
-    bool long_ok = !strcmp(method, "program.check") || !strcmp(method, "program.run") ||
-                   !strcmp(method, "program.step");
     for (;;) {
-        json_t *j = ctl_read(c, long_ok ? -1 : 30000);
+        json_t *j = ctl_read(c, timeout_ms);
         if (!j)
             return NULL;
         json_t *jid = json_object_get(j, "id");
@@ -169,12 +179,12 @@ static int ctl_wait(struct ctl_conn *c, json_t *params)
         timeout = json_number_value(t);
     double end = ctl_now() + timeout;
     json_t *sub = json_pack("{s:f}", "rate_hz", 50.0);
-    json_t *r = ctl_call(c, "messages.subscribe", sub, 1);
+    json_t *r = ctl_call(c, "messages.subscribe", sub, 1, 30000);
     json_decref(r);
     json_decref(sub);
     int id = 2;
     while (ctl_now() < end) {
-        json_t *st = ctl_call(c, "status.get", NULL, id++);
+        json_t *st = ctl_call(c, "status.get", NULL, id++, 30000);
         json_t *res = json_object_get(st, "result");
         if (!res) {
             int rc = st ? ctl_print(st) : 1;
@@ -216,7 +226,7 @@ static int ctl_watch(struct ctl_conn *c, json_t *params)
 {
     json_t *rate = json_object_get(params, "rate_hz");
     json_t *p = json_pack("{s:O}", "rate_hz", rate ? rate : json_real(5));
-    json_t *r = ctl_call(c, "status.subscribe", p, 1);
+    json_t *r = ctl_call(c, "status.subscribe", p, 1, 30000);
     json_decref(p);
     int rc = ctl_print(r) ? 1 : 0;
     json_decref(r);
@@ -283,7 +293,7 @@ int ctl_halcmd_attach(int argc, char **argv)
         json_decref(params);
         return 1;
     }
-    json_t *resp = ctl_call(&c, method, params, 1);
+    json_t *resp = ctl_call(&c, method, params, 1, 30000);    /* hal.*: at once */
     json_decref(params);
     close(c.fd);
     json_t *res = json_object_get(resp, "result"), *e = json_object_get(resp, "error");
@@ -336,7 +346,7 @@ int cmd_ctl(int argc, char **argv)
     else if (!strcmp(method, "watch"))
         rc = ctl_watch(&c, params);
     else {
-        json_t *resp = ctl_call(&c, method, params, 1);
+        json_t *resp = ctl_call(&c, method, params, 1, ctl_timeout_ms(method));
         rc = ctl_print(resp);
         json_decref(resp);
     }

@@ -256,7 +256,7 @@ static int streamer_load(struct hal *h, int argc, char **argv)
     const char *cfg = hal_arg(argc, argv, "cfg"), *file = hal_arg(argc, argv, "file");
     const char *data = hal_arg(argc, argv, "data"), *loop = hal_arg(argc, argv, "loop");
     char name[HAL_INST_NAME_MAX];
-    int ncols, st = hal_args_check(h, "streamer", argc, argv, "cfg,file,data,names,loop");
+    int ncols = 0, st = hal_args_check(h, "streamer", argc, argv, "cfg,file,data,names,loop");
     if (st == HAL_OK)
         st = stream_cfg(h, "streamer", cfg, &ncols);
     if (st != HAL_OK)
@@ -389,7 +389,7 @@ static int sampler_load(struct hal *h, int argc, char **argv)
 {
     const char *cfg = hal_arg(argc, argv, "cfg"), *file = hal_arg(argc, argv, "file");
     char path[PATH_MAX];
-    int ncols, st = hal_args_check(h, "sampler", argc, argv, "cfg,file,names");
+    int ncols = 0, st = hal_args_check(h, "sampler", argc, argv, "cfg,file,names");
     if (st == HAL_OK)
         st = stream_cfg(h, "sampler", cfg, &ncols);
     if (st != HAL_OK)
