@@ -40,6 +40,8 @@ enum motion_status {
     MOTION_ERR_CANCELLED,    /* the cancel flag was set (Ctrl-C) while planning */
     MOTION_ERR_STARVED,      /* a streamed program's next part was not planned in time: the
                               * machine stopped on the path at the end of what was planned */
+    MOTION_ERR_INDEX,        /* a synchronised move asked for the spindle encoder's index and
+                              * the spindle turned MOTION_INDEX_WAIT_REVS without one */
     MOTION_STATUS_COUNT
 };
 const char *motion_strerror(int status);
@@ -189,7 +191,10 @@ void motion_set_spindle_revs(struct motion *m, double revs, bool wired);
  * connected, and its value this period. Connected, a synchronised move that needs the
  * spindle's angle sets it (motion_out.spindle_index) and starts once the encoder has cleared
  * it, having reset its count to 0 at the index; not connected, the move starts at the first
- * whole revolution the count passes. */
+ * whole revolution the count passes. An index comes once a revolution: when the spindle has
+ * turned MOTION_INDEX_WAIT_REVS with the pin set and still set, the machine faults
+ * (MOTION_ERR_INDEX) at the move's start, the pin withdrawn. */
+#define MOTION_INDEX_WAIT_REVS 2.0
 void motion_set_spindle_index(struct motion *m, bool enabled, bool wired);
 /* `hexcnc check`: no spindle, an ideal one instead: it turns at the commanded speed, reached
  * at [SPINDLE_SYNC] ACCELERATION, and synchronised moves follow it. */

@@ -22,6 +22,7 @@ static const struct { int code; const char *text; } motion_errors[] = {
     {MOTION_ERR_ESTOP, "emergency stop"},
     {MOTION_ERR_CANCELLED, "planning stopped by the operator"},
     {MOTION_ERR_STARVED, "the program's next part was not planned in time"},
+    {MOTION_ERR_INDEX, "the spindle encoder's index did not come"},
 };
 
 /* Text of a motion status. */

@@ -190,6 +190,7 @@ struct motion_sync {
     double rpm0;
     double revs_prev;        /* last period's revolutions (the spindle's speed) */
     int index_asked;         /* spindle.0.index-enable set for this move's start */
+    double index_revs0;      /* the revolutions when it was set */
 };
 
 /* An interval's ramp and cruise times for its speeds, acceleration and length (what

@@ -298,10 +298,30 @@ static bool sync_index(struct motion_sync *y, double revs)
     return true;
 }
 
+/* The index has not come while the spindle turned MOTION_INDEX_WAIT_REVS: the request is
+ * withdrawn and the machine, at rest at the move's start, faults and says why. */
+static void index_missing(struct motion *m, const struct motion_seg *sg, double turned)
+{
+    m->index_out = -1;
+    m->sync.index_asked = 0;
+    motion_set_msg(m, "%s:%d: the spindle turned %.1f revolutions with spindle.0.index-enable "
+                   "set and the encoder never cleared it: no index pulse came (check the "
+                   "encoder's index signal and its wiring, or unconnect the pin to take the "
+                   "count's whole revolutions); the %s did not start, machine stopped",
+                   sg->file ? sg->file : "program", sg->line, turned,
+                   sg->sync == CANON_SYNC_THREAD ? "G33 move" : "tap (G33.1)");
+    m->rate = 0;
+    m->state = MOTION_FAULT;
+    m->fault_status = MOTION_ERR_INDEX;
+}
+
 /* With the encoder's index wired: asks for the index once the move may start, and whether
  * the encoder has met it since (it clears the pin, its count reset to 0 there). A pause or an
- * abort meanwhile withdraws the request; a resume asks again. */
-static bool sync_index_pin(struct motion *m, bool ready)
+ * abort meanwhile withdraws the request; a resume asks again. An index comes once a
+ * revolution: when the spindle has turned MOTION_INDEX_WAIT_REVS since the request without
+ * one, the index is missing and the machine faults (index_missing). */
+static bool sync_index_pin(struct motion *m, const struct motion_seg *sg, bool ready,
+                           double revs)
 {
     struct motion_sync *y = &m->sync;
     if (!ready) {
@@ -312,11 +332,16 @@ static bool sync_index_pin(struct motion *m, bool ready)
     }
     if (!y->index_asked) {
         y->index_asked = 1;
+        y->index_revs0 = revs;
         m->index_out = 1;             /* set this period; the encoder sees it from the next */
         return false;
     }
-    if (m->index_enabled)
+    if (m->index_enabled) {
+        double turned = fabs(revs - y->index_revs0);
+        if (turned > MOTION_INDEX_WAIT_REVS)
+            index_missing(m, sg, turned);
         return false;
+    }
     y->index_asked = 0;
     y->revs0 = 0;                     /* the count starts at the index */
     return true;
@@ -409,7 +434,8 @@ bool motion_sync_advance(struct motion *m, double dt)
         /* (with jerk limits, once the moving average has come to rest here: the move then
          * follows the spindle without it, motion_jerk.c) */
         bool ready = m->state == MOTION_RUNNING && motion_jerk_settled(m);
-        bool go = m->index_wired ? sync_index_pin(m, ready) : ready && sync_index(y, revs);
+        bool go = m->index_wired ? sync_index_pin(m, sg, ready, revs)
+                                 : ready && sync_index(y, revs);
         y->revs_prev = revs;
         if (!go) {
             m->rate = 0;              /* at rest: a pause or an abort may take it here */

@@ -568,8 +568,10 @@ static int indexed_hook(struct motion *m, const struct motion_out *o, int step, 
 
 /* With the index handshake wired: the tap sets index-enable once, waits while it stays set,
  * and starts when the encoder clears it, from its count of 0 (z + K revs = the start, within
- * 1 um); with a broken index it waits at the start (3 s, 30 revolutions) until the abort,
- * which clears the pin again. */
+ * 1 um); with a broken index it waits at the start while the spindle turns two revolutions
+ * (0.2 s at 600 rpm), then withdraws the pin and faults there with a message that says so.
+ * Before the index time-out a broken index kept the machine waiting, pin set, until an abort:
+ * the fault's assertions fail on that code. */
 START_TEST(test_index_handshake)
 {
     const double top[6] = { 0, 0, 10, 0, 0, 0 }, bottom[6] = { 0, 0, 0, 0, 0, 0 };
@@ -596,18 +598,26 @@ START_TEST(test_index_handshake)
                           "z + K revs from %.6f to %.6f", s.c_min, s.c_max);
         } else {
             tm_run(mc.m, DT, 3000, &st, indexed_hook, &s);
-            ck_assert_int_eq(st.last.state, MOTION_RUNNING);
+            ck_assert_int_eq(st.last.state, MOTION_FAULT);
+            ck_assert_int_eq(st.last.status, MOTION_ERR_INDEX);
             ck_assert_double_eq_tol(s.z_min, 10, 1e-12);
-            ck_assert(s.pin && s.sets == 1 && s.clears == 0);
-            ck_assert_int_eq(motion_abort(mc.m), MOTION_OK);
-            struct motion_out o;
-            int k = 0;
-            do {                        /* every period's output to the encoder */
+            ck_assert(!s.pin && s.sets == 1 && s.clears == 0 && s.cancels == 1);
+            /* two revolutions after the request: 10 rev/s, so 0.2 s and a period or two */
+            ck_assert_msg(s.revs > 0.37 + MOTION_INDEX_WAIT_REVS &&
+                          s.revs < 0.37 + MOTION_INDEX_WAIT_REVS + 0.5 && st.steps < 400,
+                          "faulted at %.3f revolutions, after %d periods", s.revs, st.steps);
+            const char *msg = motion_last_error(mc.m);
+            ck_assert_msg(strstr(msg, "index-enable") && strstr(msg, "no index pulse") &&
+                          strstr(msg, ":2:") && strstr(msg, "tap (G33.1)"), "%s", msg);
+            struct motion_out o;        /* it stays there, the spindle stopped */
+            for (int k = 0; k < 100; k++) {
                 motion_step(mc.m, DT, &o);
                 indexed_hook(mc.m, &o, k, &s);
-            } while (o.state != MOTION_IDLE && ++k < 100);
-            ck_assert_int_eq(o.state, MOTION_IDLE);
-            ck_assert(!s.pin && s.cancels == 1);
+            }
+            ck_assert_int_eq(o.state, MOTION_FAULT);
+            ck_assert_int_eq(o.spindle.dir, 0);
+            ck_assert_double_eq_tol(o.pose[2], 10, 1e-12);
+            ck_assert(!s.pin && s.sets == 1);
         }
         canon_prog_free(&p);
         tm_close(&mc);
