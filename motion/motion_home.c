@@ -46,7 +46,7 @@ static double search_mm(const struct motion *m, int i)
 static void enter(struct motion *m, int i, enum motion_home_phase ph)
 {
     const struct motion_joint_config *j = &m->cfg.joint[i];
-    double s = sgn(j->home_search_vel), here = m->joint_cmd[i], far = search_mm(m, i);
+    double s = sgn(j->home_search_vel), here = m->lead_L[i], far = search_mm(m, i);
     m->hphase[i] = ph;
     m->hstart[i] = here;
     switch (ph) {
@@ -62,7 +62,8 @@ static void enter(struct motion *m, int i, enum motion_home_phase ph)
 }
 
 /* The latch edge: the motor position there is HOME_OFFSET from now on. The command shifts
- * with the offset, so the motor command does not move. */
+ * with the offset, so the motor command does not move (nor, with jerk limits, the average
+ * of the leader's last set points, which all shift with it). */
 static void latch(struct motion *m, int i)
 {
     double off = m->motor_fb[i] - m->cfg.joint[i].home_offset;
@@ -70,7 +71,9 @@ static void latch(struct motion *m, int i)
     m->motor_offset[i] = off;
     m->joint_cmd[i] += shift;
     m->joint_fb[i] += shift;
+    m->lead_L[i] += shift;
     m->man.jt[i] += shift;
+    motion_jerk_shift_leg(m, i, shift);
 }
 
 /* Ends homing with a note (failure: the leg stays unhomed). */
@@ -230,6 +233,7 @@ int motion_home(struct motion *m, int joint)
     if (!next_group(m))
         return MOTION_OK;
     m->homing = 1;
+    motion_manual_enter(m);
     memset(&m->man, 0, sizeof m->man);
     m->man.kind = MAN_JOINTS;
     m->state = MOTION_MANUAL;

@@ -205,6 +205,19 @@ static void push(struct motion *m, const double *x, const struct motion_jerk_met
     scatter(m, j->last, &j->last_meta);
 }
 
+void motion_jerk_shift_leg(struct motion *m, int i, double shift)
+{
+    struct motion_jerk *j = m->jerk;
+    if (!j)
+        return;
+    int d = 3 * KINS_POSE_DIM + i;     /* the legs' place in a sample (gather) */
+    for (int k = 0; k < j->n; k++)
+        j->ring[(size_t)k * JERK_DIM + (size_t)d] += shift;
+    j->sum[d] += j->n * shift;
+    j->fresh[d] += j->fresh_n * shift;
+    j->last[d] += shift;
+}
+
 void motion_jerk_follow(struct motion *m)
 {
     struct motion_jerk *j = m->jerk;

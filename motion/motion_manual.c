@@ -18,6 +18,12 @@
  *    there; the edge is then located by bisection and the profile ends short of it.
  *  - MAN_JOINTS, one profile per leg, at its own speed and acceleration, the pose following
  *    by forward kinematics: leg jogs and the moves of homing.
+ *
+ * Both keep their state in the leader (m->lead_pose, m->lead_L) and give it to the command
+ * each period. With jerk limits the command is the leader's moving average (motion_jerk.c),
+ * as for a program: jogs, moves to a pose and homing keep every leg within MAX_JERK; a jog
+ * that ends settles T (the average's window) later, on the leader's end exactly, and the
+ * machine counts as idle only then.
  */
 
 /* Share of a leg's acceleration the first-order term dL/ds * a may use along a line; the
@@ -219,12 +225,10 @@ static void line_step(struct motion *m, double dt)
         kins_inverse(m->kins, p, L);
     }
     mm->s += ds;
-    double prev[KINS_MAX_JOINTS];
-    memcpy(prev, m->joint_cmd, sizeof prev);
-    memcpy(m->pose, p, sizeof m->pose);
-    memcpy(m->joint_cmd, L, sizeof(double) * (size_t)m->nj);
     for (int i = 0; i < m->nj; i++)
-        m->joint_vel[i] = (L[i] - prev[i]) / dt;
+        m->joint_vel[i] = (L[i] - m->lead_L[i]) / dt;
+    memcpy(m->lead_pose, p, sizeof m->lead_pose);
+    memcpy(m->lead_L, L, sizeof(double) * (size_t)m->nj);
     for (int k = 0; k < KINS_POSE_DIM; k++)
         m->pose_vel[k] = mm->u[k] * mm->v;
     m->path_vel = mm->v;
@@ -245,14 +249,14 @@ static void joints_step(struct motion *m, double dt)
         double target = mm->jt[i];
         if (!mm->jfree[i])
             target = fmin(fmax(target, m->kins->joint_min[i]), m->kins->joint_max[i]);
-        double dir = target >= m->joint_cmd[i] ? 1 : -1;
+        double dir = target >= m->lead_L[i] ? 1 : -1;
         /* a reversal of direction first brakes: profile_step works on |v| along dir */
         double v = mm->jv[i] * dir;
-        double rem = fabs(target - m->joint_cmd[i]);
+        double rem = fabs(target - m->lead_L[i]);
         if (v < 0) {  /* moving away from the target: brake first */
             double dv = fmin(-v, j->max_acc_mm_s2 * dt);
             double vn = v + dv;
-            m->joint_cmd[i] += dir * vn * dt;
+            m->lead_L[i] += dir * vn * dt;
             mm->jv[i] = vn * dir;
             m->joint_vel[i] = mm->jv[i];
             any = 1;
@@ -260,7 +264,7 @@ static void joints_step(struct motion *m, double dt)
         }
         double vt = mm->stop ? 0 : fmin(fabs(mm->jvreq[i]), j->max_vel_mm_s);
         double d = profile_step(&v, vt, j->max_acc_mm_s2, rem, dt);
-        m->joint_cmd[i] += dir * d;
+        m->lead_L[i] += dir * d;
         mm->jv[i] = v * dir;
         m->joint_vel[i] = d * dir / dt;
         if (v == 0 && (mm->stop || rem - d <= 1e-9))
@@ -269,21 +273,32 @@ static void joints_step(struct motion *m, double dt)
             any = 1;
     }
     double pose[KINS_POSE_DIM];
-    memcpy(pose, m->pose, sizeof pose);
-    m->pose_known = kins_forward(m->kins, m->joint_cmd, pose, NULL) == KINS_OK;
+    memcpy(pose, m->lead_pose, sizeof pose);
+    m->pose_known = kins_forward(m->kins, m->lead_L, pose, NULL) == KINS_OK;
     if (m->pose_known)
-        memcpy(m->pose, pose, sizeof pose);
+        memcpy(m->lead_pose, pose, sizeof pose);
     memset(m->pose_vel, 0, sizeof m->pose_vel);
     m->path_vel = 0;
     if (!any)
         mm->kind = MAN_NONE;
 }
 
-/* Manual motion may start or change only when no program runs. */
+void motion_manual_enter(struct motion *m)
+{
+    if (m->state == MOTION_MANUAL)
+        return;
+    memcpy(m->lead_pose, m->pose, sizeof m->lead_pose);
+    memcpy(m->lead_L, m->joint_cmd, sizeof m->lead_L);
+}
+
+/* Manual motion may start or change only when no program runs; it begins at the command
+ * (motion_manual_enter). */
 static int manual_allowed(struct motion *m)
 {
-    if (m->state == MOTION_IDLE || m->state == MOTION_DONE || m->state == MOTION_MANUAL)
+    if (m->state == MOTION_IDLE || m->state == MOTION_DONE || m->state == MOTION_MANUAL) {
+        motion_manual_enter(m);
         return MOTION_OK;
+    }
     motion_set_msg(m, "manual motion is not possible while the motion core is %s",
                    motion_state_name(m->state));
     return MOTION_ERR_STATE;
@@ -305,7 +320,7 @@ static void start_line(struct motion *m, const double *u, double v_req, double a
     }
     memset(mm, 0, sizeof *mm);
     mm->kind = MAN_LINE;
-    memcpy(mm->p0, m->pose, sizeof mm->p0);
+    memcpy(mm->p0, m->lead_pose, sizeof mm->p0);
     memcpy(mm->u, u, sizeof mm->u);
     mm->v = v0;
     mm->v_req = v_req;
@@ -353,9 +368,9 @@ int motion_jog(struct motion *m, enum motion_jog_frame frame, int axis, double v
         if (m->homed[axis])
             far = vel > 0 ? m->kins->joint_max[axis] : m->kins->joint_min[axis];
         else
-            far = m->joint_cmd[axis] + (vel > 0 ? 1 : -1) *
+            far = m->lead_L[axis] + (vel > 0 ? 1 : -1) *
                   (m->kins->joint_max[axis] - m->kins->joint_min[axis]);
-        mm->jt[axis] = dist > 0 ? m->joint_cmd[axis] + (vel > 0 ? dist : -dist) : far;
+        mm->jt[axis] = dist > 0 ? m->lead_L[axis] + (vel > 0 ? dist : -dist) : far;
         m->state = MOTION_MANUAL;
         return MOTION_OK;
     }
@@ -368,7 +383,7 @@ int motion_jog(struct motion *m, enum motion_jog_frame frame, int axis, double v
     double u[KINS_POSE_DIM] = { 0 };
     double sign = vel > 0 ? 1 : -1;
     if (frame == MOTION_JOG_TOOL)
-        platform_axis(m->pose, axis, u);
+        platform_axis(m->lead_pose, axis, u);
     else
         u[axis] = 1;
     for (int k = 0; k < KINS_POSE_DIM; k++)
@@ -390,7 +405,7 @@ int motion_move_to(struct motion *m, const double pose[KINS_POSE_DIM], double sp
     /* s measures mm of XYZ, or deg when only A B C change; u carries the rest along */
     double d[KINS_POSE_DIM], lin = 0, ang = 0;
     for (int k = 0; k < KINS_POSE_DIM; k++) {
-        d[k] = pose[k] - m->pose[k];
+        d[k] = pose[k] - m->lead_pose[k];
         if (k < 3)
             lin += d[k] * d[k];
         else
@@ -453,7 +468,7 @@ void motion_joint_halt(struct motion *m, int i)
 {
     struct motion_manual *mm = &m->man;
     double v = mm->jv[i], a = m->cfg.joint[i].max_acc_mm_s2;
-    mm->jt[i] = m->joint_cmd[i] + (v >= 0 ? 1 : -1) * stop_dist(v, a, m->cfg.servo_period_s);
+    mm->jt[i] = m->lead_L[i] + (v >= 0 ? 1 : -1) * stop_dist(v, a, m->cfg.servo_period_s);
 }
 
 /* Whether leg i's own move has ended. */
@@ -470,12 +485,17 @@ void motion_manual_step(struct motion *m, double dt)
         line_step(m, dt);
     else if (m->man.kind == MAN_JOINTS)
         joints_step(m, dt);
-    if (m->man.kind == MAN_NONE && !m->homing) {
+    if (m->man.kind == MAN_NONE) {
         memset(m->joint_vel, 0, sizeof m->joint_vel);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
         m->path_vel = 0;
-        m->state = MOTION_IDLE;
+        /* (with jerk limits, idle once the average has come to rest on the leader) */
+        if (!m->homing && motion_jerk_settled(m))
+            m->state = MOTION_IDLE;
     }
+    /* the leader to the command (motion_jerk_follow averages it) */
+    memcpy(m->pose, m->lead_pose, sizeof m->pose);
+    memcpy(m->joint_cmd, m->lead_L, sizeof(double) * (size_t)m->nj);
 }
 
 bool motion_pose_known(const struct motion *m)
@@ -510,6 +530,8 @@ void motion_track_feedback(struct motion *m)
     }
     if (m->pose_known)
         memcpy(m->pose, pose, sizeof pose);
+    memcpy(m->lead_pose, m->pose, sizeof m->lead_pose);
+    memcpy(m->lead_L, m->joint_cmd, sizeof m->lead_L);
 }
 
 int motion_reset(struct motion *m)

@@ -331,6 +331,12 @@ struct motion {
     double dist_mm;          /* XYZ path length covered, mm */
     /* manual motion and homing */
     struct motion_manual man;
+    /* Manual motion's own pose and legs (the leader's): with jerk limits the command
+     * (pose, joint_cmd) is their moving average, so the jogs' and homing's profiles keep
+     * their state here; without, the two are the same. Taken from the command when manual
+     * motion begins (motion_manual_enter), at rest. */
+    double lead_pose[KINS_POSE_DIM];
+    double lead_L[KINS_MAX_JOINTS];
     double motor_offset[KINS_MAX_JOINTS];  /* motor = joint + offset, mm */
     double joint_fb[KINS_MAX_JOINTS];      /* last leg feedback (joint positions), mm */
     double motor_fb[KINS_MAX_JOINTS];      /* last motor feedback, mm */
@@ -404,6 +410,9 @@ void motion_jerk_hold(struct motion *m);
 /* Whether the average has come to rest on the executor's pose (always without jerk limits):
  * the machine counts as stopped only then. */
 bool motion_jerk_settled(const struct motion *m);
+/* Homing's latch moved leg i's joint coordinate by shift (the motor's command stays): the
+ * average's samples of that leg move with it. */
+void motion_jerk_shift_leg(struct motion *m, int i, double shift);
 /* The period over which a chord's and the average's cut of a curved path is bounded: the
  * set-point period T_s and the average's window T_j give the same cut as a set-point chord
  * of sqrt(T_s^2 + T_j^2 / 3) (a chord cuts q d^2 / 8, the average q (v T_j)^2 / 24). */
@@ -433,6 +442,8 @@ void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((forma
 void motion_note(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 void motion_manual_step(struct motion *m, double dt);
 void motion_home_step(struct motion *m);
+/* Manual motion begins here (from IDLE or DONE): its leader starts at the command. */
+void motion_manual_enter(struct motion *m);
 void motion_joint_move(struct motion *m, int i, double target, double vel, int free_leg);
 void motion_joint_halt(struct motion *m, int i);
 bool motion_joint_idle(const struct motion *m, int i);

@@ -704,8 +704,8 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     if (moving && m->streaming && stream_ready(m) && m->chunk->last && m->run->nseg == 0)
         m->state = MOTION_DONE;  /* a streamed program without a move */
     if (m->state == MOTION_MANUAL) {
-        motion_manual_step(m, period_s);
-        motion_jerk_hold(m);
+        motion_manual_step(m, period_s);   /* the leader ... */
+        motion_jerk_follow(m);             /* ... and with jerk limits its average */
     } else if (moving && m->loaded && stream_ready(m) && m->run->nseg) {
         m->io_age++;
         pass_ios(m);           /* the commands at the present place first: a wait there */

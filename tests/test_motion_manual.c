@@ -2,7 +2,7 @@
  * within its speed, acceleration and length limits (measured by differencing the leg
  * commands), a jog that runs into the workspace edge stopping short of it with a note, an
  * incremental jog landing exactly, and homing on home switches finding an offset the
- * controller cannot see. */
+ * controller cannot see; with jerk limits, all of it within every leg's MAX_JERK too. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -21,8 +21,9 @@ struct rig {
     double hidden[KINS_MAX_JOINTS];
     double sw_at;
     int use_switches;
-    /* measured over the run: motor speed and acceleration, leg lengths */
-    double max_v[KINS_MAX_JOINTS], max_a[KINS_MAX_JOINTS];
+    /* measured over the run: motor speed, acceleration and jerk, leg lengths */
+    double max_v[KINS_MAX_JOINTS], max_a[KINS_MAX_JOINTS], max_j[KINS_MAX_JOINTS];
+    double pla[KINS_MAX_JOINTS];         /* last period's acceleration, for the jerk */
     double min_len[KINS_MAX_JOINTS], max_len[KINS_MAX_JOINTS];
     int steps;
 };
@@ -43,8 +44,12 @@ static void rig_step(struct rig *r, double plv[KINS_MAX_JOINTS])
          * not the motor's position) */
         double lv = (r->o.motor_pos[j] - r->prev.motor_pos[j]) / DT;
         r->max_v[j] = fmax(r->max_v[j], fabs(lv));
+        double la = (lv - plv[j]) / DT;
         if (r->steps > 0)
-            r->max_a[j] = fmax(r->max_a[j], fabs(lv - plv[j]) / DT);
+            r->max_a[j] = fmax(r->max_a[j], fabs(la));
+        if (r->steps > 1)
+            r->max_j[j] = fmax(r->max_j[j], fabs(la - r->pla[j]) / DT);
+        r->pla[j] = la;
         r->min_len[j] = fmin(r->min_len[j], r->o.joint_pos[j]);
         r->max_len[j] = fmax(r->max_len[j], r->o.joint_pos[j]);
         plv[j] = lv;
@@ -60,7 +65,7 @@ static double rig_run(struct rig *r, double max_s, double stop_after_s)
     double plv[KINS_MAX_JOINTS] = {0};
     int nj = r->mc.kins->njoints;
     for (int j = 0; j < nj; j++) {
-        r->max_v[j] = r->max_a[j] = 0;
+        r->max_v[j] = r->max_a[j] = r->max_j[j] = 0;
         r->min_len[j] = r->max_len[j] = r->prev.joint_pos[j];
     }
     r->steps = 0;
@@ -75,8 +80,12 @@ static double rig_run(struct rig *r, double max_s, double stop_after_s)
     return max_s;
 }
 
-/* The TMU hexapod with legs of vmax mm/s and amax mm/s^2; joints homed at once (no
- * switches) unless switches is set, and at its home pose. */
+/* Jerk limits for the rig's machine: legs and path (0: none, trapezoidal). */
+#define RIG_LEG_JERK 50000.0    /* mm/s^3: 2 x 1000 / 50000, a 40 ms average */
+static double rig_jerk;
+
+/* The TMU hexapod with legs of vmax mm/s and amax mm/s^2 (and rig_jerk); joints homed at
+ * once (no switches) unless switches is set, and at its home pose. */
 static void rig_open_with(struct rig *r, double vmax, double amax, int switches,
                           const char *sec_, const char *key, const char *val)
 {
@@ -85,6 +94,17 @@ static void rig_open_with(struct rig *r, double vmax, double amax, int switches,
     ck_assert_ptr_nonnull(c);
     if (sec_)
         tk_set(c, sec_, key, val);
+    if (rig_jerk > 0) {
+        char v[32];
+        snprintf(v, sizeof v, "%g", rig_jerk);
+        tk_set(c, "TRAJ", "MAX_LINEAR_JERK", v);
+        tk_set(c, "TRAJ", "MAX_ANGULAR_JERK", v);
+        for (int i = 0; i < 6; i++) {
+            char sec[24];
+            snprintf(sec, sizeof sec, "JOINT_%d", i);
+            tk_set(c, sec, "MAX_JERK", v);
+        }
+    }
     for (int i = 0; i < 6; i++) {
         char sec[24], v[32], a[32];
         snprintf(sec, sizeof sec, "JOINT_%d", i);
@@ -295,6 +315,97 @@ START_TEST(test_homing_with_switches_finds_offsets)
 }
 END_TEST
 
+/* The largest motor jerk of the last run, over the legs. */
+static double rig_peak_jerk(const struct rig *r)
+{
+    double j = 0;
+    for (int i = 0; i < r->mc.kins->njoints; i++)
+        j = fmax(j, r->max_j[i]);
+    return j;
+}
+
+/* Runs manual motion to its end and asserts every motor within 100 mm/s, 1000 mm/s^2 and
+ * (with jerk limits) RIG_LEG_JERK in every period; returns the run's peak jerk. */
+static double rig_run_limited(struct rig *r, const char *what)
+{
+    double t = rig_run(r, 200, 0);
+    ck_assert_msg(motion_get_state(r->mc.m) == MOTION_IDLE, "%s: not over in %.3f s", what, t);
+    assert_legs_within(r, 100, 1000, 0);
+    double pj = rig_peak_jerk(r);
+    ck_assert_msg(rig_jerk == 0 || pj <= RIG_LEG_JERK * (1 + 1e-6),
+                  "%s: a motor at %.1f mm/s^3 (MAX_JERK %g)", what, pj, RIG_LEG_JERK);
+    return pj;
+}
+
+/* With jerk limits, homing on switches and every kind of jog keep each motor within its
+ * MAX_JERK in every period (manual motion follows the same moving average as a program);
+ * each still ends exactly where it was sent, the latch still finds the hidden offsets, and
+ * the machine is idle only once the average has settled there. Without jerk limits the same
+ * moves reach 20 times MAX_JERK (a trapezoid's acceleration steps in one period):
+ * the measurement sees it. Manual motion was trapezoidal under jerk limits before. */
+START_TEST(test_manual_jerk_limited)
+{
+    static const double hidden[6] = {3.7, -5.2, 1.1, -0.4, 6.3, -2.9};
+    double peak[2] = {0, 0};
+    for (int jerk = 0; jerk < 2; jerk++) {
+        rig_jerk = jerk ? RIG_LEG_JERK : 0;
+        struct rig r;
+        rig_open(&r, 100, 1000, 1);
+        memcpy(r.hidden, hidden, sizeof hidden);
+        ck_assert_int_eq(motion_home(r.mc.m, -1), MOTION_OK);
+        peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "homing"));
+        ck_assert_msg(motion_all_homed(r.mc.m), "not homed: %s",
+                      motion_manual_note(r.mc.m, NULL));
+        for (int j = 0; j < 6; j++) {
+            double true_len = r.o.motor_pos[j] + hidden[j];
+            ck_assert_msg(fabs(true_len - r.o.joint_pos[j]) <= 2 * DT + 1e-9,
+                          "leg %d: thinks %.5f, is %.5f", j + 1, r.o.joint_pos[j], true_len);
+        }
+        for (int i = 0; i < 6; i++)
+            ck_assert_double_eq_tol(r.o.pose[i], r.mc.kins->home[i], 1e-9);
+        /* incremental world jog: exact, in the period the machine becomes idle */
+        double y0 = r.o.pose[1];
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 1, -25, 12.5), MOTION_OK);
+        peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "Y jog"));
+        ck_assert_double_eq_tol(r.o.pose[1], y0 - 12.5, 1e-9);
+        /* a continuous jog stopped after 0.7 s, and changed on the way */
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 0, 80, 0), MOTION_OK);
+        double plv[KINS_MAX_JOINTS] = {0};
+        for (int k = 0; k < 300; k++)
+            rig_step(&r, plv);
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 0, 30, 0), MOTION_OK);
+        double t = rig_run(&r, 200, 0.4);
+        ck_assert_int_eq(motion_get_state(r.mc.m), MOTION_IDLE);
+        assert_legs_within(&r, 100, 1000, 0);
+        ck_assert_msg(jerk == 0 || rig_peak_jerk(&r) <= RIG_LEG_JERK * (1 + 1e-6),
+                      "X jog: %.1f mm/s^3 after %.3f s", rig_peak_jerk(&r), t);
+        double at[6];
+        memcpy(at, r.o.pose, sizeof at);
+        for (int k = 0; k < 50; k++)
+            rig_step(&r, plv);
+        for (int i = 0; i < 6; i++)
+            ck_assert_msg(fabs(r.o.pose[i] - at[i]) < 1e-12, "axis %d moved on after idle", i);
+        /* a rotary jog, a tool jog and a leg jog, each exact */
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 4, -20, 3), MOTION_OK);
+        peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "B jog"));
+        ck_assert_double_eq_tol(r.o.pose[4], at[4] - 3, 1e-9);
+        double z0 = r.o.pose[2];
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_TOOL, 0, 40, 4), MOTION_OK);
+        peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "tool jog"));
+        ck_assert_msg(fabs(r.o.pose[2] - z0) > 0.05, "a tool X jog with B-3 kept Z");
+        double L2 = r.o.joint_pos[2];
+        ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_JOINT, 2, 10, 2), MOTION_OK);
+        peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "leg jog"));
+        ck_assert_double_eq_tol(r.o.joint_pos[2], L2 + 2, 1e-9);
+        tm_close(&r.mc);
+    }
+    rig_jerk = 0;
+    printf("manual motion, peak motor jerk: %.0f mm/s^3 trapezoidal, %.0f jerk-limited "
+           "(MAX_JERK %.0f)\n", peak[0], peak[1], RIG_LEG_JERK);
+    ck_assert_msg(peak[0] > 10 * RIG_LEG_JERK, "the trapezoid's jerk %.0f", peak[0]);
+}
+END_TEST
+
 static Suite *motion_manual_suite(void)
 {
     Suite *s = suite_create("motion_manual");
@@ -307,6 +418,7 @@ static Suite *motion_manual_suite(void)
     tcase_add_test(tc, test_jog_stops_at_soft_limit);
     tcase_add_test(tc, test_world_jog_needs_homing);
     tcase_add_test(tc, test_homing_with_switches_finds_offsets);
+    tcase_add_test(tc, test_manual_jerk_limited);
     suite_add_tcase(s, tc);
     return s;
 }
