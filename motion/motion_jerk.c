@@ -30,7 +30,9 @@
  * comes to rest exactly on the corner. The machine counts as stopped (paused, done, idle,
  * parked on a probe trip) only once the mean has settled on the leader. Spindle-synchronised
  * moves (G33, G33.1) bypass the mean: their jerk is the spindle's. The outputs M62..M68
- * switch with the mean too, where the tool reaches them on the path, not T/2 ahead of it.
+ * and the spindle's and coolant's commands (M3 M4 M5 S, M7 M8 M9) switch with the mean too,
+ * where the tool reaches them on the path, not T/2 ahead of it; the executor's own logic (a
+ * wait for the spindle at speed, a tap's reversal) goes by the leader's, as the plan does.
  */
 
 /* Values averaged, in this order: pose, pose rate, path pose, legs, leg rates, path speed,
@@ -45,6 +47,7 @@ struct motion_jerk_meta {
     double tool_len_mm, path_tol_mm;
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM];
     struct motion_outputs outputs;     /* M62..M68: switched where the tool is */
+    struct motion_spindle io;          /* spindle and coolant: switched where the tool is */
 };
 
 struct motion_jerk {
@@ -102,6 +105,7 @@ static void gather(const struct motion *m, double *x, struct motion_jerk_meta *m
     memcpy(mt->seg_from, m->seg_from, sizeof mt->seg_from);
     memcpy(mt->seg_to, m->seg_to, sizeof mt->seg_to);
     mt->outputs = m->outputs;
+    mt->io = m->io;
 }
 
 /* x and meta into the motion's values. */
@@ -121,6 +125,7 @@ static void scatter(struct motion *m, const double *x, const struct motion_jerk_
     memcpy(m->seg_from, mt->seg_from, sizeof m->seg_from);
     memcpy(m->seg_to, mt->seg_to, sizeof m->seg_to);
     m->outputs_out = mt->outputs;
+    m->io_out = mt->io;
 }
 
 int motion_jerk_init(struct motion *m, char *err, size_t errlen)
@@ -253,4 +258,5 @@ void motion_jerk_hold(struct motion *m)
     gather(m, j->last, &j->last_meta);
     j->primed = 0;
     m->outputs_out = m->outputs;
+    m->io_out = m->io;
 }

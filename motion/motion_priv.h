@@ -295,6 +295,7 @@ struct motion {
     struct motion_outputs outputs_out; /* what the outputs show: with jerk limits, those in
                                         * force where the mean is on the path (T/2 behind
                                         * the executor, motion_jerk.c); else outputs */
+    struct motion_spindle io_out; /* the same for the spindle and coolant (motion_out) */
     unsigned tool_done_seq;  /* the last tool change the changer finished */
     size_t waited_at_seg;    /* wait segment already passed (+1), 0 = none */
     /* G38 probing (motion_probe.c), servo thread only but the result and its counter */

@@ -767,7 +767,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
     out->feed_override = m->rate;
     out->settings_done = m->marks_base + m->marks_done;
-    out->spindle = m->io;
+    out->spindle = m->jerk ? m->io_out : m->io;
     out->spindle_index = m->index_out;
     m->index_out = 0;
     out->waiting = m->waiting;

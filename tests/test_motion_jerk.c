@@ -360,6 +360,77 @@ START_TEST(test_synced_outputs)
 }
 END_TEST
 
+/* Where coolant and spindle speed change on the path: the X of the commanded pose in the
+ * period motion's output changes. */
+struct coolant { double on_x, off_x, up_x, down_x; int mist; double rpm; };
+
+static int coolant_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    struct coolant *w = ctx;
+    if (o->spindle.mist && !w->mist)
+        w->on_x = o->pose[0];
+    if (!o->spindle.mist && w->mist)
+        w->off_x = o->pose[0];
+    if (o->spindle.rpm > w->rpm)
+        w->up_x = o->pose[0];
+    if (o->spindle.rpm < w->rpm)
+        w->down_x = o->pose[0];
+    w->mist = o->spindle.mist;
+    w->rpm = o->spindle.rpm;
+    return 0;
+}
+
+/* M7 with S1200 and M9 with S600 between straight feeds at 50 mm/s blended on through them:
+ * coolant and spindle speed change where the tool is at the blocks' ends, with jerk limits as
+ * without. Before they went out with the mean, they changed T/2 = 20 ms (1 mm) ahead of the
+ * tool with jerk limits: at X-10.975 and X9.025. */
+START_TEST(test_synced_spindle_coolant)
+{
+    for (int jerk = 0; jerk < 2; jerk++) {
+        struct canon_prog p;
+        canon_prog_init(&p);
+        double at[6] = { -30, 0, 645, 0, 0, 0 };
+        memcpy(p.start, at, sizeof at);
+        p.start_path_mode = 640;
+        p.start_path_tol_mm = 0.01;
+        tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 900);
+        for (int i = 1; i <= 3; i++) {
+            at[0] += 20;
+            tm_add(&p, CANON_FEED, 2 * i, at, 3000, 0);
+            if (i < 3) {
+                struct canon_cmd c;
+                memset(&c, 0, sizeof c);
+                c.type = CANON_COOLANT;
+                c.line = 2 * i + 1;
+                c.file = "test.ngc";
+                c.ivalue = i == 1 ? 7 : 9;
+                ck_assert_int_eq(canon_prog_sink(&p, &c), 0);
+                tm_add(&p, CANON_SPINDLE_SPEED, 2 * i + 1, NULL, 0, i == 1 ? 1200 : 600);
+            }
+        }
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
+        char err[400];
+        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
+        ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+        struct coolant w = { .on_x = NAN, .off_x = NAN, .up_x = NAN, .down_x = NAN };
+        struct tm_stats st;
+        tm_run(mc.m, DT, 100000, &st, coolant_hook, &w);
+        ck_assert_int_eq(st.last.state, MOTION_DONE);
+        printf("M7 S1200 at X-10, M9 S600 at X10, %s: coolant at X%.3f and X%.3f, speed at "
+               "X%.3f and X%.3f\n", jerk ? "jerk-limited" : "trapezoidal", w.on_x, w.off_x,
+               w.up_x, w.down_x);
+        /* within a period's travel (0.05 mm) of the blocks' ends */
+        ck_assert_msg(fabs(w.on_x + 10) <= 0.06 && fabs(w.off_x - 10) <= 0.06 &&
+                      fabs(w.up_x + 10) <= 0.06 && fabs(w.down_x - 10) <= 0.06,
+                      "coolant at X%.3f and X%.3f, speed at X%.3f and X%.3f", w.on_x,
+                      w.off_x, w.up_x, w.down_x);
+        tm_close(&mc);
+        canon_prog_free(&p);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("motion_jerk");
@@ -371,6 +442,7 @@ int main(void)
     tcase_add_loop_test(tc, test_small_arcs, 0, 3);
     tcase_add_loop_test(tc, test_blended_corners, 0, 2);
     tcase_add_test(tc, test_synced_outputs);
+    tcase_add_test(tc, test_synced_spindle_coolant);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
