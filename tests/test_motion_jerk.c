@@ -322,6 +322,47 @@ static int switch_hook(struct motion *m, const struct motion_out *o, int step, v
     return 0;
 }
 
+/* Three straight feeds of 20 mm along X at 50 mm/s from X-30, G64 P0.01 (the path blends
+ * on through the block ends at X-10 and X10); between(p, line, i) adds what stands after
+ * the i-th (1, 2); S900 first when speed is set. */
+static void feeds_between(struct canon_prog *p, int speed,
+                          void (*between)(struct canon_prog *, int, int))
+{
+    canon_prog_init(p);
+    double at[6] = { -30, 0, 645, 0, 0, 0 };
+    memcpy(p->start, at, sizeof at);
+    p->start_path_mode = 640;
+    p->start_path_tol_mm = 0.01;
+    if (speed)
+        tm_add(p, CANON_SPINDLE_SPEED, 1, NULL, 0, 900);
+    for (int i = 1; i <= 3; i++) {
+        at[0] += 20;
+        tm_add(p, CANON_FEED, 2 * i, at, 3000, 0);
+        if (i < 3)
+            between(p, 2 * i + 1, i);
+    }
+}
+
+/* Runs p on the TMU hexapod (with jerk limits or without) to its end, hook watching. */
+static void run_to_end(int jerk, const struct canon_prog *p, tm_hook hook, void *ctx)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
+    char err[400];
+    ck_assert_msg(motion_load(mc.m, p, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+    struct tm_stats st;
+    tm_run(mc.m, DT, 100000, &st, hook, ctx);
+    ck_assert_int_eq(st.last.state, MOTION_DONE);
+    tm_close(&mc);
+}
+
+/* M62 after the first feed, M63 after the second. */
+static void add_dout(struct canon_prog *p, int line, int i)
+{
+    tm_add(p, CANON_DIGITAL_OUT, line, NULL, 0, i == 1 ? 1 : 0);
+}
+
 /* M62 and M63 between straight feeds at 50 mm/s blended on through them: the output switches
  * where the tool is at the blocks' ends, with jerk limits as without (the executor reaches
  * those ends T/2 = 20 ms, 1 mm, ahead of the tool). */
@@ -329,32 +370,14 @@ START_TEST(test_synced_outputs)
 {
     for (int jerk = 0; jerk < 2; jerk++) {
         struct canon_prog p;
-        canon_prog_init(&p);
-        double at[6] = { -30, 0, 645, 0, 0, 0 };
-        memcpy(p.start, at, sizeof at);
-        p.start_path_mode = 640;
-        p.start_path_tol_mm = 0.01;
-        for (int i = 1; i <= 3; i++) {
-            at[0] += 20;
-            tm_add(&p, CANON_FEED, 2 * i, at, 3000, 0);
-            if (i < 3)
-                tm_add(&p, CANON_DIGITAL_OUT, 2 * i + 1, NULL, 0, i == 1 ? 1 : 0);
-        }
-        struct tm_machine mc;
-        ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
-        char err[400];
-        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
-        ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+        feeds_between(&p, 0, add_dout);
         struct switches w = { .on_x = NAN, .off_x = NAN };
-        struct tm_stats st;
-        tm_run(mc.m, DT, 100000, &st, switch_hook, &w);
-        ck_assert_int_eq(st.last.state, MOTION_DONE);
+        run_to_end(jerk, &p, switch_hook, &w);
         printf("M62 at X-10, M63 at X10, %s: switched at X%.3f and X%.3f\n",
                jerk ? "jerk-limited" : "trapezoidal", w.on_x, w.off_x);
         /* within a period's travel (0.05 mm) of the blocks' ends */
         ck_assert_msg(fabs(w.on_x + 10) <= 0.06 && fabs(w.off_x - 10) <= 0.06,
                       "switched at X%.3f and X%.3f", w.on_x, w.off_x);
-        tm_close(&mc);
         canon_prog_free(&p);
     }
 }
@@ -380,6 +403,19 @@ static int coolant_hook(struct motion *m, const struct motion_out *o, int step, 
     return 0;
 }
 
+/* M7 and S1200 after the first feed, M9 and S600 after the second. */
+static void add_coolant_speed(struct canon_prog *p, int line, int i)
+{
+    struct canon_cmd c;
+    memset(&c, 0, sizeof c);
+    c.type = CANON_COOLANT;
+    c.line = line;
+    c.file = "test.ngc";
+    c.ivalue = i == 1 ? 7 : 9;
+    ck_assert_int_eq(canon_prog_sink(p, &c), 0);
+    tm_add(p, CANON_SPINDLE_SPEED, line, NULL, 0, i == 1 ? 1200 : 600);
+}
+
 /* M7 with S1200 and M9 with S600 between straight feeds at 50 mm/s blended on through them:
  * coolant and spindle speed change where the tool is at the blocks' ends, with jerk limits as
  * without. Before they went out with the mean, they changed T/2 = 20 ms (1 mm) ahead of the
@@ -388,35 +424,9 @@ START_TEST(test_synced_spindle_coolant)
 {
     for (int jerk = 0; jerk < 2; jerk++) {
         struct canon_prog p;
-        canon_prog_init(&p);
-        double at[6] = { -30, 0, 645, 0, 0, 0 };
-        memcpy(p.start, at, sizeof at);
-        p.start_path_mode = 640;
-        p.start_path_tol_mm = 0.01;
-        tm_add(&p, CANON_SPINDLE_SPEED, 1, NULL, 0, 900);
-        for (int i = 1; i <= 3; i++) {
-            at[0] += 20;
-            tm_add(&p, CANON_FEED, 2 * i, at, 3000, 0);
-            if (i < 3) {
-                struct canon_cmd c;
-                memset(&c, 0, sizeof c);
-                c.type = CANON_COOLANT;
-                c.line = 2 * i + 1;
-                c.file = "test.ngc";
-                c.ivalue = i == 1 ? 7 : 9;
-                ck_assert_int_eq(canon_prog_sink(&p, &c), 0);
-                tm_add(&p, CANON_SPINDLE_SPEED, 2 * i + 1, NULL, 0, i == 1 ? 1200 : 600);
-            }
-        }
-        struct tm_machine mc;
-        ck_assert_int_eq(tm_open(&mc, jerk_cfg(jerk), &kins_hexapod_ops), 0);
-        char err[400];
-        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "%s", err);
-        ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
+        feeds_between(&p, 1, add_coolant_speed);
         struct coolant w = { .on_x = NAN, .off_x = NAN, .up_x = NAN, .down_x = NAN };
-        struct tm_stats st;
-        tm_run(mc.m, DT, 100000, &st, coolant_hook, &w);
-        ck_assert_int_eq(st.last.state, MOTION_DONE);
+        run_to_end(jerk, &p, coolant_hook, &w);
         printf("M7 S1200 at X-10, M9 S600 at X10, %s: coolant at X%.3f and X%.3f, speed at "
                "X%.3f and X%.3f\n", jerk ? "jerk-limited" : "trapezoidal", w.on_x, w.off_x,
                w.up_x, w.down_x);
@@ -425,7 +435,6 @@ START_TEST(test_synced_spindle_coolant)
                       fabs(w.up_x + 10) <= 0.06 && fabs(w.down_x - 10) <= 0.06,
                       "coolant at X%.3f and X%.3f, speed at X%.3f and X%.3f", w.on_x,
                       w.off_x, w.up_x, w.down_x);
-        tm_close(&mc);
         canon_prog_free(&p);
     }
 }

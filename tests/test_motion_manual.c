@@ -155,6 +155,21 @@ static void assert_legs_within(const struct rig *r, double vmax, double amax, in
     }
 }
 
+/* Every leg homed, knowing its true length (motor + hidden offset) to within the latch
+ * pass's travel in two periods, and the platform at [KINS] HOME. */
+static void assert_homed_exactly(const struct rig *r, const double *hidden)
+{
+    ck_assert_msg(motion_all_homed(r->mc.m), "not homed: %s",
+                  motion_manual_note(r->mc.m, NULL));
+    for (int j = 0; j < 6; j++) {
+        double true_len = r->o.motor_pos[j] + hidden[j];
+        ck_assert_msg(fabs(true_len - r->o.joint_pos[j]) <= 2 * DT + 1e-9,
+                      "leg %d: thinks %.5f, is %.5f", j + 1, r->o.joint_pos[j], true_len);
+    }
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(r->o.pose[i], r->mc.kins->home[i], 1e-9);
+}
+
 /* A world X jog asked for 100 mm/s with legs of 20 mm/s and 200 mm/s^2: every leg stays
  * within its limits in every period, and the busiest one gets near its speed limit (the jog
  * is slowed only as far as the legs need). */
@@ -301,16 +316,9 @@ START_TEST(test_homing_with_switches_finds_offsets)
                       r.max_v[j] == 0, "leg %d of group 1 moved with group 0", j + 1);
     ck_assert_msg(r.max_v[0] > 1, "group 0 did not start");
     rig_run(&r, 200, 0);
-    ck_assert_msg(motion_all_homed(r.mc.m), "not homed: %s", motion_manual_note(r.mc.m, NULL));
     /* speeds and accelerations of the motors; lengths are unknown until each latch */
     assert_legs_within(&r, 100, 1000, 0);
-    for (int j = 0; j < 6; j++) {
-        double true_len = r.o.motor_pos[j] + hidden[j];
-        ck_assert_msg(fabs(true_len - r.o.joint_pos[j]) <= 2 * DT + 1e-9,
-                      "leg %d: thinks %.5f, is %.5f", j + 1, r.o.joint_pos[j], true_len);
-    }
-    for (int i = 0; i < 6; i++)
-        ck_assert_double_eq_tol(r.o.pose[i], r.mc.kins->home[i], 1e-9);
+    assert_homed_exactly(&r, hidden);
     tm_close(&r.mc);
 }
 END_TEST
@@ -354,15 +362,7 @@ START_TEST(test_manual_jerk_limited)
         memcpy(r.hidden, hidden, sizeof hidden);
         ck_assert_int_eq(motion_home(r.mc.m, -1), MOTION_OK);
         peak[jerk] = fmax(peak[jerk], rig_run_limited(&r, "homing"));
-        ck_assert_msg(motion_all_homed(r.mc.m), "not homed: %s",
-                      motion_manual_note(r.mc.m, NULL));
-        for (int j = 0; j < 6; j++) {
-            double true_len = r.o.motor_pos[j] + hidden[j];
-            ck_assert_msg(fabs(true_len - r.o.joint_pos[j]) <= 2 * DT + 1e-9,
-                          "leg %d: thinks %.5f, is %.5f", j + 1, r.o.joint_pos[j], true_len);
-        }
-        for (int i = 0; i < 6; i++)
-            ck_assert_double_eq_tol(r.o.pose[i], r.mc.kins->home[i], 1e-9);
+        assert_homed_exactly(&r, hidden);
         /* incremental world jog: exact, in the period the machine becomes idle */
         double y0 = r.o.pose[1];
         ck_assert_int_eq(motion_jog(r.mc.m, MOTION_JOG_WORLD, 1, -25, 12.5), MOTION_OK);
