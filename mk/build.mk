@@ -145,7 +145,8 @@ RUN_ENV := HEXCNC_ROOT=$(CURDIR) HEXCNC_BIN=$(abspath $(HEXCNC)) \
            HEXCNC_PLUGIN_DIR=$(abspath $(LIBDIR)) HEXCNC_BUILD=$(abspath $(BUILD)) \
            CK_DEFAULT_TIMEOUT=120 HEXCNC_SANITIZED=$(if $(SAN),1,0)
 
-test: all $(TEST_BINS)
+# (the benches are built too, so that each still compiles; bench_servo_runs.sh runs one)
+test: all $(TEST_BINS) $(BENCH_BINS)
 	@$(RUN_ENV) sh mk/run-tests.sh $(TEST_BINS) -- $(SCRIPT_TESTS)
 
 bench: all $(BENCH_BINS)

@@ -6,6 +6,7 @@ LIB_SRCS += task/session.c task/session_machine.c task/session_prog.c task/sessi
             task/session_server.c task/session_api.c
 TESTS += test_e2e test_run_faults test_run_settings test_run_startup
 BENCHES += bench_servo bench_session
+SCRIPT_TESTS += tests/bench_servo_runs.sh
 SCRIPT_TESTS += tests/e2e/run_cli.sh
 SCRIPT_TESTS += tests/e2e/run_large.sh tests/e2e/machine_session.sh tests/e2e/python_client.sh \
                 tests/e2e/stream_session.sh tests/e2e/machine_probe.sh tests/e2e/jerk_session.sh \
