@@ -205,8 +205,10 @@ static void push(struct motion *m, const double *x, const struct motion_jerk_met
     else
         for (int d = 0; d < JERK_DIM; d++)
             j->last[d] = j->sum[d] / j->n;
-    /* the window's middle sample: where the mean lies on the path */
-    j->last_meta = j->meta[(j->head + j->n / 2) % j->n];
+    /* the window's middle sample: where the mean lies on the path; at rest, where the
+     * leader is (the mean is there too): what the leader passed standing there is reached,
+     * so a spindle started at a stop is out before the wait for its speed begins */
+    j->last_meta = j->still >= j->n - 1 ? *mt : j->meta[(j->head + j->n / 2) % j->n];
     scatter(m, j->last, &j->last_meta);
 }
 

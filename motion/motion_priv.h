@@ -281,7 +281,8 @@ struct motion {
                               * at-speed input is wired) */
     int at_speed;            /* the spindle's at-speed input this period */
     int waiting;             /* holding at a SEG_WAIT for the spindle */
-    long io_age;             /* periods since a spindle or coolant command last changed */
+    long io_age;             /* periods since a spindle or coolant command last changed and
+                              * went out (motion_out.spindle: with jerk limits, later) */
     int wait_tool;           /* plan a wait at M6 (motion_hal: tool-changed is wired) */
     struct motion_tool tool; /* tool change requests and the tool in the spindle */
     bool din[MOTION_MAX_DIO];  /* motion.digital-in-NN this period */

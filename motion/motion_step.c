@@ -767,7 +767,13 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
     out->feed_override = m->rate;
     out->settings_done = m->marks_base + m->marks_done;
-    out->spindle = m->jerk ? m->io_out : m->io;
+    /* (with jerk limits the spindle gets a command when the average reaches it: the wait
+     * for it at speed counts from then, not from when the executor passed it) */
+    struct motion_spindle sp = m->jerk ? m->io_out : m->io;
+    if (sp.dir != m->io.dir || sp.rpm != m->io.rpm || sp.mist != m->io.mist ||
+        sp.flood != m->io.flood)
+        m->io_age = 0;
+    out->spindle = sp;
     out->spindle_index = m->index_out;
     m->index_out = 0;
     out->waiting = m->waiting;
