@@ -31,8 +31,9 @@
  * parked on a probe trip) only once the mean has settled on the leader. Spindle-synchronised
  * moves (G33, G33.1) bypass the mean: their jerk is the spindle's. The outputs M62..M68
  * and the spindle's and coolant's commands (M3 M4 M5 S, M7 M8 M9) switch with the mean too,
- * where the tool reaches them on the path, not T/2 ahead of it; the executor's own logic (a
- * wait for the spindle at speed, a tap's reversal) goes by the leader's, as the plan does.
+ * where the tool reaches them on the path, not T/2 ahead of it (at rest, at once). The
+ * executor's own logic goes by the leader's, but for a wait for the spindle at speed, which
+ * counts from when motion_out gives the spindle the command (motion_step.c).
  */
 
 /* Values averaged, in this order: pose, pose rate, path pose, legs, leg rates, path speed,
