@@ -90,6 +90,19 @@ START_TEST(test_leg_limits_not_needless)
 }
 END_TEST
 
+/* The TMU hexapod where the legs bind, with leg-bound G61 program k (tm_leg_bound_points)
+ * at F30000 loaded; its points into *pts, their number returned. */
+static int load_leg_bound(struct tm_machine *mc, struct canon_prog *p, int k,
+                          const double (**pts)[6])
+{
+    ck_assert_int_eq(tm_open(mc, tm_leg_bound_hexapod_cfg(), &kins_hexapod_ops), 0);
+    int n = tm_leg_bound_points(k, pts);
+    tm_g61_points(p, *pts, n, 30000);
+    char err[512] = "";
+    ck_assert_msg(motion_load(mc->m, p, err, sizeof err) == MOTION_OK, "load: %s", err);
+    return n;
+}
+
 /* Where the legs bind (bench_topp's machine and G61 programs), the planned time is within
  * 4.5 % of the time-optimal one: the TOPP-RA reference bench_topp computes for the same
  * path and limits, 11.5910 s and 6.0341 s (4000 grid intervals per move). Run at the
@@ -101,13 +114,9 @@ START_TEST(test_leg_bound_time_near_optimal)
     static const double topp_s[2] = { 11.5910, 6.0341 };
     for (int k = 0; k < 2; k++) {
         struct tm_machine mc;
-        ck_assert_int_eq(tm_open(&mc, tm_leg_bound_hexapod_cfg(), &kins_hexapod_ops), 0);
-        const double (*pts)[6];
-        int n = tm_leg_bound_points(k, &pts);
         struct canon_prog p;
-        tm_g61_points(&p, pts, n, 30000);
-        char err[512] = "";
-        ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "load: %s", err);
+        const double (*pts)[6];
+        int n = load_leg_bound(&mc, &p, k, &pts);
         struct motion_plan_info info;
         motion_plan_info(mc.m, &info);
         printf("leg-bound G61 program %d: planned %.4f s, %.4fx the time-optimal %.4f s\n",
@@ -146,14 +155,9 @@ START_TEST(test_leg_limits_under_changing_override)
     for (int k = 0; k < 2; k++)
         for (size_t w = 0; w < sizeof walks / sizeof walks[0]; w++) {
             struct tm_machine mc;
-            ck_assert_int_eq(tm_open(&mc, tm_leg_bound_hexapod_cfg(), &kins_hexapod_ops), 0);
-            const double (*pts)[6];
-            int n = tm_leg_bound_points(k, &pts);
             struct canon_prog p;
-            tm_g61_points(&p, pts, n, 30000);
-            char err[512] = "";
-            ck_assert_msg(motion_load(mc.m, &p, err, sizeof err) == MOTION_OK, "load: %s",
-                          err);
+            const double (*pts)[6];
+            int n = load_leg_bound(&mc, &p, k, &pts);
             ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
             struct tm_stats s;
             tm_run(mc.m, DT, 1000000, &s, tm_override_hook, (void *)&walks[w]);
