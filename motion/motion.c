@@ -110,9 +110,7 @@ static void rewind_plan(struct motion *m)
     atomic_store(&m->input_seq, 0);
     motion_probe_reset(m);
     atomic_store(&m->probe_seq, 0);
-    if (m->sync.index_asked)
-        m->index_out = -1;   /* a wait for the index given up */
-    m->sync.index_asked = 0;
+    motion_sync_index_withdraw(m);
     m->sync.phase = SYNC_IDLE;
     m->line = m->run && m->run->nseg ? m->run->segs[0].line : 0;
     m->file = m->run && m->run->nseg ? m->run->segs[0].file : NULL;

@@ -436,6 +436,9 @@ bool motion_sync_at(const struct motion *m, double *s, double *v);
 /* Whether the spindle drives the path now (following it, or a tap's own moves between): the
  * jerk limiter's moving average stands aside, so the tool keeps its place on the thread. */
 bool motion_sync_direct(const struct motion *m);
+/* A synchronised move's request for the encoder's index (spindle.0.index-enable), if one
+ * is out, given up: the pin is cleared. */
+void motion_sync_index_withdraw(struct motion *m);
 
 /* Formats the instance's message (motion.c). */
 void motion_set_msg(struct motion *m, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

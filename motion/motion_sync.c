@@ -298,16 +298,23 @@ static bool sync_index(struct motion_sync *y, double revs)
     return true;
 }
 
+void motion_sync_index_withdraw(struct motion *m)
+{
+    if (m->sync.index_asked)
+        m->index_out = -1;
+    m->sync.index_asked = 0;
+}
+
 /* The index has not come while the spindle turned MOTION_INDEX_WAIT_REVS: the request is
  * withdrawn and the machine, at rest at the move's start, faults and says why. */
 static void index_missing(struct motion *m, const struct motion_seg *sg, double turned)
 {
-    m->index_out = -1;
-    m->sync.index_asked = 0;
+    motion_sync_index_withdraw(m);
     motion_set_msg(m, "%s:%d: the spindle turned %.1f revolutions with spindle.0.index-enable "
                    "set and the encoder never cleared it: no index pulse came (check the "
-                   "encoder's index signal and its wiring, or unconnect the pin to take the "
-                   "count's whole revolutions); the %s did not start, machine stopped",
+                   "encoder's index signal and its wiring; with the pin left unconnected, "
+                   "each pass starts at a whole revolution of the count instead); the %s did "
+                   "not start, machine stopped",
                    sg->file ? sg->file : "program", sg->line, turned,
                    sg->sync == CANON_SYNC_THREAD ? "G33 move" : "tap (G33.1)");
     m->rate = 0;
@@ -325,9 +332,7 @@ static bool sync_index_pin(struct motion *m, const struct motion_seg *sg, bool r
 {
     struct motion_sync *y = &m->sync;
     if (!ready) {
-        if (y->index_asked)
-            m->index_out = -1;
-        y->index_asked = 0;
+        motion_sync_index_withdraw(m);
         return false;
     }
     if (!y->index_asked) {
