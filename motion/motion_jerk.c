@@ -39,6 +39,7 @@
 /* Values averaged, in this order: pose, pose rate, path pose, legs, leg rates, path speed,
  * distance. */
 #define JERK_DIM (3 * KINS_POSE_DIM + 2 * KINS_MAX_JOINTS + 2)
+#define JERK_LEGS (3 * KINS_POSE_DIM)  /* where the legs begin in a sample */
 
 /* What is not averaged: the move being followed, delayed by half the window (where the mean
  * lies on the path). */
@@ -218,7 +219,7 @@ void motion_jerk_shift_leg(struct motion *m, int i, double shift)
     struct motion_jerk *j = m->jerk;
     if (!j)
         return;
-    int d = 3 * KINS_POSE_DIM + i;     /* the legs' place in a sample (gather) */
+    int d = JERK_LEGS + i;
     for (int k = 0; k < j->n; k++)
         j->ring[(size_t)k * JERK_DIM + (size_t)d] += shift;
     j->sum[d] += j->n * shift;
