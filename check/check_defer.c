@@ -25,9 +25,10 @@
 struct check_defer *check_defer_new(struct kins *k, const struct kins_tool_frame *tf,
                                     int cold_forward)
 {
-    struct check_defer *d = calloc(1, sizeof *d);
+    struct check_defer *d = aligned_alloc(alignof(struct check_defer), sizeof *d);
     if (!d)
         return NULL;
+    memset(d, 0, sizeof *d);
     d->kins = k;
     d->have_tf = tf != NULL;
     if (tf)
@@ -119,10 +120,6 @@ static void compute(const struct check_defer *d, struct check_defer_slot *s)
         struct kins_check ck;
         s->ok = kins_check_pose(d->kins, s->pose, &ck) == KINS_OK;
         s->value = s->ok ? ck.condition : 0;
-    } else if (s->kind == CHECK_DEFER_TIP) {
-        double tip[3];
-        tip_at(d, s->tool_len_mm, s->pose, tip);
-        s->value = motion_dist_seg(tip, s->t0, s->t1);
     }
     atomic_store_explicit(&s->state, CHECK_DEFER_DONE, memory_order_release);
 }
@@ -157,8 +154,7 @@ struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defe
     struct check_defer_slot *s = &d->slot[d->head_local % CHECK_DEFER_SLOTS];
     s->kind = kind;
     atomic_store_explicit(&s->state, kind == CHECK_DEFER_DEVIATION ||
-                          kind == CHECK_DEFER_CONDITION || kind == CHECK_DEFER_TIP
-                          ? CHECK_DEFER_WAITING : CHECK_DEFER_DONE, memory_order_relaxed);
+                          kind == CHECK_DEFER_CONDITION ? CHECK_DEFER_WAITING : CHECK_DEFER_DONE, memory_order_relaxed);
     return s;
 }
 

@@ -3,6 +3,7 @@
 #ifndef HEXCNC_CHECK_DEFER_H
 #define HEXCNC_CHECK_DEFER_H
 
+#include <stdalign.h>
 #include <stdatomic.h>
 #include <stddef.h>
 
@@ -14,9 +15,8 @@
 enum check_defer_kind {
     CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
     CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed */
-    CHECK_DEFER_TIP,                 /* the commanded tip against its move's line t0 t1:
-                                      * computed */
-    CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning */
+    CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning (value: the
+                                      * largest tip deviation the pass measured in the move) */
     CHECK_DEFER_MOVE,                /* a straight move's start: its line and file */
 };
 enum check_defer_state { CHECK_DEFER_WAITING, CHECK_DEFER_DONE };
@@ -29,20 +29,23 @@ enum check_defer_tip { CHECK_TIP_NONE, CHECK_TIP_LINE /* against the segment t0 
 /* One measure: what the pass took (written before commit, read-only after) and the result
  * (written by the thread that computes it, before `state` becomes DONE). */
 struct check_defer_slot {
-    _Atomic int state;               /* enum check_defer_state */
+    alignas(64) _Atomic int state;   /* enum check_defer_state (each slot on cache lines
+                                      * of its own: the helper writes one while the pass
+                                      * fills the next) */
     enum check_defer_kind kind;
     int line;                        /* the period's program line and file, machine time */
     const char *file;
+    long period;                     /* the period's index in the pass */
     double time_s, dist_mm;
     double pose[KINS_POSE_DIM];      /* this period's commanded pose */
     double p0[KINS_POSE_DIM];        /* deviation: the last period's, and both set points */
     double L0[KINS_MAX_JOINTS], L1[KINS_MAX_JOINTS];
     enum check_defer_tip tip_mode;
     double tool_len_mm;              /* the tool of the period, for the tip */
-    double t0[3], t1[3];             /* CHECK_TIP_LINE, _AXIS and TIP: the move's tip line */
+    double t0[3], t1[3];             /* CHECK_TIP_LINE and _AXIS: the move's tip line */
     int ok;                          /* result: the solve succeeded */
-    double value;                    /* deviation (mm), condition number, tip's (mm);
-                                      * MOVE: how far the planner may round the move, mm */
+    double value;                    /* deviation (mm), condition number; MOVE: how far the
+                                      * planner may round the move, mm; FLUSH: see above */
     double value2;                   /* deviation: the orientation's, deg */
     double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
 };
@@ -51,9 +54,12 @@ struct check_defer {
     struct kins *kins;               /* what the measures are computed with (read-only) */
     struct kins_tool_frame tf;
     int have_tf, cold_forward;
-    _Atomic size_t head;             /* slots committed (the pass writes) */
-    _Atomic size_t claim;            /* slots taken for computing (both, compare-and-swap) */
-    size_t head_local, apply;        /* the pass's own: committed, applied */
+    /* Each on a cache line of its own: a line both threads write goes back and forth
+     * between the cores at every write, and the pass commits a slot every few periods. */
+    alignas(64) _Atomic size_t head; /* slots committed (the pass writes) */
+    alignas(64) _Atomic size_t claim;/* slots taken for computing (both, compare-and-swap) */
+    alignas(64) size_t head_local;   /* the pass's own: committed, applied */
+    size_t apply;
     struct check_defer_slot slot[CHECK_DEFER_SLOTS];
 };
 

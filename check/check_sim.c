@@ -30,6 +30,7 @@ struct sim {
     double len_lo[KINS_MAX_JOINTS];    /* the legs' length range */
     double len_hi[KINS_MAX_JOINTS];
     double min_mm[KINS_MAX_JOINTS], max_mm[KINS_MAX_JOINTS];     /* the legs' figures so far */
+    double over[KINS_MAX_JOINTS];      /* this period: how many of its limits each leg is over */
     double peak_vel[KINS_MAX_JOINTS], peak_acc[KINS_MAX_JOINTS], peak_jerk[KINS_MAX_JOINTS];
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
     int line;                          /* program line of the previous period */
@@ -44,6 +45,14 @@ struct sim {
     int tip_fresh;                     /* the move began this period */
     int tip_swing;                     /* the move turns A B C (the tip may leave the line
                                         * the platform follows) and is not under G43.4 */
+    double move_tip_max;               /* the tip's largest deviation measured in place in
+                                        * the move being followed (its FLUSH carries it) */
+    double tip_max;                    /* the largest measured in place, its line and period */
+    int tip_max_line;
+    long tip_max_period;
+    double def_tip_max;                /* the largest of the deviations' tips (applied in */
+    int def_tip_line;                  /* order), its line and period */
+    long def_tip_period;
     double blk_tip_max;                /* the tip's largest deviation in this move, its line */
     double blk_tip_tol;                /* and how far the planner may round the move, mm */
     int blk_tip_line;
@@ -108,12 +117,16 @@ static __attribute__((noinline)) void legs_report(struct sim *s, const struct mo
 
 /* Leg lengths, rates from successive set points and accelerations from successive rates.
  * This runs every period: arithmetic and comparisons on the pass's own arrays (the figures
- * go into the result at the end, check_simulate), the reports out of line. */
-static void legs_period(struct sim *s, const struct motion_out *out)
+ * go into the result at the end, check_simulate), which the compiler runs two legs at a
+ * time (each leg's count of limits over goes into an array: an `or` across the legs would
+ * keep the loop from being vectorised); whether any leg is over, for the reports out of
+ * line. */
+static __attribute__((noinline)) int legs_period(struct sim *restrict s,
+                                                 const double *restrict Lp)
 {
-    int over = 0;
-    for (int i = 0; i < s->nj; i++) {
-        double L = out->joint_pos[i], v = (L - s->L0[i]) * s->inv_T;
+    int n = s->nj;
+    for (int i = 0; i < n; i++) {
+        double L = Lp[i], v = (L - s->L0[i]) * s->inv_T;
         double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
         double aj = fabs(a - s->a0[i]) * s->inv_T;
         s->min_mm[i] = L < s->min_mm[i] ? L : s->min_mm[i];
@@ -121,14 +134,17 @@ static void legs_period(struct sim *s, const struct motion_out *out)
         s->peak_vel[i] = av > s->peak_vel[i] ? av : s->peak_vel[i];
         s->peak_acc[i] = aa > s->peak_acc[i] ? aa : s->peak_acc[i];
         s->peak_jerk[i] = aj > s->peak_jerk[i] ? aj : s->peak_jerk[i];
-        over |= (L > s->len_hi[i]) | (L < s->len_lo[i]) | (av > s->vel_thr[i]) |
-                (aa > s->acc_thr[i]) | (aj > s->jerk_thr[i]);
+        s->over[i] = (L > s->len_hi[i] ? 1.0 : 0.0) + (L < s->len_lo[i] ? 1.0 : 0.0) +
+                     (av > s->vel_thr[i] ? 1.0 : 0.0) + (aa > s->acc_thr[i] ? 1.0 : 0.0) +
+                     (aj > s->jerk_thr[i] ? 1.0 : 0.0);
         s->v0[i] = v;
         s->a0[i] = a;
         s->jerk[i] = aj;
     }
-    if (over)
-        legs_report(s, out);
+    int over = 0;
+    for (int i = 0; i < n; i++)
+        over |= s->over[i] != 0;
+    return over;
 }
 
 /* The pass's leg figures into the result. */
@@ -177,15 +193,23 @@ static void tip_flush(struct sim *s)
 static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind kind,
                                          const struct motion_out *out);
 
+/* The end of the move being followed, in order with the measures: its tip warning, with the
+ * largest deviation measured in place. */
+static void tip_end_move(struct sim *s, const struct motion_out *out)
+{
+    struct check_defer_slot *q = slot_for(s, CHECK_DEFER_FLUSH, out);
+    q->value = s->move_tip_max;
+    check_defer_commit(s->dq);
+    s->move_tip_max = 0;
+}
+
 /* The straight feed being followed: its tip line (from the kinematics' tool at its ends, or
  * the programmed tip under G43.4), computed once per move. */
 static void tip_move(struct sim *s, const struct motion_out *out)
 {
     if (out->seg_kind != 1) {
-        if (s->tip_line) {
-            slot_for(s, CHECK_DEFER_FLUSH, out);
-            check_defer_commit(s->dq);
-        }
+        if (s->tip_line)
+            tip_end_move(s, out);
         s->tip_line = 0;
         return;
     }
@@ -193,10 +217,8 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     if (s->tip_line && !memcmp(s->tip_key, out->seg_from, sizeof s->tip_key))
         return;
     s->tip_fresh = 1;
-    if (s->tip_line) {
-        slot_for(s, CHECK_DEFER_FLUSH, out);
-        check_defer_commit(s->dq);
-    }
+    if (s->tip_line)
+        tip_end_move(s, out);
     s->tip_line = 1;
     memcpy(s->tip_key, out->seg_from, sizeof s->tip_key);
     if (out->tcp) {
@@ -214,29 +236,43 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     check_defer_commit(s->dq);
 }
 
-/* The tip's deviation d at program line `line`, into the figures. */
-static void tip_record(struct sim *s, int line, double d)
+/* A deviation's tip d at program line `line`, in order, into the figures. */
+static void tip_record(struct sim *s, int line, long period, double d)
 {
-    struct check_result *r = s->r;
-    if (d > r->max_tip_deviation_mm)
-        r->max_tip_deviation_mm = d, r->max_tip_deviation_line = line;
+    if (d > s->def_tip_max)
+        s->def_tip_max = d, s->def_tip_line = line, s->def_tip_period = period;
     if (d > s->blk_tip_max)
         s->blk_tip_max = d;
 }
 
 /* Every period of a straight feed that turns A B C without G43.4: the commanded tip against
- * the line between the tip's positions at the move's ends (applied in order with the
- * deviations' tips, which measure the same move). */
+ * the line between the tip's positions at the move's ends. Measured here, in place: a
+ * rotation and a distance cost less than a slot of the ring every period. */
 static void tip_period(struct sim *s, const struct motion_out *out)
 {
     tip_move(s, out);
     if (!s->tip_line || !s->tip_swing)
         return;
-    struct check_defer_slot *q = slot_for(s, CHECK_DEFER_TIP, out);
-    q->tool_len_mm = out->tcp ? out->tool_len_mm : s->tf.length_mm;
-    memcpy(q->t0, s->tip_t0, sizeof q->t0);
-    memcpy(q->t1, s->tip_t1, sizeof q->t1);
-    check_defer_commit(s->dq);
+    double tip[3];
+    tip_of(s, out, out->pose, tip);
+    double d = motion_dist_seg(tip, s->tip_t0, s->tip_t1);
+    if (d > s->move_tip_max)
+        s->move_tip_max = d;
+    if (d > s->tip_max)
+        s->tip_max = d, s->tip_max_line = out->line, s->tip_max_period = s->r->periods;
+}
+
+/* The tip's figure: the larger of the two maxima, the earlier on a tie (in a period, the
+ * tip is measured before its deviation), as one pass in order would find it. */
+static void tip_figure(const struct sim *s)
+{
+    struct check_result *r = s->r;
+    double v = s->def_tip_max;
+    int line = s->def_tip_line;
+    if (s->tip_max > v || (s->tip_max == v && s->tip_max_period <= s->def_tip_period))
+        v = s->tip_max, line = s->tip_max_line;
+    if (v > r->max_tip_deviation_mm)
+        r->max_tip_deviation_mm = v, r->max_tip_deviation_line = line;
 }
 
 /* Kinematic deviation between the previous set point and this one (check_defer.c computes
@@ -275,7 +311,7 @@ static void deviation_result(struct sim *s, const struct check_defer_slot *q)
     if (s->o->trace)
         check_trace_deviation(s->o->trace, q->dist_mm, q->time_s, q->value);
     if (q->tip_mode != CHECK_TIP_NONE)
-        tip_record(s, q->line, q->tip);
+        tip_record(s, q->line, q->period, q->tip);
 }
 
 /* A condition number's result against [KINS] SINGULAR_CONDITION, in order. */
@@ -307,8 +343,10 @@ static void apply(struct sim *s, const struct check_defer_slot *q)
     switch (q->kind) {
     case CHECK_DEFER_DEVIATION: deviation_result(s, q); break;
     case CHECK_DEFER_CONDITION: singularity(s, q); break;
-    case CHECK_DEFER_TIP: tip_record(s, q->line, q->value); break;
-    case CHECK_DEFER_FLUSH: tip_flush(s); break;
+    case CHECK_DEFER_FLUSH:
+        s->blk_tip_max = fmax(s->blk_tip_max, q->value);
+        tip_flush(s);
+        break;
     case CHECK_DEFER_MOVE:
         s->blk_tip_line = q->line, s->blk_tip_file = q->file, s->blk_tip_tol = q->value;
         break;
@@ -321,7 +359,7 @@ static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind ki
     struct check_defer_slot *q;
     while (!(q = check_defer_push(s->dq, kind)))
         apply(s, check_defer_next(s->dq, 1));
-    q->line = out->line, q->file = out->file;
+    q->line = out->line, q->file = out->file, q->period = s->r->periods;
     q->time_s = out->time_elapsed_s, q->dist_mm = out->distance_done_mm;
     memcpy(q->pose, out->pose, sizeof q->pose);
     return q;
@@ -451,7 +489,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         }
         st = motion_step(mc->motion, s.T, &out);
         r->periods++;
-        legs_period(&s, &out);
+        if (legs_period(&s, out.joint_pos))
+            legs_report(&s, &out);
         if (s.have_tf)
             tip_period(&s, &out);
         measures(&s, &out);
@@ -469,11 +508,10 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     }
     motion_set_rates(mc->motion, true);
     legs_figures(&s);
-    if (s.tip_line) {
-        slot_for(&s, CHECK_DEFER_FLUSH, &out);
-        check_defer_commit(s.dq);
-    }
+    if (s.tip_line)
+        tip_end_move(&s, &out);
     drain(&s);
+    tip_figure(&s);
     check_defer_free(own);
     r->machining_time_s = out.time_elapsed_s;
     r->length_mm = out.distance_total_mm;
