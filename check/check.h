@@ -85,6 +85,9 @@ struct check_opts {
                                       * servo period */
     int cold_forward;                /* 1: forward kinematics started from home each time
                                       * (for comparison; the default warm start is faster) */
+    int solve_every_condition;       /* 1: every condition number solved (for comparison;
+                                      * by default a bound from the last one solved answers
+                                      * where solving could change nothing) */
     struct check_trace *trace;       /* optional: filled with samples for plots */
 };
 /* The defaults: deviation every 50 ms, condition number every 500 ms, and both at every change
@@ -130,6 +133,9 @@ struct check_result {
     int max_condition_line;
     double condition_limit;          /* [KINS] SINGULAR_CONDITION */
     long condition_evals;
+    long condition_bounded;          /* of them, answered by a bound from the last one solved
+                                      * (check_sim.c: it could change neither the largest
+                                      * nor the verdict) */
     double deviation_every_s, condition_every_s; /* the schedule used */
     double servo_cpu_s;              /* CPU time of the servo-rate pass's thread, s */
     double plan_cpu_s;               /* CPU time of the reach pass and the planner, s (a

@@ -117,9 +117,14 @@ static void compute(const struct check_defer *d, struct check_defer_slot *s)
     if (s->kind == CHECK_DEFER_DEVIATION) {
         deviation(d, s);
     } else if (s->kind == CHECK_DEFER_CONDITION) {
-        struct kins_check ck;
-        s->ok = kins_check_pose(d->kins, s->pose, &ck) == KINS_OK;
-        s->value = s->ok ? ck.condition : 0;
+        s->has_m = d->kins->ops->condition_matrix != NULL;
+        if (s->has_m) {            /* the pass solves it only where no bound answers */
+            s->ok = kins_condition_matrix(d->kins, s->pose, s->m) == KINS_OK;
+        } else {
+            struct kins_check ck;
+            s->ok = kins_check_pose(d->kins, s->pose, &ck) == KINS_OK;
+            s->value = s->ok ? ck.condition : 0;
+        }
     }
     atomic_store_explicit(&s->state, CHECK_DEFER_DONE, memory_order_release);
 }

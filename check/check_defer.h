@@ -9,12 +9,15 @@
 
 #include "check/check_priv.h"
 
-#define CHECK_DEFER_SLOTS 16384      /* measures in flight (6 MB): what the pass takes while
-                                      * the planner plans a window (about 10 ms) */
+#define CHECK_DEFER_SLOTS 8192       /* measures in flight (7 MB): several times what the
+                                      * pass takes while the planner plans a window (about
+                                      * 10 ms, 40 s of machine time, 3000 measures on dense
+                                      * code) */
 
 enum check_defer_kind {
     CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
-    CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed */
+    CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed, or the
+                                      * matrix it is of (has_m), which the pass bounds */
     CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning (value: the
                                       * largest tip deviation the pass measured in the move) */
     CHECK_DEFER_MOVE,                /* a straight move's start: its line and file */
@@ -48,6 +51,9 @@ struct check_defer_slot {
                                       * planner may round the move, mm; FLUSH: see above */
     double value2;                   /* deviation: the orientation's, deg */
     double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
+    int has_m;                       /* condition: m holds the kinematics' condition matrix
+                                      * (kins_condition_matrix), value nothing */
+    double m[KINS_MAX_JOINTS * KINS_POSE_DIM];
 };
 
 struct check_defer {

@@ -111,7 +111,8 @@ void check_print_json(const struct check_result *r, FILE *f)
     fprintf(f, ",\"line\":%d", r->max_condition_line);
     json_field(f, "limit", r->condition_limit, 0);
     json_field(f, "every_s", r->condition_every_s, 0);
-    fprintf(f, ",\"evaluations\":%ld}", r->condition_evals);
+    fprintf(f, ",\"evaluations\":%ld,\"bounded\":%ld}", r->condition_evals,
+            r->condition_bounded);
     json_legs(r, f);
     json_problems("problems", r->problems, r->nproblems, f);
     json_problems("warnings", r->warnings, r->nwarnings, f);

@@ -7,9 +7,12 @@
 #include "check/check_defer.h"
 #include "check/check_priv.h"
 #include "check/plot.h"
+#include "kins/kins_svd.h"
 
 #define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
 #define MAX_PERIODS_FACTOR 2 /* the run stops at twice the planned time (a stuck planner) */
+#define CHECK_COND_BOUND_MARGIN 1e-9  /* relative to the largest singular value: what the
+                                       * condition bound adds for the solver's rounding */
 
 /* State of the pass between periods. */
 struct sim {
@@ -59,6 +62,9 @@ struct sim {
     const char *blk_tip_file;
     long trace_every, trace_count;
     struct check_defer *dq;            /* the costly measures, applied in order */
+    int have_ref;                      /* a condition matrix solved exactly: the bound's */
+    double ref_m[KINS_MAX_JOINTS * KINS_POSE_DIM];   /* reference, its extreme singular */
+    double ref_smax, ref_smin;         /* values */
 };
 
 static void drain(struct sim *s);
@@ -314,6 +320,45 @@ static void deviation_result(struct sim *s, const struct check_defer_slot *q)
         tip_record(s, q->line, q->period, q->tip);
 }
 
+/* Whether the condition number of slot q's matrix is bounded by the last one solved at or
+ * below both the largest so far and the limit, so that solving it could change nothing.
+ * Weyl: each singular value of M moves by at most ||M - M_ref||_2 <= ||M - M_ref||_F = e,
+ * so cond(M) <= (smax_ref + e) / (smin_ref - e). The margin covers the solver's rounding
+ * (relative 1e-14 here) many times over. */
+static int condition_bounded(const struct sim *s, const struct check_defer_slot *q)
+{
+    if (!s->have_ref)
+        return 0;
+    double e2 = 0;
+    for (int i = 0; i < s->nj * KINS_POSE_DIM; i++)
+        e2 += (q->m[i] - s->ref_m[i]) * (q->m[i] - s->ref_m[i]);
+    double e = sqrt(e2) + CHECK_COND_BOUND_MARGIN * s->ref_smax, lo = s->ref_smin - e;
+    if (!(lo > 0))
+        return 0;
+    double bound = (s->ref_smax + e) / lo;
+    return bound <= s->r->max_condition && bound <= s->r->condition_limit;
+}
+
+/* The condition number of slot q: its value, or its matrix solved (which becomes the
+ * bound's reference); -1 when a bound shows it can change nothing. */
+static double condition_of(struct sim *s, const struct check_defer_slot *q)
+{
+    if (!q->has_m)
+        return q->value;
+    if (!s->o->solve_every_condition && condition_bounded(s, q)) {
+        s->r->condition_bounded++;
+        return -1;
+    }
+    double smax, smin, cond;
+    int nm = s->nj * KINS_POSE_DIM;
+    s->have_ref = kins_svd_extremes(q->m, s->nj, KINS_POSE_DIM, &smax, &smin, &cond) == 0;
+    if (!s->have_ref)
+        return INFINITY;
+    memcpy(s->ref_m, q->m, (size_t)nm * sizeof *s->ref_m);
+    s->ref_smax = smax, s->ref_smin = smin;
+    return cond;
+}
+
 /* A condition number's result against [KINS] SINGULAR_CONDITION, in order. */
 static void singularity(struct sim *s, const struct check_defer_slot *q)
 {
@@ -321,19 +366,20 @@ static void singularity(struct sim *s, const struct check_defer_slot *q)
     if (!q->ok)
         return;
     r->condition_evals++;
-    if (q->value > r->max_condition)
-        r->max_condition = q->value, r->max_condition_line = q->line;
-    if (!(q->value > r->condition_limit))
+    double value = condition_of(s, q);
+    if (value > r->max_condition)
+        r->max_condition = value, r->max_condition_line = q->line;
+    if (!(value > r->condition_limit))
         return;
     const double *P = q->pose;
     struct check_problem p = { .kind = CHECK_SINGULAR, .line = q->line, .leg = -1,
-                               .value = q->value, .limit = r->condition_limit,
+                               .value = value, .limit = r->condition_limit,
                                .time_s = q->time_s, .count = 1 };
     snprintf(p.file, sizeof p.file, "%s", q->file ? q->file : "");
     snprintf(p.message, sizeof p.message, "the machine comes close to a singular pose at X%.3f "
              "Y%.3f Z%.3f A%.3f B%.3f C%.3f: condition number %.1f above %.1f ([KINS] "
              "SINGULAR_CONDITION); it loses stiffness and accuracy there", P[0], P[1], P[2],
-             P[3], P[4], P[5], q->value, r->condition_limit);
+             P[3], P[4], P[5], value, r->condition_limit);
     check_add_problem(r, &p);
 }
 

@@ -315,6 +315,21 @@ static int hexapod_check(struct kins *k, const double pose[KINS_POSE_DIM],
     return KINS_OK;
 }
 
+/* The matrix hexapod_check takes the condition number of: the Jacobian with the angle
+ * columns scaled by the lever arm. */
+static int hexapod_condition_matrix(struct kins *k, const double pose[KINS_POSE_DIM],
+                                    double *m)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    struct hexapod_rot o;
+    struct hexapod_legs lg;
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
+        return KINS_ERR_ARG;
+    for (int i = 0; i < HEXAPOD_LEGS; i++)
+        hexapod_jac_row(&o, &lg, i, h->inv_char_len, &m[i * KINS_POSE_DIM]);
+    return KINS_OK;
+}
+
 /* Tool tip in both frames: one is fixed by configuration, the other follows the pose. */
 static int hexapod_tool_point(struct kins *k, const double pose[KINS_POSE_DIM],
                               double tip_base_mm[3], double tip_platform_mm[3])
@@ -419,6 +434,7 @@ const struct kins_ops kins_hexapod_ops = {
     .inverse_rates = hexapod_inverse_rates,
     .inverse_path = hexapod_inverse_path,
     .jacobian = hexapod_jacobian,
+    .condition_matrix = hexapod_condition_matrix,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

@@ -113,6 +113,12 @@ struct kins_ops {
      * mm/deg), analytic. Statuses as inverse (written whatever the reach). NULL: the planner
      * differences the inverse. */
     int (*jacobian)(struct kins *k, const double pose[KINS_POSE_DIM], double *jac);
+    /* Optional: the matrix whose condition number `check` reports, row-major njoints x 6
+     * (the hexapod's: its Jacobian with the angle columns scaled by the lever arm), cheaply,
+     * so that a caller can bound the number between poses (kins_svd_extremes). Statuses:
+     * KINS_ERR_ARG for a pose that is not a number, else KINS_OK whatever the reach. NULL:
+     * no bound; check each pose. */
+    int (*condition_matrix)(struct kins *k, const double pose[KINS_POSE_DIM], double *m);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -174,6 +180,10 @@ static inline int kins_tool_point(struct kins *k, const double *pose, double *ti
                                   double *tip_platform_mm)
 { return k->ops->tool_point ? k->ops->tool_point(k, pose, tip_base_mm, tip_platform_mm)
                             : KINS_ERR_ARG; }
+
+/* The matrix of kins_ops.condition_matrix; KINS_ERR_ARG when the model has none. */
+static inline int kins_condition_matrix(struct kins *k, const double *pose, double *m)
+{ return k->ops->condition_matrix ? k->ops->condition_matrix(k, pose, m) : KINS_ERR_ARG; }
 
 /* The model's tool frame; KINS_ERR_ARG when it has none. */
 static inline int kins_get_tool_frame(struct kins *k, struct kins_tool_frame *out)

@@ -12,6 +12,12 @@ extern "C" {
  * Gram matrix; relative error below 1e-8, the SVD where the condition passes 1e4). Not for
  * the servo hot path. */
 int kins_svd_condition(const double *m, int rows, int cols, double *cond);
+/* The same, with the largest and smallest singular values (cond is the same bits as
+ * kins_svd_condition's). By Weyl's inequality a singular value of m + E lies within the
+ * spectral norm of E (at most its Frobenius norm) of m's: what a caller bounds the
+ * condition number of a nearby matrix with. */
+int kins_svd_extremes(const double *m, int rows, int cols, double *smax, double *smin,
+                      double *cond);
 
 #ifdef __cplusplus
 }

@@ -149,6 +149,8 @@ struct motion_chunk {
     struct motion_plan plan;
     size_t k_enter, s_enter; /* where the executor enters: knot and its segment */
     size_t k_leave, s_leave; /* where it leaves for the successor: knot and its segment */
+    double t_leave_s;        /* plan.kt[k_leave] (0 without knots): the executor reads it
+                              * every period, a cache line away from the knots' array */
     int last;                /* holds the program's end: no successor, run to the end */
     int sync;                /* ends at rest on an M66 wait: the interpreter reads on once the
                               * machine has its answer; the successor starts at rest there */

@@ -585,9 +585,12 @@ static void pass_marks(struct motion *m)
     pass_marks_to(m, reached_seg(m));
 }
 
-static void pass_ios(struct motion *m)
+static inline void pass_ios(struct motion *m)
 {
-    pass_ios_to(m, reached_seg(m));
+    size_t reached = reached_seg(m);   /* (most periods have none to pass: tested here) */
+    const struct motion_plan *p = m->run;
+    if (m->ios_done < p->nios && p->ios[m->ios_done].at <= reached)
+        pass_ios_to(m, reached);
 }
 
 void motion_set_inputs(struct motion *m, const bool *din, int nd, const double *ain, int na)
@@ -685,7 +688,7 @@ static void stream_watch(struct motion *m)
                    !atomic_load_explicit(&c->next, memory_order_acquire) ? c : NULL;
         else if (!c->last && !m->tail_taken &&
                  !atomic_load_explicit(&c->next, memory_order_acquire) &&
-                 c->plan.kt[c->k_leave] - m->tau_s < 0.25)
+                 c->t_leave_s - m->tau_s < 0.25)
             wait = c;
     }
     atomic_store_explicit(&m->stream_wait, wait, memory_order_release);
@@ -769,11 +772,11 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->settings_done = m->marks_base + m->marks_done;
     /* (with jerk limits the spindle gets a command when the average reaches it: the wait
      * for it at speed counts from then, not from when the executor passed it) */
-    struct motion_spindle sp = m->jerk ? m->io_out : m->io;
-    if (sp.dir != m->io.dir || sp.rpm != m->io.rpm || sp.mist != m->io.mist ||
-        sp.flood != m->io.flood)
+    const struct motion_spindle *sp = m->jerk ? &m->io_out : &m->io;
+    if (sp->dir != m->io.dir || sp->rpm != m->io.rpm || sp->mist != m->io.mist ||
+        sp->flood != m->io.flood)
         m->io_age = 0;
-    out->spindle = sp;
+    out->spindle = *sp;
     out->spindle_index = m->index_out;
     m->index_out = 0;
     out->waiting = m->waiting;

@@ -348,6 +348,7 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     c->s_enter = s_enter;
     c->k_leave = k_leave;
     c->s_leave = s_leave;
+    c->t_leave_s = p->nknot ? p->kt[k_leave] : 0;
     c->last = final && !sync;
     c->sync = sync;
     c->t0_s = s->t_done_s;

@@ -149,6 +149,76 @@ START_TEST(test_near_singular_pose)
 }
 END_TEST
 
+/* A wandering five-axis program of n short blocks (X Y Z A B C on each), run twice over,
+ * written to path. */
+static void write_wander(const char *path, int n)
+{
+    FILE *f = fopen(path, "w");
+    ck_assert(f != NULL);
+    fprintf(f, "G21 G90 G64 P0.01\nG1 X0 Y0 Z645 A0 B0 C0 F2000\n");
+    for (int j = 0; j <= 2 * n; j++) {
+        int i = j <= n ? j : 2 * n - j;  /* out and back along the same poses */
+        double t = 0.004 * i;
+        fprintf(f, "X%.4f Y%.4f Z%.4f A%.4f B%.4f C%.4f\n", 60 * sin(t), 45 * sin(1.7 * t),
+                645 + 15 * sin(0.9 * t), 9 * sin(1.3 * t), 8 * cos(1.1 * t) - 8,
+                12 * sin(0.7 * t));
+    }
+    fprintf(f, "M2\n");
+    fclose(f);
+}
+
+/* The condition number between poses: a bound from the last one solved (Weyl) answers most
+ * measures, and the check finds exactly what solving every one finds: the largest, its
+ * line, and on a machine whose limit the path crosses, every problem with its value. */
+START_TEST(test_condition_bound)
+{
+    char path[] = "/tmp/hexcnc_wanderXXXXXX";
+    int fd = mkstemp(path);
+    ck_assert(fd >= 0);
+    close(fd);
+    write_wander(path, 2000);
+    static const char *inis[] = { TMU_INI, "tests/check/tmu-singular.ini" };
+    for (int k = 0; k < 2; k++) {
+        struct check_opts o;
+        struct check_result a, b;
+        check_opts_default(&o);
+        int sa = run(inis[k], path, &o, &a);
+        o.solve_every_condition = 1;
+        int sb = run(inis[k], path, &o, &b);
+        ck_assert_int_eq(sa, sb);
+        ck_assert_int_eq(b.condition_bounded, 0);
+        ck_assert_int_eq(a.condition_evals, b.condition_evals);
+        ck_assert_msg(a.condition_evals > 200, "%ld measures", a.condition_evals);
+        ck_assert(a.max_condition == b.max_condition);
+        ck_assert_int_eq(a.max_condition_line, b.max_condition_line);
+        ck_assert_uint_eq(a.nproblems, b.nproblems);
+        size_t singular = 0;
+        for (size_t i = 0; i < a.nproblems; i++) {
+            const struct check_problem *p = &a.problems[i], *q = &b.problems[i];
+            ck_assert_int_eq(p->kind, q->kind);
+            ck_assert_int_eq(p->line, q->line);
+            ck_assert_int_eq(p->count, q->count);
+            ck_assert(p->value == q->value);
+            singular += p->kind == CHECK_SINGULAR;
+        }
+        printf("condition bound on %s: %ld of %ld measures bounded, largest %.4f at line %d, "
+               "%zu singular problems\n", inis[k], a.condition_bounded, a.condition_evals,
+               a.max_condition, a.max_condition_line, singular);
+        if (k == 0) {            /* well within the limit: most measures need no solving
+                                  * (on the way back, none) */
+            ck_assert_uint_eq(singular, 0);
+            ck_assert_msg(a.condition_bounded > a.condition_evals / 2, "%ld of %ld",
+                          a.condition_bounded, a.condition_evals);
+        } else {                 /* the limit is crossed: those are solved and reported */
+            ck_assert(singular > 10);
+        }
+        check_result_free(&a);
+        check_result_free(&b);
+    }
+    unlink(path);
+}
+END_TEST
+
 START_TEST(test_interpreter_error)
 {
     struct check_result r;
@@ -418,6 +488,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_leg_speed_over_drive_limit);
     tcase_add_test(tc, test_leg_acceleration_over_drive_limit);
     tcase_add_test(tc, test_near_singular_pose);
+    tcase_add_test(tc, test_condition_bound);
     tcase_add_test(tc, test_interpreter_error);
     tcase_add_test(tc, test_deviation_measure);
     tcase_add_test(tc, test_json_and_exit_status);

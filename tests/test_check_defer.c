@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "check/check_defer.h"
+#include "kins/kins_svd.h"
 #include "tests/test_check_util.h"
 
 #define TMU_INI "configs/sim/tmu-hexapod.ini"
@@ -29,12 +30,21 @@ static void *help(void *arg)
     return NULL;
 }
 
-/* Measure i along a wandering path (a deviation, a condition number or a move's end, by
- * turns); its line is i, so the order it comes back in shows. */
+/* The pose of measure i along a wandering path. */
+static void pose_of(int i, double pose[6])
+{
+    double a = 1e-3 * i;
+    double p[6] = { 40 * sin(a), 30 * cos(1.3 * a), 640 + 5 * sin(0.7 * a), 5 * sin(0.9 * a),
+                    4 * cos(1.1 * a), 6 * sin(0.5 * a) };
+    memcpy(pose, p, sizeof p);
+}
+
+/* Measure i (a deviation, a condition number or a move's end, by turns); its line is i, so
+ * the order it comes back in shows. */
 static void fill(struct check_defer_slot *q, struct kins *k, int i)
 {
-    double a = 1e-3 * i, pose[6] = { 40 * sin(a), 30 * cos(1.3 * a), 640 + 5 * sin(0.7 * a),
-                                     5 * sin(0.9 * a), 4 * cos(1.1 * a), 6 * sin(0.5 * a) };
+    double pose[6];
+    pose_of(i, pose);
     q->line = i, q->file = "t.ngc", q->time_s = 1e-3 * i, q->dist_mm = i;
     memcpy(q->pose, pose, sizeof pose);
     if (q->kind == CHECK_DEFER_DEVIATION) {
@@ -50,6 +60,18 @@ static void fill(struct check_defer_slot *q, struct kins *k, int i)
     } else if (q->kind == CHECK_DEFER_FLUSH) {
         q->value = i;                    /* nothing to compute: passed through as it is */
     }
+}
+
+/* What slot q gives: its value, or the condition number of its matrix (as the pass would
+ * solve it: the same bits as kins_check_pose's). */
+static double value_of(const struct check_defer_slot *q)
+{
+    double cond = -1;
+    if (q->kind != CHECK_DEFER_CONDITION || !q->has_m)
+        return q->value;
+    ck_assert(q->ok);
+    ck_assert_int_eq(kins_svd_condition(q->m, 6, KINS_POSE_DIM, &cond), 0);
+    return cond;
 }
 
 /* All measures through the ring, applied as they become ready (and when it is full), with a
@@ -72,15 +94,15 @@ static void run(struct kins *k, int with_helper, int *line, double *value, doubl
         struct check_defer_slot *s;
         while (!(s = check_defer_push(d, kind))) {
             q = check_defer_next(d, 1);
-            line[n] = q->line, value[n] = q->value, tip[n++] = q->tip;
+            line[n] = q->line, value[n] = value_of(q), tip[n++] = q->tip;
         }
         fill(s, k, i);
         check_defer_commit(d);
         while ((q = check_defer_next(d, 0)))
-            line[n] = q->line, value[n] = q->value, tip[n++] = q->tip;
+            line[n] = q->line, value[n] = value_of(q), tip[n++] = q->tip;
     }
     while ((q = check_defer_next(d, 1)))
-        line[n] = q->line, value[n] = q->value, tip[n++] = q->tip;
+        line[n] = q->line, value[n] = value_of(q), tip[n++] = q->tip;
     ck_assert_int_eq(n, MEASURES);
     if (with_helper) {
         atomic_store(&h.stop, 1);
@@ -111,8 +133,14 @@ START_TEST(test_defer_order_and_values)
                       v1[i], v2[i]);
         if (i % 3 == 0 && i % 5 < 2)
             ck_assert(t1[i] == t2[i]);
-        if (i % 3 == 1)
-            ck_assert(v1[i] > 1 && v1[i] < 50);   /* condition numbers of the TMU */
+        if (i % 3 == 1) {                         /* condition numbers of the TMU, as */
+            struct kins_check ck;                 /* the kinematics' check gives them */
+            ck_assert(v1[i] > 1 && v1[i] < 50);
+            double pose[6];
+            pose_of(i, pose);
+            ck_assert_int_eq(kins_check_pose(k, pose, &ck), KINS_OK);
+            ck_assert(v1[i] == ck.condition);
+        }
         if (i % 3 == 2)
             ck_assert(v1[i] == i);
     }

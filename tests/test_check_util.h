@@ -11,7 +11,10 @@
 static inline const char *tc_path(const char *rel, char *buf, size_t len)
 {
     const char *root = getenv("HEXCNC_ROOT");
-    snprintf(buf, len, "%s/%s", root ? root : ".", rel);
+    if (rel[0] == '/')                   /* absolute: as it is */
+        snprintf(buf, len, "%s", rel);
+    else
+        snprintf(buf, len, "%s/%s", root ? root : ".", rel);
     return buf;
 }
 
