@@ -33,7 +33,8 @@ struct sim {
     double len_lo[KINS_MAX_JOINTS];    /* the legs' length range */
     double len_hi[KINS_MAX_JOINTS];
     double min_mm[KINS_MAX_JOINTS], max_mm[KINS_MAX_JOINTS];     /* the legs' figures so far */
-    double over[KINS_MAX_JOINTS];      /* this period: how many of its limits each leg is over */
+    double over[KINS_MAX_JOINTS];      /* this period: by how much each leg is over the
+                                        * nearest of its limits (> 0: over one) */
     double peak_vel[KINS_MAX_JOINTS], peak_acc[KINS_MAX_JOINTS], peak_jerk[KINS_MAX_JOINTS];
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
     int line;                          /* program line of the previous period */
@@ -124,9 +125,9 @@ static __attribute__((noinline)) void legs_report(struct sim *s, const struct mo
 /* Leg lengths, rates from successive set points and accelerations from successive rates.
  * This runs every period: arithmetic and comparisons on the pass's own arrays (the figures
  * go into the result at the end, check_simulate), which the compiler runs two legs at a
- * time (each leg's count of limits over goes into an array: an `or` across the legs would
- * keep the loop from being vectorised); whether any leg is over, for the reports out of
- * line. */
+ * time (each leg's excess over its nearest limit goes into an array: an `or` across the
+ * legs would keep the loop from being vectorised); whether any leg is over, for the
+ * reports out of line. */
 static __attribute__((noinline)) int legs_period(struct sim *restrict s,
                                                  const double *restrict Lp)
 {
@@ -140,16 +141,18 @@ static __attribute__((noinline)) int legs_period(struct sim *restrict s,
         s->peak_vel[i] = av > s->peak_vel[i] ? av : s->peak_vel[i];
         s->peak_acc[i] = aa > s->peak_acc[i] ? aa : s->peak_acc[i];
         s->peak_jerk[i] = aj > s->peak_jerk[i] ? aj : s->peak_jerk[i];
-        s->over[i] = (L > s->len_hi[i] ? 1.0 : 0.0) + (L < s->len_lo[i] ? 1.0 : 0.0) +
-                     (av > s->vel_thr[i] ? 1.0 : 0.0) + (aa > s->acc_thr[i] ? 1.0 : 0.0) +
-                     (aj > s->jerk_thr[i] ? 1.0 : 0.0);
+        double e1 = L - s->len_hi[i], e2 = s->len_lo[i] - L, e3 = av - s->vel_thr[i];
+        double e4 = aa - s->acc_thr[i], e5 = aj - s->jerk_thr[i];
+        e1 = e1 > e2 ? e1 : e2, e3 = e3 > e4 ? e3 : e4;
+        e1 = e1 > e5 ? e1 : e5;
+        s->over[i] = e1 > e3 ? e1 : e3;  /* > 0: some limit is over */
         s->v0[i] = v;
         s->a0[i] = a;
         s->jerk[i] = aj;
     }
     int over = 0;
     for (int i = 0; i < n; i++)
-        over |= s->over[i] != 0;
+        over |= s->over[i] > 0;
     return over;
 }
 

@@ -209,6 +209,8 @@ static void ideal_spindle(struct motion *m, double dt)
         return;
     double want = m->io.dir * m->io.rpm / 60.0, step = m->cfg.spindle_acc_rpm_s / 60.0 * dt;
     double r0 = m->ideal_rps, diff = want - r0;
+    if (want == 0 && r0 == 0)
+        return;                        /* at rest, and told to stay there */
     m->ideal_rps = isnan(step) || fabs(diff) <= step ? want : r0 + copysign(step, diff);
     m->spindle_revs += 0.5 * (r0 + m->ideal_rps) * dt;
 }
