@@ -13,9 +13,11 @@
 static int hexapod_pose_frame(const double pose[KINS_POSE_DIM], double t_mm[3],
                               struct hexapod_rot *o)
 {
-    for (int j = 0; j < KINS_POSE_DIM; j++)
-        if (!isfinite(pose[j]))
-            return KINS_ERR_ARG;
+    double z = 0;            /* 0 times a number is 0, times an infinity or a NaN NaN: */
+    for (int j = 0; j < KINS_POSE_DIM; j++)   /* one test for the six (every period) */
+        z += pose[j] * 0.0;
+    if (!(z == 0))
+        return KINS_ERR_ARG;
     t_mm[0] = pose[KINS_X];
     t_mm[1] = pose[KINS_Y];
     t_mm[2] = pose[KINS_Z];

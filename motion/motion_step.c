@@ -753,10 +753,9 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
     out->path_tol_mm = m->path_tol_mm;
     memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
     memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
-    for (int i = 0; i < m->nj; i++) {
-        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];
-        out->joint_fb[i] = m->joint_fb[i];
-    }
+    for (int i = 0; i < KINS_MAX_JOINTS; i++)   /* (all: a fixed count is vectorised; */
+        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];  /* unused ones are 0) */
+    memcpy(out->joint_fb, m->joint_fb, sizeof out->joint_fb);
     memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
     out->njoints = m->nj;
     out->line = m->line;

@@ -324,6 +324,13 @@ START_TEST(test_failures)
     ck_assert_mem_eq(pose, keep, sizeof keep);
     double nan_pose[6] = { 0, 0, NAN, 0, 0, 0 };
     ck_assert_int_eq(kins_inverse(k, nan_pose, legs), KINS_ERR_ARG);
+    for (int j = 0; j < 6; j++) {        /* an infinity anywhere, either sign */
+        double inf_pose[6] = { 0, 0, 600, 0, 0, 0 };
+        inf_pose[j] = j % 2 ? -INFINITY : INFINITY;
+        ck_assert_int_eq(kins_inverse(k, inf_pose, legs), KINS_ERR_ARG);
+        struct kins_check ck;
+        ck_assert_int_eq(kins_check_pose(k, inf_pose, &ck), KINS_ERR_ARG);
+    }
     kins_free(k);
 
     /* Legs of 100 mm on a machine whose platform joints are 383 mm apart across a base gap
