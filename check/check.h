@@ -88,6 +88,8 @@ struct check_opts {
     int solve_every_condition;       /* 1: every condition number solved (for comparison;
                                       * by default a bound from the last one solved answers
                                       * where solving could change nothing) */
+    int legs_every_period;           /* 1: the legs tested period by period (for comparison;
+                                      * by default in batches of periods, the same results) */
     struct check_trace *trace;       /* optional: filled with samples for plots */
 };
 /* The defaults: deviation every 50 ms, condition number every 500 ms, and both at every change

@@ -169,6 +169,11 @@ void check_defer_commit(struct check_defer *d)
     atomic_store_explicit(&d->head, d->head_local, memory_order_release);
 }
 
+const struct check_defer_slot *check_defer_oldest(const struct check_defer *d)
+{
+    return d->apply == d->head_local ? NULL : &d->slot[d->apply % CHECK_DEFER_SLOTS];
+}
+
 struct check_defer_slot *check_defer_next(struct check_defer *d, int wait)
 {
     if (d->apply == d->head_local)

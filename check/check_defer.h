@@ -79,6 +79,9 @@ int check_defer_work(struct check_defer *d);
  * first); then check_defer_commit publishes it. */
 struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defer_kind kind);
 void check_defer_commit(struct check_defer *d);
+/* The oldest slot not yet applied (what the pass wrote in it; its result may not be there
+ * yet), or NULL when every slot is applied. */
+const struct check_defer_slot *check_defer_oldest(const struct check_defer *d);
 /* The oldest slot not yet applied, once its result is there (wait: computing it, or waiting
  * for the helper that is); NULL when none is ready without waiting, or none is left. */
 struct check_defer_slot *check_defer_next(struct check_defer *d, int wait);

@@ -11,6 +11,7 @@
 
 #define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
 #define MAX_PERIODS_FACTOR 2 /* the run stops at twice the planned time (a stuck planner) */
+#define LEG_BATCH 64          /* periods whose legs are tested together (legs_batch) */
 #define CHECK_COND_BOUND_MARGIN 1e-9  /* relative to the largest singular value: what the
                                        * condition bound adds for the solver's rounding */
 
@@ -23,18 +24,25 @@ struct sim {
     double T;                          /* servo period, s */
     double inv_T;                      /* 1 / T, 1/s */
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
-    double v0[KINS_MAX_JOINTS];        /* leg rate over the previous period, mm/s (the
+    double v0[KINS_MAX_JOINTS];        /* leg rate over the last period tested, mm/s (the
                                         * machine starts at rest: 0) */
-    double a0[KINS_MAX_JOINTS];        /* leg acceleration of the previous period, mm/s^2 */
+    double a0[KINS_MAX_JOINTS];        /* leg acceleration of the last period tested */
     double jerk_thr[KINS_MAX_JOINTS];  /* jerk beyond which a leg is over (HUGE_VAL: none) */
     double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
     double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
-    double jerk[KINS_MAX_JOINTS];      /* leg jerk of this period, mm/s^3 */
+    double jerk[KINS_MAX_JOINTS];      /* leg jerk of the last period tested, mm/s^3 */
     double len_lo[KINS_MAX_JOINTS];    /* the legs' length range */
     double len_hi[KINS_MAX_JOINTS];
     double min_mm[KINS_MAX_JOINTS], max_mm[KINS_MAX_JOINTS];     /* the legs' figures so far */
-    double over[KINS_MAX_JOINTS];      /* this period: by how much each leg is over the
-                                        * nearest of its limits (> 0: over one) */
+    /* The periods whose legs are not tested yet (legs_batch): their set points leg by leg,
+     * and where each period was; the legs before them are bL0 (v0, a0 and jerk are theirs). */
+    double Lb[KINS_MAX_JOINTS][LEG_BATCH];
+    int bline[LEG_BATCH];
+    const char *bfile[LEG_BATCH];
+    double btime[LEG_BATCH];
+    int bn, bcap;                      /* periods held, and how many make a batch */
+    long bfirst;                       /* the pass's index of the first (r->periods) */
+    double bL0[KINS_MAX_JOINTS];
     double peak_vel[KINS_MAX_JOINTS], peak_acc[KINS_MAX_JOINTS], peak_jerk[KINS_MAX_JOINTS];
     double p0[KINS_POSE_DIM];          /* commanded pose of the previous period */
     int line;                          /* program line of the previous period */
@@ -68,17 +76,25 @@ struct sim {
     double ref_smax, ref_smin;         /* values */
 };
 
-static void drain(struct sim *s);
+static void drain_before(struct sim *s, long period);
 
-/* Adds a leg limit problem (velocity or acceleration) at the current period. */
-static void leg_limit(struct sim *s, const struct motion_out *out, enum check_kind k, int leg,
+/* Where a held period was: its program line and file, its machine time, its index. */
+struct period_at {
+    int line;
+    const char *file;
+    double time_s;
+    long period;
+};
+
+/* Adds a leg limit problem (velocity or acceleration) at period w. */
+static void leg_limit(struct sim *s, const struct period_at *w, enum check_kind k, int leg,
                       double value, double limit)
 {
-    drain(s);                          /* the measures before it come first, as they came */
-    double t_s = out->time_elapsed_s;
-    struct check_problem p = { .kind = k, .line = out->line, .leg = leg, .value = value,
+    drain_before(s, w->period);        /* the measures before it come first, as they came */
+    double t_s = w->time_s;
+    struct check_problem p = { .kind = k, .line = w->line, .leg = leg, .value = value,
                                .limit = limit, .time_s = t_s, .count = 1 };
-    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
+    snprintf(p.file, sizeof p.file, "%s", w->file ? w->file : "");
     const char *what = k == CHECK_LEG_VELOCITY ? "moves at"
                        : k == CHECK_LEG_JERK ? "changes its acceleration at" : "accelerates at";
     const char *unit = k == CHECK_LEG_VELOCITY ? "mm/s" : k == CHECK_LEG_JERK ? "mm/s^3"
@@ -91,69 +107,109 @@ static void leg_limit(struct sim *s, const struct motion_out *out, enum check_ki
     check_add_problem(s->r, &p);
 }
 
-/* A leg beyond its length range at this period. */
-static void leg_out_of_range(struct sim *s, const struct motion_out *out, int i, double L)
+/* A leg beyond its length range at period w. */
+static void leg_out_of_range(struct sim *s, const struct period_at *w, int i, double L)
 {
-    drain(s);
+    drain_before(s, w->period);
     const struct check_leg *lg = &s->r->leg[i];
-    struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = out->line, .leg = i,
-                               .value = L, .time_s = out->time_elapsed_s, .count = 1 };
+    struct check_problem p = { .kind = CHECK_LEG_RANGE, .line = w->line, .leg = i,
+                               .value = L, .time_s = w->time_s, .count = 1 };
     p.limit = L > lg->limit_max_mm ? lg->limit_max_mm : lg->limit_min_mm;
-    snprintf(p.file, sizeof p.file, "%s", out->file ? out->file : "");
+    snprintf(p.file, sizeof p.file, "%s", w->file ? w->file : "");
     snprintf(p.message, sizeof p.message, "leg %d reaches %.3f mm, beyond its limit %.3f mm",
              i + 1, L, p.limit);
     check_add_problem(s->r, &p);
 }
 
-/* The limit problems of one period, leg by leg (out of line: the period had one). */
-static __attribute__((noinline)) void legs_report(struct sim *s, const struct motion_out *out)
+/* One leg's periods of the batch, from the state before them: lengths, rates from
+ * successive set points, accelerations from successive rates, jerks from successive
+ * accelerations, into the figures (the same values, compared the same way, as period by
+ * period: a minimum or a maximum does not depend on the order it is taken in). Its state
+ * after them into end[] (length, rate, acceleration, jerk); whether any period was over a
+ * limit (the batch's own extremes against the limits). */
+static int leg_batch(struct sim *restrict s, int i, int n, double end[4])
 {
-    for (int i = 0; i < s->nj; i++) {
-        const struct check_leg *lg = &s->r->leg[i];
-        double L = out->joint_pos[i], av = fabs(s->v0[i]), aa = fabs(s->a0[i]);
-        if (L > lg->limit_max_mm || L < lg->limit_min_mm)
-            leg_out_of_range(s, out, i, L);
-        if (av > s->vel_thr[i])
-            leg_limit(s, out, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
-        if (aa > s->acc_thr[i])
-            leg_limit(s, out, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
-        if (s->jerk[i] > s->jerk_thr[i])
-            leg_limit(s, out, CHECK_LEG_JERK, i, s->jerk[i], lg->limit_jerk_mm_s3);
+    const double *L = s->Lb[i], T = s->inv_T;
+    double Lp = s->bL0[i], vp = s->v0[i], ap = s->a0[i], aj = s->jerk[i];
+    double lo = HUGE_VAL, hi = -HUGE_VAL, pv = 0, pa = 0, pj = 0;
+    for (int k = 0; k < n; k++) {
+        double Lk = L[k], v = (Lk - Lp) * T, a = (v - vp) * T;
+        double av = fabs(v), aa = fabs(a);
+        aj = fabs(a - ap) * T;
+        lo = Lk < lo ? Lk : lo;
+        hi = Lk > hi ? Lk : hi;
+        pv = av > pv ? av : pv;
+        pa = aa > pa ? aa : pa;
+        pj = aj > pj ? aj : pj;
+        Lp = Lk, vp = v, ap = a;
+    }
+    end[0] = Lp, end[1] = vp, end[2] = ap, end[3] = aj;
+    s->min_mm[i] = lo < s->min_mm[i] ? lo : s->min_mm[i];
+    s->max_mm[i] = hi > s->max_mm[i] ? hi : s->max_mm[i];
+    s->peak_vel[i] = pv > s->peak_vel[i] ? pv : s->peak_vel[i];
+    s->peak_acc[i] = pa > s->peak_acc[i] ? pa : s->peak_acc[i];
+    s->peak_jerk[i] = pj > s->peak_jerk[i] ? pj : s->peak_jerk[i];
+    return hi > s->len_hi[i] || lo < s->len_lo[i] || pv > s->vel_thr[i] ||
+           pa > s->acc_thr[i] || pj > s->jerk_thr[i];
+}
+
+/* The batch again period by period, from the state before it, reporting each period's
+ * legs over a limit (out of line: a batch had one). */
+static __attribute__((noinline)) void legs_report(struct sim *s, int n)
+{
+    double Lp[KINS_MAX_JOINTS], vp[KINS_MAX_JOINTS], ap[KINS_MAX_JOINTS];
+    memcpy(Lp, s->bL0, sizeof Lp);
+    memcpy(vp, s->v0, sizeof vp);
+    memcpy(ap, s->a0, sizeof ap);
+    for (int k = 0; k < n; k++) {
+        struct period_at w = { s->bline[k], s->bfile[k], s->btime[k], s->bfirst + k };
+        for (int i = 0; i < s->nj; i++) {
+            const struct check_leg *lg = &s->r->leg[i];
+            double L = s->Lb[i][k], v = (L - Lp[i]) * s->inv_T;
+            double a = (v - vp[i]) * s->inv_T, aj = fabs(a - ap[i]) * s->inv_T;
+            double av = fabs(v), aa = fabs(a);
+            if (L > lg->limit_max_mm || L < lg->limit_min_mm)
+                leg_out_of_range(s, &w, i, L);
+            if (av > s->vel_thr[i])
+                leg_limit(s, &w, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
+            if (aa > s->acc_thr[i])
+                leg_limit(s, &w, CHECK_LEG_ACCELERATION, i, aa, lg->limit_acc_mm_s2);
+            if (aj > s->jerk_thr[i])
+                leg_limit(s, &w, CHECK_LEG_JERK, i, aj, lg->limit_jerk_mm_s3);
+            Lp[i] = L, vp[i] = v, ap[i] = a;
+        }
     }
 }
 
-/* Leg lengths, rates from successive set points and accelerations from successive rates.
- * This runs every period: arithmetic and comparisons on the pass's own arrays (the figures
- * go into the result at the end, check_simulate), which the compiler runs two legs at a
- * time (each leg's excess over its nearest limit goes into an array: an `or` across the
- * legs would keep the loop from being vectorised); whether any leg is over, for the
- * reports out of line. */
-static __attribute__((noinline)) int legs_period(struct sim *restrict s,
-                                                 const double *restrict Lp)
+/* Tests the legs of the periods held: leg by leg through the batch (independent work the
+ * processor overlaps, where period by period each leg's chain waited on the last), and
+ * period by period again only when some limit was over. */
+static void legs_batch(struct sim *s)
 {
-    int n = s->nj;
-    for (int i = 0; i < n; i++) {
-        double L = Lp[i], v = (L - s->L0[i]) * s->inv_T;
-        double a = (v - s->v0[i]) * s->inv_T, av = fabs(v), aa = fabs(a);
-        double aj = fabs(a - s->a0[i]) * s->inv_T;
-        s->min_mm[i] = L < s->min_mm[i] ? L : s->min_mm[i];
-        s->max_mm[i] = L > s->max_mm[i] ? L : s->max_mm[i];
-        s->peak_vel[i] = av > s->peak_vel[i] ? av : s->peak_vel[i];
-        s->peak_acc[i] = aa > s->peak_acc[i] ? aa : s->peak_acc[i];
-        s->peak_jerk[i] = aj > s->peak_jerk[i] ? aj : s->peak_jerk[i];
-        double e1 = L - s->len_hi[i], e2 = s->len_lo[i] - L, e3 = av - s->vel_thr[i];
-        double e4 = aa - s->acc_thr[i], e5 = aj - s->jerk_thr[i];
-        e1 = e1 > e2 ? e1 : e2, e3 = e3 > e4 ? e3 : e4;
-        e1 = e1 > e5 ? e1 : e5;
-        s->over[i] = e1 > e3 ? e1 : e3;  /* > 0: some limit is over */
-        s->v0[i] = v;
-        s->a0[i] = a;
-        s->jerk[i] = aj;
-    }
-    int over = 0;
-    for (int i = 0; i < n; i++)
-        over |= s->over[i] > 0;
-    return over;
+    int n = s->bn, over = 0;
+    double end[KINS_MAX_JOINTS][4];
+    if (!n)
+        return;
+    for (int i = 0; i < s->nj; i++)
+        over |= leg_batch(s, i, n, end[i]);
+    if (over)
+        legs_report(s, n);
+    for (int i = 0; i < s->nj; i++)
+        s->bL0[i] = end[i][0], s->v0[i] = end[i][1], s->a0[i] = end[i][2], s->jerk[i] = end[i][3];
+    s->bn = 0;
+}
+
+/* Holds this period's legs for legs_batch. */
+static void legs_hold(struct sim *s, const struct motion_out *out)
+{
+    int k = s->bn;
+    if (k == 0)
+        s->bfirst = s->r->periods;
+    for (int i = 0; i < s->nj; i++)
+        s->Lb[i][k] = out->joint_pos[i];
+    s->bline[k] = out->line, s->bfile[k] = out->file, s->btime[k] = out->time_elapsed_s;
+    if (++s->bn == s->bcap)
+        legs_batch(s);
 }
 
 /* The pass's leg figures into the result. */
@@ -406,20 +462,30 @@ static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind ki
                                          const struct motion_out *out)
 {
     struct check_defer_slot *q;
-    while (!(q = check_defer_push(s->dq, kind)))
+    while (!(q = check_defer_push(s->dq, kind))) {
+        legs_batch(s);                 /* (the legs' problems before the measures after) */
         apply(s, check_defer_next(s->dq, 1));
+    }
     q->line = out->line, q->file = out->file, q->period = s->r->periods;
     q->time_s = out->time_elapsed_s, q->dist_mm = out->distance_done_mm;
     memcpy(q->pose, out->pose, sizeof q->pose);
     return q;
 }
 
-/* Every measure taken so far, applied (waiting for those being computed). */
+/* The measures taken before period `period`, applied (waiting for those being computed):
+ * what comes before a problem found in that period. */
+static void drain_before(struct sim *s, long period)
+{
+    const struct check_defer_slot *o;
+    while ((o = check_defer_oldest(s->dq)) && o->period < period)
+        apply(s, check_defer_next(s->dq, 1));
+}
+
+/* The legs held tested, and every measure taken so far applied. */
 static void drain(struct sim *s)
 {
-    const struct check_defer_slot *q;
-    while ((q = check_defer_next(s->dq, 1)))
-        apply(s, q);
+    legs_batch(s);
+    drain_before(s, LONG_MAX);
 }
 
 /* Whether the pose has moved CHECK_COND_STEP_MM or _DEG from where the condition number
@@ -453,8 +519,12 @@ static void measures(struct sim *s, const struct motion_out *out)
         deviation(s, out);
         s->next_dev_s = t + s->o->deviation_every_s;
     }
-    const struct check_defer_slot *q;
-    while ((q = check_defer_next(s->dq, 0)))     /* what is ready, without waiting */
+    /* what is ready, without waiting, of the periods whose legs are tested (a leg's problem
+     * comes before the measures of its period and after) */
+    long before = s->bn ? s->bfirst : LONG_MAX;
+    const struct check_defer_slot *o, *q;
+    while ((o = check_defer_oldest(s->dq)) && o->period < before &&
+           (q = check_defer_next(s->dq, 0)))
         apply(s, q);
 }
 
@@ -521,6 +591,9 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         return CHECK_ERR_KINS;
     }
     memcpy(s.p0, start, sizeof s.p0);
+    memcpy(s.bL0, s.L0, sizeof s.bL0);
+    s.bcap = (o->trace && !feed) || o->legs_every_period ? 1 : LEG_BATCH;  /* (the trace
+                                                        * samples the legs' rates) */
     for (int i = 0; i < KINS_POSE_DIM; i++)   /* the first line change takes it */
         s.cond_pose[i] = HUGE_VAL;
     int st = MOTION_OK;
@@ -538,8 +611,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         }
         st = motion_step(mc->motion, s.T, &out);
         r->periods++;
-        if (legs_period(&s, out.joint_pos))
-            legs_report(&s, &out);
+        legs_hold(&s, &out);
         if (s.have_tf)
             tip_period(&s, &out);
         measures(&s, &out);
@@ -556,6 +628,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
             motion_resume(mc->motion);
     }
     motion_set_rates(mc->motion, true);
+    legs_batch(&s);
     legs_figures(&s);
     if (s.tip_line)
         tip_end_move(&s, &out);

@@ -219,6 +219,53 @@ START_TEST(test_condition_bound)
 }
 END_TEST
 
+/* The legs tested in batches of periods find what period by period finds: every problem
+ * in the same order (leg rates over a drive's limit interleaved with condition numbers over
+ * the threshold), with the same values, times and counts, and the same figures. */
+START_TEST(test_legs_in_batches)
+{
+    char path[] = "/tmp/hexcnc_wanderXXXXXX";
+    int fd = mkstemp(path);
+    ck_assert(fd >= 0);
+    close(fd);
+    write_wander(path, 800);
+    struct check_opts o;
+    struct check_result a, b;
+    check_opts_default(&o);
+    int sa = run("tests/check/tmu-slow-singular.ini", path, &o, &a);
+    o.legs_every_period = 1;
+    int sb = run("tests/check/tmu-slow-singular.ini", path, &o, &b);
+    ck_assert_int_eq(sa, CHECK_ERR_VIOLATION);
+    ck_assert_int_eq(sa, sb);
+    ck_assert_uint_eq(a.nproblems, b.nproblems);
+    size_t legs = 0, singular = 0, changes = 0;
+    for (size_t i = 0; i < a.nproblems; i++) {
+        const struct check_problem *p = &a.problems[i], *q = &b.problems[i];
+        ck_assert_int_eq(p->kind, q->kind);
+        ck_assert_int_eq(p->line, q->line);
+        ck_assert_int_eq(p->leg, q->leg);
+        ck_assert_int_eq(p->count, q->count);
+        ck_assert(p->value == q->value && p->time_s == q->time_s);
+        ck_assert_str_eq(p->message, q->message);
+        legs += p->kind == CHECK_LEG_VELOCITY;
+        singular += p->kind == CHECK_SINGULAR;
+        changes += i > 0 && p->kind != a.problems[i - 1].kind;
+    }
+    printf("legs in batches: %zu problems (%zu leg rates, %zu condition numbers, the kind "
+           "changing %zu times in order)\n", a.nproblems, legs, singular, changes);
+    ck_assert(legs > 100 && singular > 10 && changes > 20);
+    for (int i = 0; i < 6; i++) {
+        ck_assert(a.leg[i].min_mm == b.leg[i].min_mm && a.leg[i].max_mm == b.leg[i].max_mm);
+        ck_assert(a.leg[i].peak_vel_mm_s == b.leg[i].peak_vel_mm_s);
+        ck_assert(a.leg[i].peak_acc_mm_s2 == b.leg[i].peak_acc_mm_s2);
+        ck_assert(a.leg[i].peak_jerk_mm_s3 == b.leg[i].peak_jerk_mm_s3);
+    }
+    check_result_free(&a);
+    check_result_free(&b);
+    unlink(path);
+}
+END_TEST
+
 START_TEST(test_interpreter_error)
 {
     struct check_result r;
@@ -489,6 +536,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_leg_acceleration_over_drive_limit);
     tcase_add_test(tc, test_near_singular_pose);
     tcase_add_test(tc, test_condition_bound);
+    tcase_add_test(tc, test_legs_in_batches);
     tcase_add_test(tc, test_interpreter_error);
     tcase_add_test(tc, test_deviation_measure);
     tcase_add_test(tc, test_json_and_exit_status);
