@@ -150,9 +150,13 @@ START_TEST(test_near_singular_pose)
 END_TEST
 
 /* A wandering five-axis program of n short blocks (X Y Z A B C on each), run twice over,
- * written to path. */
-static void write_wander(const char *path, int n)
+ * written to a new file in /tmp whose name goes into path (unlink it when done). */
+static void write_wander(char path[32], int n)
 {
+    snprintf(path, 32, "/tmp/hexcnc_wanderXXXXXX");
+    int fd = mkstemp(path);
+    ck_assert(fd >= 0);
+    close(fd);
     FILE *f = fopen(path, "w");
     ck_assert(f != NULL);
     fprintf(f, "G21 G90 G64 P0.01\nG1 X0 Y0 Z645 A0 B0 C0 F2000\n");
@@ -172,10 +176,7 @@ static void write_wander(const char *path, int n)
  * line, and on a machine whose limit the path crosses, every problem with its value. */
 START_TEST(test_condition_bound)
 {
-    char path[] = "/tmp/hexcnc_wanderXXXXXX";
-    int fd = mkstemp(path);
-    ck_assert(fd >= 0);
-    close(fd);
+    char path[32];
     write_wander(path, 2000);
     static const char *inis[] = { TMU_INI, "tests/check/tmu-singular.ini" };
     for (int k = 0; k < 2; k++) {
@@ -224,10 +225,7 @@ END_TEST
  * the threshold), with the same values, times and counts, and the same figures. */
 START_TEST(test_legs_in_batches)
 {
-    char path[] = "/tmp/hexcnc_wanderXXXXXX";
-    int fd = mkstemp(path);
-    ck_assert(fd >= 0);
-    close(fd);
+    char path[32];
     write_wander(path, 800);
     struct check_opts o;
     struct check_result a, b;
