@@ -121,6 +121,16 @@ static void leg_out_of_range(struct sim *s, const struct period_at *w, int i, do
     check_add_problem(s->r, &p);
 }
 
+/* A leg's rate, acceleration and jerk at length L from its length, rate and acceleration a
+ * period before (1/T = inv_T): the one formula of both the batch and its replay. */
+static inline void leg_diffs(double L, double Lp, double vp, double ap, double inv_T,
+                             double *v, double *a, double *aj)
+{
+    *v = (L - Lp) * inv_T;
+    *a = (*v - vp) * inv_T;
+    *aj = fabs(*a - ap) * inv_T;
+}
+
 /* One leg's periods of the batch, from the state before them: lengths, rates from
  * successive set points, accelerations from successive rates, jerks from successive
  * accelerations, into the figures (the same values, compared the same way, as period by
@@ -133,9 +143,9 @@ static int leg_batch(struct sim *restrict s, int i, int n, double end[4])
     double Lp = s->bL0[i], vp = s->v0[i], ap = s->a0[i], aj = s->jerk[i];
     double lo = HUGE_VAL, hi = -HUGE_VAL, pv = 0, pa = 0, pj = 0;
     for (int k = 0; k < n; k++) {
-        double Lk = L[k], v = (Lk - Lp) * T, a = (v - vp) * T;
+        double Lk = L[k], v, a;
+        leg_diffs(Lk, Lp, vp, ap, T, &v, &a, &aj);
         double av = fabs(v), aa = fabs(a);
-        aj = fabs(a - ap) * T;
         lo = Lk < lo ? Lk : lo;
         hi = Lk > hi ? Lk : hi;
         pv = av > pv ? av : pv;
@@ -165,8 +175,8 @@ static __attribute__((noinline)) void legs_report(struct sim *s, int n)
         struct period_at w = { s->bline[k], s->bfile[k], s->btime[k], s->bfirst + k };
         for (int i = 0; i < s->nj; i++) {
             const struct check_leg *lg = &s->r->leg[i];
-            double L = s->Lb[i][k], v = (L - Lp[i]) * s->inv_T;
-            double a = (v - vp[i]) * s->inv_T, aj = fabs(a - ap[i]) * s->inv_T;
+            double L = s->Lb[i][k], v, a, aj;
+            leg_diffs(L, Lp[i], vp[i], ap[i], s->inv_T, &v, &a, &aj);
             double av = fabs(v), aa = fabs(a);
             if (L > lg->limit_max_mm || L < lg->limit_min_mm)
                 leg_out_of_range(s, &w, i, L);
