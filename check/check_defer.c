@@ -159,7 +159,9 @@ struct check_defer_slot *check_defer_push(struct check_defer *d, enum check_defe
     struct check_defer_slot *s = &d->slot[d->head_local % CHECK_DEFER_SLOTS];
     s->kind = kind;
     atomic_store_explicit(&s->state, kind == CHECK_DEFER_DEVIATION ||
-                          kind == CHECK_DEFER_CONDITION ? CHECK_DEFER_WAITING : CHECK_DEFER_DONE, memory_order_relaxed);
+                          kind == CHECK_DEFER_CONDITION ? CHECK_DEFER_WAITING
+                                                        : CHECK_DEFER_DONE,
+                          memory_order_relaxed);
     return s;
 }
 
