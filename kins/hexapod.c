@@ -93,37 +93,16 @@ static inline int joints_checked(struct kins *k, const double *pose, const struc
 }
 
 /* Inverse kinematics: joint i = |t + R·p_i - b_i| - offset_i; then the workspace's other
- * limits (hexapod_workspace.c). The servo thread's every period: the legs' lengths alone
- * (no unit vectors), from the joint centres by coordinate, so that the compiler runs the
- * loop two legs at a time; each leg's arithmetic is hexapod_legs_eval's, in its order, and
- * gives the same bits. */
+ * limits (hexapod_workspace.c). */
 static int hexapod_inverse(struct kins *k, const double pose[KINS_POSE_DIM], double *joints)
 {
     const struct hexapod *h = (const struct hexapod *)k;
     struct hexapod_rot o;
-    double t[3], len[HEXAPOD_LEGS], rpz[HEXAPOD_LEGS];
-    if (hexapod_pose_frame(pose, t, &o) != KINS_OK)
+    struct hexapod_legs lg;
+    if (hexapod_pose_legs(h, pose, &o, &lg) != KINS_OK)
         return KINS_ERR_ARG;
-    const double *px = h->soa_p[0], *py = h->soa_p[1], *pz = h->soa_p[2];
-    for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        double rp0 = o.r[0][0] * px[i] + o.r[0][1] * py[i] + o.r[0][2] * pz[i];
-        double rp1 = o.r[1][0] * px[i] + o.r[1][1] * py[i] + o.r[1][2] * pz[i];
-        double rp2 = o.r[2][0] * px[i] + o.r[2][1] * py[i] + o.r[2][2] * pz[i];
-        double v0 = t[0] + rp0 - h->soa_b[0][i];
-        double v1 = t[1] + rp1 - h->soa_b[1][i];
-        double v2 = t[2] + rp2 - h->soa_b[2][i];
-        len[i] = sqrt(v0 * v0 + v1 * v1 + v2 * v2);
-        rpz[i] = rp2;
-    }
-    int st = KINS_OK;
-    bool up = o.r[2][2] > 0;             /* hexapod_ws_plain's test */
-    for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        joints[i] = len[i] - h->offset_mm[i];
-        if (joints[i] < k->joint_min[i] || joints[i] > k->joint_max[i])
-            st = KINS_ERR_UNREACHABLE;
-        up &= pose[KINS_Z] + rpz[i] - h->soa_b[2][i] > 0;
-    }
-    if (st != KINS_OK || (!h->ws_extra && up))
+    int st = hexapod_lengths_of(k, &lg, joints);
+    if (st != KINS_OK || hexapod_ws_plain(h, pose, &o, &lg))
         return st;
     return hexapod_ws_full(h, pose);
 }

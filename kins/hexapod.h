@@ -20,9 +20,6 @@ struct hexapod {
     struct kins base;                  /* generic part; must stay first */
     double b_mm[HEXAPOD_LEGS][3];      /* base joint centres in the base frame, mm */
     double p_mm[HEXAPOD_LEGS][3];      /* platform joint centres in the platform frame, mm */
-    double soa_b[3][HEXAPOD_LEGS];     /* the same joint centres by coordinate (x of every */
-    double soa_p[3][HEXAPOD_LEGS];     /* leg, then y, then z): the inverse's loop over the
-                                        * legs then runs two legs to an instruction */
     double offset_mm[HEXAPOD_LEGS];    /* leg length offsets: joint value (the length the
                                         * drive reports) + offset = joint-centre distance, mm */
     double pdist_mm[HEXAPOD_LEGS][HEXAPOD_LEGS]; /* platform joint spacing, mm */

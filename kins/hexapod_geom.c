@@ -234,9 +234,6 @@ int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *er
         st = hexapod_read_offsets(h, cfg, err, errlen);
     if (st != KINS_OK)
         return st;
-    for (int i = 0; i < HEXAPOD_LEGS; i++)
-        for (int j = 0; j < 3; j++)
-            h->soa_b[j][i] = h->b_mm[i][j], h->soa_p[j][i] = h->p_mm[i][j];
     int home_found;
     st = kins_cfg_numbers(cfg, "KINS", "HOME", h->base.home, KINS_POSE_DIM, &home_found, err,
                           errlen);
