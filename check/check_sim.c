@@ -30,12 +30,11 @@ struct sim {
     double jerk_thr[KINS_MAX_JOINTS];  /* jerk beyond which a leg is over (HUGE_VAL: none) */
     double vel_thr[KINS_MAX_JOINTS];   /* rate and acceleration beyond which a leg is over */
     double acc_thr[KINS_MAX_JOINTS];   /* its limit (the limit plus LIMIT_SLACK) */
-    double jerk[KINS_MAX_JOINTS];      /* leg jerk of the last period tested, mm/s^3 */
     double len_lo[KINS_MAX_JOINTS];    /* the legs' length range */
     double len_hi[KINS_MAX_JOINTS];
     double min_mm[KINS_MAX_JOINTS], max_mm[KINS_MAX_JOINTS];     /* the legs' figures so far */
     /* The periods whose legs are not tested yet (legs_batch): their set points leg by leg,
-     * and where each period was; the legs before them are bL0 (v0, a0 and jerk are theirs). */
+     * and where each period was; the legs before them are bL0 (v0 and a0 are theirs). */
     double Lb[KINS_MAX_JOINTS][LEG_BATCH];
     int bline[LEG_BATCH];
     const char *bfile[LEG_BATCH];
@@ -135,15 +134,15 @@ static inline void leg_diffs(double L, double Lp, double vp, double ap, double i
  * successive set points, accelerations from successive rates, jerks from successive
  * accelerations, into the figures (the same values, compared the same way, as period by
  * period: a minimum or a maximum does not depend on the order it is taken in). Its state
- * after them into end[] (length, rate, acceleration, jerk); whether any period was over a
- * limit (the batch's own extremes against the limits). */
-static int leg_batch(struct sim *restrict s, int i, int n, double end[4])
+ * after them into end[] (length, rate, acceleration); whether any period was over a limit
+ * (the batch's own extremes against the limits). */
+static int leg_batch(struct sim *restrict s, int i, int n, double end[3])
 {
     const double *L = s->Lb[i], T = s->inv_T;
-    double Lp = s->bL0[i], vp = s->v0[i], ap = s->a0[i], aj = s->jerk[i];
+    double Lp = s->bL0[i], vp = s->v0[i], ap = s->a0[i];
     double lo = HUGE_VAL, hi = -HUGE_VAL, pv = 0, pa = 0, pj = 0;
     for (int k = 0; k < n; k++) {
-        double Lk = L[k], v, a;
+        double Lk = L[k], v, a, aj;
         leg_diffs(Lk, Lp, vp, ap, T, &v, &a, &aj);
         double av = fabs(v), aa = fabs(a);
         lo = Lk < lo ? Lk : lo;
@@ -153,7 +152,7 @@ static int leg_batch(struct sim *restrict s, int i, int n, double end[4])
         pj = aj > pj ? aj : pj;
         Lp = Lk, vp = v, ap = a;
     }
-    end[0] = Lp, end[1] = vp, end[2] = ap, end[3] = aj;
+    end[0] = Lp, end[1] = vp, end[2] = ap;
     s->min_mm[i] = lo < s->min_mm[i] ? lo : s->min_mm[i];
     s->max_mm[i] = hi > s->max_mm[i] ? hi : s->max_mm[i];
     s->peak_vel[i] = pv > s->peak_vel[i] ? pv : s->peak_vel[i];
@@ -178,7 +177,7 @@ static __attribute__((noinline)) void legs_report(struct sim *s, int n)
             double L = s->Lb[i][k], v, a, aj;
             leg_diffs(L, Lp[i], vp[i], ap[i], s->inv_T, &v, &a, &aj);
             double av = fabs(v), aa = fabs(a);
-            if (L > lg->limit_max_mm || L < lg->limit_min_mm)
+            if (L > s->len_hi[i] || L < s->len_lo[i])
                 leg_out_of_range(s, &w, i, L);
             if (av > s->vel_thr[i])
                 leg_limit(s, &w, CHECK_LEG_VELOCITY, i, av, lg->limit_vel_mm_s);
@@ -197,7 +196,7 @@ static __attribute__((noinline)) void legs_report(struct sim *s, int n)
 static void legs_batch(struct sim *s)
 {
     int n = s->bn, over = 0;
-    double end[KINS_MAX_JOINTS][4];
+    double end[KINS_MAX_JOINTS][3];
     if (!n)
         return;
     for (int i = 0; i < s->nj; i++)
@@ -205,7 +204,7 @@ static void legs_batch(struct sim *s)
     if (over)
         legs_report(s, n);
     for (int i = 0; i < s->nj; i++)
-        s->bL0[i] = end[i][0], s->v0[i] = end[i][1], s->a0[i] = end[i][2], s->jerk[i] = end[i][3];
+        s->bL0[i] = end[i][0], s->v0[i] = end[i][1], s->a0[i] = end[i][2];
     s->bn = 0;
 }
 
