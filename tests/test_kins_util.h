@@ -62,6 +62,16 @@ static inline void tk_setf(struct tk_cfg *c, const char *sec, const char *key, d
     tk_set(c, sec, key, buf);
 }
 
+/* Sets key to the number v in each of the six legs' sections, [JOINT_0] .. [JOINT_5]. */
+static inline void tk_setf_joints(struct tk_cfg *c, const char *key, double v)
+{
+    for (int i = 0; i < 6; i++) {
+        char sec[24];
+        snprintf(sec, sizeof sec, "JOINT_%d", i);
+        tk_setf(c, sec, key, v);
+    }
+}
+
 /* A fresh parametric hexapod: radii (mm), pair half-angles (deg), leg limits (mm). */
 static inline struct tk_cfg *tk_hexapod(double rb, double rp, double hb, double hp,
                                         double lmin, double lmax)
@@ -74,12 +84,8 @@ static inline struct tk_cfg *tk_hexapod(double rb, double rp, double hb, double 
     tk_setf(c, "KINS", "PLATFORM_RADIUS", rp);
     tk_setf(c, "KINS", "BASE_HALF_ANGLE", hb);
     tk_setf(c, "KINS", "PLATFORM_HALF_ANGLE", hp);
-    for (int i = 0; i < 6; i++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", i);
-        tk_setf(c, sec, "MIN_LIMIT", lmin);
-        tk_setf(c, sec, "MAX_LIMIT", lmax);
-    }
+    tk_setf_joints(c, "MIN_LIMIT", lmin);
+    tk_setf_joints(c, "MAX_LIMIT", lmax);
     return c;
 }
 

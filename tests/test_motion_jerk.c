@@ -24,17 +24,7 @@ static struct tk_cfg *jerk_cfg(int jerk)
     ck_assert_ptr_nonnull(c);
     if (!jerk)
         return c;
-    char v[32];
-    snprintf(v, sizeof v, "%g", LIN_JERK);
-    tk_set(c, "TRAJ", "MAX_LINEAR_JERK", v);
-    snprintf(v, sizeof v, "%g", ANG_JERK);
-    tk_set(c, "TRAJ", "MAX_ANGULAR_JERK", v);
-    snprintf(v, sizeof v, "%g", LEG_JERK);
-    for (int j = 0; j < 6; j++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        tk_set(c, sec, "MAX_JERK", v);
-    }
+    tm_set_jerk(c, LIN_JERK, ANG_JERK, LEG_JERK);
     return c;
 }
 

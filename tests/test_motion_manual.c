@@ -94,17 +94,8 @@ static void rig_open_with(struct rig *r, double vmax, double amax, int switches,
     ck_assert_ptr_nonnull(c);
     if (sec_)
         tk_set(c, sec_, key, val);
-    if (rig_jerk > 0) {
-        char v[32];
-        snprintf(v, sizeof v, "%g", rig_jerk);
-        tk_set(c, "TRAJ", "MAX_LINEAR_JERK", v);
-        tk_set(c, "TRAJ", "MAX_ANGULAR_JERK", v);
-        for (int i = 0; i < 6; i++) {
-            char sec[24];
-            snprintf(sec, sizeof sec, "JOINT_%d", i);
-            tk_set(c, sec, "MAX_JERK", v);
-        }
-    }
+    if (rig_jerk > 0)
+        tm_set_jerk(c, rig_jerk, rig_jerk, rig_jerk);
     for (int i = 0; i < 6; i++) {
         char sec[24], v[32], a[32];
         snprintf(sec, sizeof sec, "JOINT_%d", i);

@@ -32,14 +32,7 @@ static struct tk_cfg *machine_cfg(int jerk)
     ck_assert_ptr_nonnull(c);
     if (!jerk)
         return c;
-    tk_set(c, "TRAJ", "MAX_LINEAR_JERK", "500000");     /* 2 x 5000 / 0.02 */
-    tk_set(c, "TRAJ", "MAX_ANGULAR_JERK", "200000");    /* 2 x 2000 / 0.02 */
-    for (int j = 0; j < 6; j++) {
-        char sec[24], v[32];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        snprintf(v, sizeof v, "%g", LEG_JERK);
-        tk_set(c, sec, "MAX_JERK", v);
-    }
+    tm_set_jerk(c, 500000, 200000, LEG_JERK);   /* 2 x 5000 / 0.02, 2 x 2000 / 0.02 */
     return c;
 }
 

@@ -18,13 +18,7 @@ static struct tk_cfg *stream_cfg(int jerk)
     struct tk_cfg *c = tm_hexapod_cfg();
     if (!c || !jerk)
         return c;
-    tk_setf(c, "TRAJ", "MAX_LINEAR_JERK", LEG_JERK);
-    tk_setf(c, "TRAJ", "MAX_ANGULAR_JERK", 120000);
-    for (int j = 0; j < 6; j++) {
-        char sec[24];
-        snprintf(sec, sizeof sec, "JOINT_%d", j);
-        tk_setf(c, sec, "MAX_JERK", LEG_JERK);
-    }
+    tm_set_jerk(c, LEG_JERK, 120000, LEG_JERK);
     return c;
 }
 

@@ -62,6 +62,15 @@ static inline void tm_set_legs(struct tk_cfg *c, const char *vel, const char *ac
     }
 }
 
+/* Jerk limits: [TRAJ] MAX_LINEAR_JERK lin (mm/s^3), MAX_ANGULAR_JERK ang (deg/s^3), and
+ * every leg's MAX_JERK leg (mm/s^3). */
+static inline void tm_set_jerk(struct tk_cfg *c, double lin, double ang, double leg)
+{
+    tk_setf(c, "TRAJ", "MAX_LINEAR_JERK", lin);
+    tk_setf(c, "TRAJ", "MAX_ANGULAR_JERK", ang);
+    tk_setf_joints(c, "MAX_JERK", leg);
+}
+
 /* Builds kinematics and motion from a table; returns 0 or prints why not. */
 static inline int tm_open(struct tm_machine *mc, struct tk_cfg *c, const struct kins_ops *ops)
 {
