@@ -129,26 +129,39 @@ static void compute(const struct check_defer *d, struct check_defer_slot *s)
     atomic_store_explicit(&s->state, CHECK_DEFER_DONE, memory_order_release);
 }
 
-/* Claims the slot at `claim` if it lies before head; its index into *i. */
-static int claim_one(struct check_defer *d, size_t *i)
+/* Claims up to `most` slots from `claim` on, as far as head, with one compare-and-swap;
+ * the first's index into *first, how many it took. */
+static size_t claim_run(struct check_defer *d, size_t most, size_t *first)
 {
     size_t c = atomic_load_explicit(&d->claim, memory_order_relaxed);
-    while (c < atomic_load_explicit(&d->head, memory_order_acquire))
-        if (atomic_compare_exchange_weak(&d->claim, &c, c + 1)) {
-            *i = c;
-            return 1;
+    for (;;) {
+        size_t h = atomic_load_explicit(&d->head, memory_order_acquire);
+        if (c >= h)
+            return 0;
+        size_t n = h - c < most ? h - c : most;
+        if (atomic_compare_exchange_weak(&d->claim, &c, c + n)) {
+            *first = c;
+            return n;
         }
-    return 0;
+    }
+}
+
+/* Computes the n slots claimed from index first on (those not done already). */
+static void compute_run(struct check_defer *d, size_t first, size_t n)
+{
+    for (size_t i = first; i < first + n; i++) {
+        struct check_defer_slot *s = &d->slot[i % CHECK_DEFER_SLOTS];
+        if (atomic_load_explicit(&s->state, memory_order_acquire) != CHECK_DEFER_DONE)
+            compute(d, s);
+    }
 }
 
 int check_defer_work(struct check_defer *d)
 {
-    size_t i;
-    if (!d || !claim_one(d, &i))
+    size_t i, n;
+    if (!d || !(n = claim_run(d, 1, &i)))
         return 0;
-    struct check_defer_slot *s = &d->slot[i % CHECK_DEFER_SLOTS];
-    if (atomic_load_explicit(&s->state, memory_order_acquire) != CHECK_DEFER_DONE)
-        compute(d, s);
+    compute_run(d, i, n);
     return 1;
 }
 
@@ -188,7 +201,8 @@ struct check_defer_slot *check_defer_next(struct check_defer *d, int wait)
              * go on; a value is taken at once (claim never passes a slot untaken) */
             if (state != CHECK_DEFER_DONE && !wait)
                 return NULL;
-            check_defer_work(d);
+            size_t i = 0, n = claim_run(d, CHECK_DEFER_RUN, &i);
+            compute_run(d, i, n);
             continue;
         }
         if (state == CHECK_DEFER_DONE)

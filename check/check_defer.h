@@ -14,6 +14,10 @@
                                       * 10 ms, 40 s of machine time, 3000 measures on dense
                                       * code) */
 
+#define CHECK_DEFER_RUN 32           /* slots the pass claims at once when it computes them
+                                      * itself (one locked instruction, a full fence on x86,
+                                      * for all of them) */
+
 enum check_defer_kind {
     CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
     CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed, or the
