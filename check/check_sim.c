@@ -53,12 +53,17 @@ struct sim {
     int tip_line;                      /* a straight feed's tip line, its ends t0 t1 (the */
     double tip_key[KINS_POSE_DIM];     /* move's start, to know when the move changes) */
     double tip_t0[3], tip_t1[3];
+    double tip_d[3], tip_n2;           /* t1 - t0 and its length squared */
+    double tip_to[KINS_POSE_DIM];      /* the move's end pose, and the tool its tip t1 was */
+    double tip_len;                    /* taken with (-1: under G43.4): the next move's t0 */
     int tip_fresh;                     /* the move began this period */
     int tip_swing;                     /* the move turns A B C (the tip may leave the line
                                         * the platform follows) and is not under G43.4 */
-    double move_tip_max;               /* the tip's largest deviation measured in place in
-                                        * the move being followed (its FLUSH carries it) */
-    double tip_max;                    /* the largest measured in place, its line and period */
+    double move_tip2;                  /* the square of the tip's largest deviation measured
+                                        * in place in the move being followed (the next
+                                        * MOVE or FLUSH carries it) */
+    double tip_max2;                   /* the square of the largest measured in place, its
+                                        * line and period */
     int tip_max_line;
     long tip_max_period;
     double def_tip_max;                /* the largest of the deviations' tips (applied in */
@@ -136,23 +141,34 @@ static inline void leg_diffs(double L, double Lp, double vp, double ap, double i
  * period: a minimum or a maximum does not depend on the order it is taken in). Its state
  * after them into end[] (length, rate, acceleration); whether any period was over a limit
  * (the batch's own extremes against the limits). */
+/* (Lengths, rates and accelerations are finite, the kinematics refusing a pose that is not:
+ * with that said to the compiler, the extremes' loop becomes the vector max and min.) */
+__attribute__((optimize("finite-math-only", "no-signed-zeros")))
 static int leg_batch(struct sim *restrict s, int i, int n, double end[3])
 {
     const double *L = s->Lb[i], T = s->inv_T;
-    double Lp = s->bL0[i], vp = s->v0[i], ap = s->a0[i];
+    double v[LEG_BATCH], a[LEG_BATCH], j[LEG_BATCH];
+    /* (leg_diffs' three differences, each period's from the one before it: written as
+     * arrays, every period's is independent of the others' and the loops are vectorised) */
+    v[0] = (L[0] - s->bL0[i]) * T;
+    for (int k = 1; k < n; k++)
+        v[k] = (L[k] - L[k - 1]) * T;
+    a[0] = (v[0] - s->v0[i]) * T;
+    for (int k = 1; k < n; k++)
+        a[k] = (v[k] - v[k - 1]) * T;
+    j[0] = fabs(a[0] - s->a0[i]) * T;
+    for (int k = 1; k < n; k++)
+        j[k] = fabs(a[k] - a[k - 1]) * T;
     double lo = HUGE_VAL, hi = -HUGE_VAL, pv = 0, pa = 0, pj = 0;
     for (int k = 0; k < n; k++) {
-        double Lk = L[k], v, a, aj;
-        leg_diffs(Lk, Lp, vp, ap, T, &v, &a, &aj);
-        double av = fabs(v), aa = fabs(a);
+        double Lk = L[k], av = fabs(v[k]), aa = fabs(a[k]);
         lo = Lk < lo ? Lk : lo;
         hi = Lk > hi ? Lk : hi;
         pv = av > pv ? av : pv;
         pa = aa > pa ? aa : pa;
-        pj = aj > pj ? aj : pj;
-        Lp = Lk, vp = v, ap = a;
+        pj = j[k] > pj ? j[k] : pj;
     }
-    end[0] = Lp, end[1] = vp, end[2] = ap;
+    end[0] = L[n - 1], end[1] = v[n - 1], end[2] = a[n - 1];
     s->min_mm[i] = lo < s->min_mm[i] ? lo : s->min_mm[i];
     s->max_mm[i] = hi > s->max_mm[i] ? hi : s->max_mm[i];
     s->peak_vel[i] = pv > s->peak_vel[i] ? pv : s->peak_vel[i];
@@ -268,13 +284,14 @@ static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind ki
                                          const struct motion_out *out);
 
 /* The end of the move being followed, in order with the measures: its tip warning, with the
- * largest deviation measured in place. */
+ * largest deviation measured in place. A straight move that follows at once ends it with
+ * its own MOVE instead (one slot for both). */
 static void tip_end_move(struct sim *s, const struct motion_out *out)
 {
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_FLUSH, out);
-    q->value = s->move_tip_max;
+    q->value2 = sqrt(s->move_tip2);
     check_defer_commit(s->dq);
-    s->move_tip_max = 0;
+    s->move_tip2 = 0;
 }
 
 /* The straight feed being followed: its tip line (from the kinematics' tool at its ends, or
@@ -291,23 +308,37 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     if (s->tip_line && !memcmp(s->tip_key, out->seg_from, sizeof s->tip_key))
         return;
     s->tip_fresh = 1;
-    if (s->tip_line)
-        tip_end_move(s, out);
+    int flush = s->tip_line;
     s->tip_line = 1;
     memcpy(s->tip_key, out->seg_from, sizeof s->tip_key);
+    double len = out->tcp ? -1 : s->tf.length_mm;    /* (tip_of's tool) */
     if (out->tcp) {
         memcpy(s->tip_t0, out->seg_from, sizeof s->tip_t0);
         memcpy(s->tip_t1, out->seg_to, sizeof s->tip_t1);
     } else {
-        tip_of(s, out, out->seg_from, s->tip_t0);
+        /* (a move that starts where the last one ended, with the same tool, starts at its
+         * tip: the same function of the same numbers) */
+        if (flush && len == s->tip_len && !memcmp(out->seg_from, s->tip_to, sizeof s->tip_to))
+            memcpy(s->tip_t0, s->tip_t1, sizeof s->tip_t0);
+        else
+            tip_of(s, out, out->seg_from, s->tip_t0);
         tip_of(s, out, out->seg_to, s->tip_t1);
     }
+    s->tip_len = len;
+    memcpy(s->tip_to, out->seg_to, sizeof s->tip_to);
+    double n2 = 0;
+    for (int i = 0; i < 3; i++)
+        s->tip_d[i] = s->tip_t1[i] - s->tip_t0[i], n2 += s->tip_d[i] * s->tip_d[i];
+    s->tip_n2 = n2;
     s->tip_swing = !out->tcp && (out->seg_from[3] != out->seg_to[3] ||
                                  out->seg_from[4] != out->seg_to[4] ||
                                  out->seg_from[5] != out->seg_to[5]);
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_MOVE, out);
     q->value = out->path_tol_mm;             /* the warning's line, file and tolerance */
+    q->ok = flush;                           /* the move before ends here: its largest */
+    q->value2 = sqrt(s->move_tip2);          /* deviation in place */
     check_defer_commit(s->dq);
+    s->move_tip2 = 0;
 }
 
 /* A deviation's tip d at program line `line`, in order, into the figures. */
@@ -327,13 +358,18 @@ static void tip_period(struct sim *s, const struct motion_out *out)
     tip_move(s, out);
     if (!s->tip_line || !s->tip_swing)
         return;
-    double tip[3];
+    double tip[3], w[3], u = 0, e2 = 0;
     tip_of(s, out, out->pose, tip);
-    double d = motion_dist_seg(tip, s->tip_t0, s->tip_t1);
-    if (d > s->move_tip_max)
-        s->move_tip_max = d;
-    if (d > s->tip_max)
-        s->tip_max = d, s->tip_max_line = out->line, s->tip_max_period = s->r->periods;
+    for (int i = 0; i < 3; i++)    /* (motion_dist_seg's distance, kept squared: the root of
+                                    * the largest square is the largest root) */
+        w[i] = tip[i] - s->tip_t0[i], u += w[i] * s->tip_d[i];
+    u = s->tip_n2 > 0 ? fmin(1, fmax(0, u / s->tip_n2)) : 0;
+    for (int i = 0; i < 3; i++)
+        e2 += (w[i] - u * s->tip_d[i]) * (w[i] - u * s->tip_d[i]);
+    if (e2 > s->move_tip2)
+        s->move_tip2 = e2;
+    if (e2 > s->tip_max2)
+        s->tip_max2 = e2, s->tip_max_line = out->line, s->tip_max_period = s->r->periods;
 }
 
 /* The tip's figure: the larger of the two maxima, the earlier on a tie (in a period, the
@@ -341,10 +377,10 @@ static void tip_period(struct sim *s, const struct motion_out *out)
 static void tip_figure(const struct sim *s)
 {
     struct check_result *r = s->r;
-    double v = s->def_tip_max;
+    double v = s->def_tip_max, tip_max = sqrt(s->tip_max2);
     int line = s->def_tip_line;
-    if (s->tip_max > v || (s->tip_max == v && s->tip_max_period <= s->def_tip_period))
-        v = s->tip_max, line = s->tip_max_line;
+    if (tip_max > v || (tip_max == v && s->tip_max_period <= s->def_tip_period))
+        v = tip_max, line = s->tip_max_line;
     if (v > r->max_tip_deviation_mm)
         r->max_tip_deviation_mm = v, r->max_tip_deviation_line = line;
 }
@@ -458,10 +494,14 @@ static void apply(struct sim *s, const struct check_defer_slot *q)
     case CHECK_DEFER_DEVIATION: deviation_result(s, q); break;
     case CHECK_DEFER_CONDITION: singularity(s, q); break;
     case CHECK_DEFER_FLUSH:
-        s->blk_tip_max = fmax(s->blk_tip_max, q->value);
+        s->blk_tip_max = fmax(s->blk_tip_max, q->value2);
         tip_flush(s);
         break;
     case CHECK_DEFER_MOVE:
+        if (q->ok) {                   /* the move before ends here */
+            s->blk_tip_max = fmax(s->blk_tip_max, q->value2);
+            tip_flush(s);
+        }
         s->blk_tip_line = q->line, s->blk_tip_file = q->file, s->blk_tip_tol = q->value;
         break;
     }
@@ -611,6 +651,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         s.trace_every = check_trace_begin(o->trace, planned_s, s.T);
     memset(&out, 0, sizeof out);
     motion_set_rates(mc->motion, false);   /* rates come from differences of set points */
+    motion_set_brief(mc->motion, true);    /* (and the record holds what the pass reads) */
     for (long n = 0; n < max_periods; n++) {
         if (feed && motion_stream_starving(mc->motion)) {
             if (!feed->wait(feed->ctx))
@@ -637,6 +678,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
             motion_resume(mc->motion);
     }
     motion_set_rates(mc->motion, true);
+    motion_set_brief(mc->motion, false);
     legs_batch(&s);
     legs_figures(&s);
     if (s.tip_line)

@@ -404,6 +404,11 @@ double motion_dist_seg(const double p[3], const double a[3], const double b[3]);
 /* Off: motion_step computes the leg positions alone, joint_vel and pose_vel read 0 (a check
  * that differences successive set points; a fifth less time per period). On by default. */
 void motion_set_rates(struct motion *m, bool on);
+/* On: motion_step fills only what a check of the path reads (pose, tcp, tool_len_mm,
+ * seg_kind, seg_from, seg_to, path_tol_mm, joint_pos, line, file, state, status,
+ * time_elapsed_s, distance_done_mm, distance_total_mm) and leaves the rest of the record as
+ * it was: on dense code the record was a tenth of a check's period. Off by default. */
+void motion_set_brief(struct motion *m, bool on);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
 /* Tool changes: whether programs planned from now on stop at M6 until the changer is done,
  * and the changer's answer to request seq (the tool is then in the spindle). */

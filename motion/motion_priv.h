@@ -279,6 +279,7 @@ struct motion {
                               * program to the next; off after an abort or a fault) */
     int no_rates;            /* motion_set_rates(m, false): legs only, no rates (a check
                               * differences the set points itself) */
+    int brief;               /* motion_set_brief(m, true): the output record's first part */
     int wait_at_speed;       /* plan a wait for the spindle after M3/M4/S (motion_hal: the
                               * at-speed input is wired) */
     int at_speed;            /* the spindle's at-speed input this period */

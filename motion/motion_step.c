@@ -631,6 +631,12 @@ void motion_set_rates(struct motion *m, bool on)
         m->no_rates = !on;
 }
 
+void motion_set_brief(struct motion *m, bool on)
+{
+    if (m)
+        m->brief = on;
+}
+
 void motion_set_wait_at_speed(struct motion *m, bool on)
 {
     if (m)
@@ -742,42 +748,45 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         motion_jerk_hold(m);
     }
     stream_watch(m);
-    memcpy(out->pose, m->pose, sizeof out->pose);
-    memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
-    out->tcp = m->loaded && m->tcp;
-    out->tool_len_mm = out->tcp ? m->tool_len_mm : 0;
-    memcpy(out->prog_pose, out->tcp ? m->prog_pose : m->pose, sizeof out->prog_pose);
-    out->seg_kind = m->loaded ? m->seg_kind : 0;
-    memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
-    memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
-    out->path_tol_mm = m->path_tol_mm;
-    memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
-    memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
-    for (int i = 0; i < KINS_MAX_JOINTS; i++)   /* (all: a fixed count is vectorised; */
-        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];  /* unused ones are 0) */
-    memcpy(out->joint_fb, m->joint_fb, sizeof out->joint_fb);
-    memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
-    out->njoints = m->nj;
-    out->line = m->line;
-    out->file = m->file;
-    out->state = m->state;
-    out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
-    out->path_vel = m->path_vel;
-    out->time_elapsed_s = m->elapsed_s;
-    out->time_remaining_s = remaining(m);
-    out->distance_done_mm = m->dist_mm;
-    out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
-    out->feed_override = m->rate;
-    out->settings_done = m->marks_base + m->marks_done;
     /* (with jerk limits the spindle gets a command when the average reaches it: the wait
      * for it at speed counts from then, not from when the executor passed it) */
     const struct motion_spindle *sp = m->jerk ? &m->io_out : &m->io;
     if (sp->dir != m->io.dir || sp->rpm != m->io.rpm || sp->mist != m->io.mist ||
         sp->flood != m->io.flood)
         m->io_age = 0;
-    out->spindle = *sp;
-    out->spindle_index = m->index_out;
+    int index_out = m->index_out;
     m->index_out = 0;
+    memcpy(out->pose, m->pose, sizeof out->pose);
+    out->tcp = m->loaded && m->tcp;
+    out->tool_len_mm = out->tcp ? m->tool_len_mm : 0;
+    out->seg_kind = m->loaded ? m->seg_kind : 0;
+    memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
+    memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
+    out->path_tol_mm = m->path_tol_mm;
+    memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
+    out->line = m->line;
+    out->file = m->file;
+    out->state = m->state;
+    out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
+    out->time_elapsed_s = m->elapsed_s;
+    out->distance_done_mm = m->dist_mm;
+    out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
+    if (m->brief)
+        return ret;
+    memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
+    memcpy(out->prog_pose, out->tcp ? m->prog_pose : m->pose, sizeof out->prog_pose);
+    memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
+    for (int i = 0; i < KINS_MAX_JOINTS; i++)   /* (all: a fixed count is vectorised; */
+        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];  /* unused ones are 0) */
+    memcpy(out->joint_fb, m->joint_fb, sizeof out->joint_fb);
+    memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
+    out->njoints = m->nj;
+    out->path_vel = m->path_vel;
+    out->time_remaining_s = remaining(m);
+    out->feed_override = m->rate;
+    out->settings_done = m->marks_base + m->marks_done;
+    out->spindle = *sp;
+    out->spindle_index = index_out;
     out->waiting = m->waiting;
     out->tool = m->tool;
     out->outputs = m->jerk ? m->outputs_out : m->outputs;

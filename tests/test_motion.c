@@ -135,6 +135,60 @@ START_TEST(test_trapezoid_hexapod)
 }
 END_TEST
 
+/* motion_set_brief: the record's brief part is the same, bit for bit, as with the whole record
+ * (two machines run the same five-axis program side by side), the rest is left as it was,
+ * and the executor's own course does not change: both end together in the same place. */
+START_TEST(test_brief_record)
+{
+    struct tm_machine a, b;
+    open_hexapod(&a);
+    open_hexapod(&b);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
+           e2[6] = {-10, 15, 640, -2, 4, -6};
+    memcpy(p.start, s0, sizeof s0);
+    tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
+    tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
+    load_start(a.m, &p);
+    load_start(b.m, &p);
+    motion_set_brief(b.m, true);
+    struct motion_out oa, ob;
+    memset(&oa, 0, sizeof oa);
+    memset(&ob, 0xff, sizeof ob);           /* (a NaN in every double the brief leaves) */
+    long n = 0;
+    do {
+        ck_assert_int_eq(motion_step(a.m, DT, &oa), MOTION_OK);
+        ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
+        ck_assert(!memcmp(oa.pose, ob.pose, sizeof oa.pose));
+        ck_assert(!memcmp(oa.joint_pos, ob.joint_pos, sizeof oa.joint_pos));
+        ck_assert(!memcmp(oa.seg_from, ob.seg_from, sizeof oa.seg_from));
+        ck_assert(!memcmp(oa.seg_to, ob.seg_to, sizeof oa.seg_to));
+        ck_assert_int_eq(oa.tcp, ob.tcp);
+        ck_assert(oa.tool_len_mm == ob.tool_len_mm && oa.path_tol_mm == ob.path_tol_mm);
+        ck_assert_int_eq(oa.seg_kind, ob.seg_kind);
+        ck_assert_int_eq(oa.line, ob.line);
+        ck_assert((!oa.file && !ob.file) || (oa.file && ob.file && !strcmp(oa.file, ob.file)));
+        ck_assert_int_eq(oa.state, ob.state);
+        ck_assert_int_eq(oa.status, ob.status);
+        ck_assert(oa.time_elapsed_s == ob.time_elapsed_s);
+        ck_assert(oa.distance_done_mm == ob.distance_done_mm);
+        ck_assert(oa.distance_total_mm == ob.distance_total_mm);
+        ck_assert(isnan(ob.time_remaining_s) && isnan(ob.pose_vel[0]) &&
+                  isnan(ob.joint_vel[0]) && isnan(ob.motor_pos[0]) && isnan(ob.path_vel));
+    } while (oa.state == MOTION_RUNNING && ++n < 100000);
+    ck_assert_int_eq(oa.state, MOTION_DONE);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(ob.pose[i], e2[i], 1e-9);
+    motion_set_brief(b.m, false);            /* off again: the whole record */
+    ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
+    ck_assert(ob.time_remaining_s == 0 && ob.path_vel == 0);
+    canon_prog_free(&p);
+    tm_close(&a);
+    tm_close(&b);
+}
+END_TEST
+
 /* Largest distance of the run's XYZ from a circle of radius r about c in the plane normal n,
  * and largest distance from that plane (for a planar arc). */
 struct arc_check { double c[3], n[3], r, max_rad_err, max_plane_err; };
@@ -451,6 +505,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_trapezoid_trivial);
     tcase_add_test(tc, test_triangle_and_rapid);
     tcase_add_test(tc, test_trapezoid_hexapod);
+    tcase_add_test(tc, test_brief_record);
     tcase_add_test(tc, test_arcs);
     tcase_add_test(tc, test_helix);
     tcase_add_test(tc, test_dwell);
