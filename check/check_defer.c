@@ -201,7 +201,9 @@ struct check_defer_slot *check_defer_next(struct check_defer *d, int wait)
              * go on; a value is taken at once (claim never passes a slot untaken) */
             if (state != CHECK_DEFER_DONE && !wait)
                 return NULL;
-            size_t i = 0, n = claim_run(d, CHECK_DEFER_RUN, &i);
+            /* (waiting, the pass computes a run at once; else it takes the value alone,
+             * and leaves the measures after it to the helper) */
+            size_t i = 0, n = claim_run(d, wait ? CHECK_DEFER_RUN : 1, &i);
             compute_run(d, i, n);
             continue;
         }

@@ -149,12 +149,53 @@ START_TEST(test_defer_order_and_values)
 }
 END_TEST
 
+/* The pass takes a value that needs no computing without taking the measures behind it:
+ * those wait for the helper (and once it must wait, it computes a run of them itself). */
+START_TEST(test_defer_value_alone)
+{
+    char ip[1024], err[1024];
+    struct check_machine *mc;
+    ck_assert_msg(check_machine_open(tc_path(TMU_INI, ip, sizeof ip), &mc, err, sizeof err) == 0,
+                  "%s", err);
+    struct kins *k = check_machine_kins(mc);
+    struct kins_tool_frame tf;
+    ck_assert_int_eq(kins_get_tool_frame(k, &tf), KINS_OK);
+    struct check_defer *d = check_defer_new(k, &tf, 0);
+    ck_assert(d != NULL);
+    for (int i = 0; i < 6; i++) {
+        struct check_defer_slot *s = check_defer_push(d, i == 0 ? CHECK_DEFER_FLUSH
+                                                                : CHECK_DEFER_DEVIATION);
+        ck_assert(s != NULL);
+        fill(s, k, i);
+        check_defer_commit(d);
+    }
+    const struct check_defer_slot *q = check_defer_next(d, 0);
+    ck_assert(q != NULL && q->line == 0);
+    ck_assert_int_eq(atomic_load(&d->claim), 1);       /* the value alone */
+    ck_assert(check_defer_next(d, 0) == NULL);           /* the measure waits */
+    ck_assert_int_eq(check_defer_work(d), 1);            /* the helper takes one */
+    q = check_defer_next(d, 0);
+    ck_assert(q != NULL && q->line == 1 && q->ok);
+    q = check_defer_next(d, 1);                          /* the pass must go on: it */
+    ck_assert(q != NULL && q->line == 2);                /* computes the rest at once */
+    ck_assert_int_eq(atomic_load(&d->claim), 6);
+    for (int i = 3; i < 6; i++) {
+        q = check_defer_next(d, 0);
+        ck_assert(q != NULL && q->line == i && q->ok);
+    }
+    ck_assert(check_defer_next(d, 0) == NULL);
+    check_defer_free(d);
+    check_machine_close(mc);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("check_defer");
     TCase *tc = tcase_create("defer");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_defer_order_and_values);
+    tcase_add_test(tc, test_defer_value_alone);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
