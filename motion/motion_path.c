@@ -663,6 +663,29 @@ int motion_path_build(struct motion *m, const struct canon_prog *prog,
     return MOTION_OK;
 }
 
+int motion_plan_reserve(struct motion_plan *p, size_t nseg, size_t narc, size_t nknot)
+{
+    if (p->capseg || p->caparc || p->capknot)
+        return 0;                     /* (an empty plan's arrays only) */
+    struct motion_plan r = { 0 };
+    double **arr[7] = {&r.ks, &r.kv, &r.kt, &r.krho, &r.iacc, &r.irho, &r.ivp};
+    int ok = nseg && nknot && (r.segs = malloc(nseg * sizeof *r.segs)) &&
+             (!narc || (r.arcs = malloc(narc * sizeof *r.arcs)));
+    for (int i = 0; i < 7 && ok; i++)
+        ok = (*arr[i] = malloc(nknot * sizeof **arr[i])) != NULL;
+    if (!ok) {                        /* (the plan grows as it needs instead) */
+        free(r.segs), free(r.arcs);
+        for (int i = 0; i < 7; i++)
+            free(*arr[i]);
+        return -1;
+    }
+    p->segs = r.segs, p->capseg = nseg;
+    p->arcs = r.arcs, p->caparc = narc;
+    p->ks = r.ks, p->kv = r.kv, p->kt = r.kt, p->krho = r.krho;
+    p->iacc = r.iacc, p->irho = r.irho, p->ivp = r.ivp, p->capknot = nknot;
+    return 0;
+}
+
 /* Frees everything a plan holds and empties it. */
 void motion_plan_free(struct motion_plan *p)
 {

@@ -370,6 +370,7 @@ static int plan_window(struct motion_stream *s, bool final, bool sync)
     if (s->m) {                  /* the executor's from now on; a check keeps the arrays */
         c->plan = *p;
         memset(p, 0, sizeof *p);
+        motion_plan_reserve(p, c->plan.capseg, c->plan.caparc, c->plan.capknot);
     }
     if (!final)
         shift_window(s, cut);
