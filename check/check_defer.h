@@ -22,9 +22,10 @@ enum check_defer_kind {
     CHECK_DEFER_DEVIATION,           /* forward kinematics at mid-chord: computed */
     CHECK_DEFER_CONDITION,           /* the condition number at a pose: computed, or the
                                       * matrix it is of (has_m), which the pass bounds */
-    CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning (value: the
+    CHECK_DEFER_FLUSH,               /* a straight move's end: its tip warning (value2: the
                                       * largest tip deviation the pass measured in the move) */
-    CHECK_DEFER_MOVE,                /* a straight move's start: its line and file */
+    CHECK_DEFER_MOVE,                /* a straight move's start: its line and file; with ok
+                                      * set, also the end of the move before (as FLUSH) */
 };
 enum check_defer_state { CHECK_DEFER_WAITING, CHECK_DEFER_DONE };
 /* How a deviation measures the tip of the interpolated legs. */
@@ -50,10 +51,11 @@ struct check_defer_slot {
     enum check_defer_tip tip_mode;
     double tool_len_mm;              /* the tool of the period, for the tip */
     double t0[3], t1[3];             /* CHECK_TIP_LINE and _AXIS: the move's tip line */
-    int ok;                          /* result: the solve succeeded */
+    int ok;                          /* result: the solve succeeded (MOVE: see above) */
     double value;                    /* deviation (mm), condition number; MOVE: how far the
-                                      * planner may round the move, mm; FLUSH: see above */
-    double value2;                   /* deviation: the orientation's, deg */
+                                      * planner may round the move, mm */
+    double value2;                   /* deviation: the orientation's, deg; FLUSH, MOVE: the
+                                      * tip's largest deviation in the move before, mm */
     double tip;                      /* deviation: the tip's, mm (tip_mode != NONE) */
     int has_m;                       /* condition: m holds the kinematics' condition matrix
                                       * (kins_condition_matrix), value nothing */

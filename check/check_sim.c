@@ -140,9 +140,9 @@ static inline void leg_diffs(double L, double Lp, double vp, double ap, double i
  * accelerations, into the figures (the same values, compared the same way, as period by
  * period: a minimum or a maximum does not depend on the order it is taken in). Its state
  * after them into end[] (length, rate, acceleration); whether any period was over a limit
- * (the batch's own extremes against the limits). */
-/* (Lengths, rates and accelerations are finite, the kinematics refusing a pose that is not:
- * with that said to the compiler, the extremes' loop becomes the vector max and min.) */
+ * (the batch's own extremes against the limits). Lengths, rates and accelerations are
+ * finite (the kinematics refuse a pose that is not): with that said to the compiler, the
+ * extremes' loop becomes the vector max and min. */
 __attribute__((optimize("finite-math-only", "no-signed-zeros")))
 static int leg_batch(struct sim *restrict s, int i, int n, double end[3])
 {
