@@ -1,7 +1,7 @@
 # motion/: segment queue, velocity planner, servo-period interpolator, and its HAL component.
 LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/motion_plan.c \
             motion/motion_caps.c motion/motion_blend.c motion/motion_chord.c \
-            motion/motion_step.c motion/motion_manual.c motion/motion_home.c \
+            motion/motion_step.c motion/motion_rate.c motion/motion_manual.c motion/motion_home.c \
             motion/motion_stream.c motion/motion_merge.c motion/motion_probe.c \
             motion/motion_jerk.c motion/motion_sync.c
 TESTS += test_motion test_motion_run test_motion_legs test_motion_override test_motion_hal \

@@ -319,7 +319,7 @@ struct motion {
     bool index_enabled;      /* its value this period */
     int index_out;           /* motion_out.spindle_index of this period */
     struct motion_sync sync;
-    struct motion_phase_memo phases; /* motion_step.c's plan_at: the last interval's phases */
+    struct motion_phase_memo phases; /* motion_plan_at's: the last interval's phases */
     int have_cmd;            /* joint_cmd holds a command */
     double pose[KINS_POSE_DIM];     /* the platform's commanded pose */
     double pose_vel[KINS_POSE_DIM];
@@ -482,6 +482,16 @@ double motion_seg_abc_curvature(const struct motion_plan *p, const struct motion
  * the planner's instructions on dense code). -1, and nothing reserved, when out of memory. */
 int motion_plan_reserve(struct motion_plan *p, size_t nseg, size_t narc, size_t nknot);
 void motion_plan_free(struct motion_plan *p);
+/* The plan's clock under the feed override (motion_rate.c). Plan position, speed and
+ * acceleration at plan time tau within interval ci (its phases memoised in *mp). */
+void motion_plan_at(const struct motion_plan *p, size_t ci, double tau, double *s, double *v,
+                    double *a, struct motion_phase_memo *mp);
+/* The override ceiling at plan time tau, which may lie past interval ci (>= 1). */
+double motion_ceiling_ahead(const struct motion_plan *p, size_t ci, double tau);
+/* The rate after a period dt: toward the target, within every phase's acceleration limit
+ * the period passes, and at most the ceiling (vp: the plan's speed now). */
+double motion_next_rate(const struct motion *m, double target, double vp, double ceiling,
+                        double dt);
 
 /* Planning (motion_plan.c). */
 int motion_plan_profile(struct motion *m, char *err, size_t errlen);
