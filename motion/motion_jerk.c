@@ -227,11 +227,9 @@ void motion_jerk_shift_leg(struct motion *m, int i, double shift)
     j->last[d] += shift;
 }
 
-void motion_jerk_follow(struct motion *m)
+void motion_jerk_average(struct motion *m)
 {
     struct motion_jerk *j = m->jerk;
-    if (!j)
-        return;
     if (motion_sync_direct(m)) {
         /* a synchronised move follows the spindle itself: a lag of T/2 would put the tool
          * off the thread, by a different amount on the way out of a tap than on the way in.

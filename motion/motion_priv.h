@@ -390,13 +390,31 @@ void motion_probe_reset(struct motion *m);
 /* G38 probing (motion_probe.c), called by the executor (motion_step.c). Before the clock
  * advances: watches the probe input on a probe segment; true while a trip asks the path
  * to come to rest (the feed override's target is then 0). */
-bool motion_probe_watch(struct motion *m);
+/* (Each of the three tests inline what it needs before anything else, so that the common
+ * period, no probe wired and no probe move, makes no call.) */
+bool motion_probe_watch_wired(struct motion *m);
+static inline bool motion_probe_watch(struct motion *m)
+{
+    if (m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED)
+        return true;
+    return m->probe_wired && motion_probe_watch_wired(m);
+}
 /* After the clock advanced: a probe move the path came onto this period is looked at from
  * its start (an input already as sought stops it there, before it moves). */
-void motion_probe_arm(struct motion *m);
+void motion_probe_arm_wired(struct motion *m);
+static inline void motion_probe_arm(struct motion *m)
+{
+    if (m->probe_wired)
+        motion_probe_arm_wired(m);
+}
 /* After the pose of the period is evaluated: publishes the result once the probe move has
  * come to rest (tripped) or reached its end (no trip). */
-void motion_probe_settle(struct motion *m);
+void motion_probe_settle_move(struct motion *m);
+static inline void motion_probe_settle(struct motion *m)
+{
+    if (m->probe_seg)
+        motion_probe_settle_move(m);
+}
 
 /* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
 #define MOTION_JERK_MAX_S 1.0
@@ -406,7 +424,12 @@ int motion_jerk_init(struct motion *m, char *err, size_t errlen);
 void motion_jerk_free(struct motion *m);
 /* After the executor evaluated the period: its pose, legs and rates go into the average and
  * the motion's values become the average's (the move, line and file of the window's middle). */
-void motion_jerk_follow(struct motion *m);
+void motion_jerk_average(struct motion *m);
+static inline void motion_jerk_follow(struct motion *m)
+{
+    if (m->jerk)                 /* (without jerk limits, no call) */
+        motion_jerk_average(m);
+}
 /* The evaluation failed: the motion's values go back to the last output. */
 void motion_jerk_restore(struct motion *m);
 /* A period without program motion (manual, idle, paused, done, fault): the average holds
@@ -435,7 +458,14 @@ bool motion_sync_advance(struct motion *m, double dt);
  * time: the wait for the index at a run's first move, and a tap's spindle reversals with
  * the run-on travelled back (the executor's clock skips it, motion_step.c). */
 double motion_sync_extra_s(const struct motion *m, const struct motion_plan *p, size_t j);
-bool motion_sync_at(const struct motion *m, double *s, double *v);
+bool motion_sync_position(const struct motion *m, const struct motion_seg *sg, double *s,
+                          double *v);
+static inline bool motion_sync_at(const struct motion *m, double *s, double *v)
+{
+    const struct motion_seg *sg = &m->run->segs[m->cs];
+    return sg->sync && motion_sync_position(m, sg, s, v);  /* (no call off a synchronised
+                                                            * move) */
+}
 /* Whether the spindle drives the path now (following it, or a tap's own moves between): the
  * jerk limiter's moving average stands aside, so the tool keeps its place on the thread. */
 bool motion_sync_direct(const struct motion *m);

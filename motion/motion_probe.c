@@ -47,12 +47,8 @@ static void take_pose(const struct motion *m, double pose[KINS_POSE_DIM])
     memcpy(pose, m->prog_pose, sizeof m->prog_pose);
 }
 
-bool motion_probe_watch(struct motion *m)
+bool motion_probe_watch_wired(struct motion *m)
 {
-    if (m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED)
-        return true;
-    if (!m->probe_wired)
-        return false;
     /* the stop before a probe move counts as its start: nothing moves before the input is
      * first looked at */
     size_t k = m->cs;
@@ -81,12 +77,11 @@ bool motion_probe_watch(struct motion *m)
     return true;
 }
 
-void motion_probe_arm(struct motion *m)
+void motion_probe_arm_wired(struct motion *m)
 {
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
-    if (!m->probe_wired || !sg->probe || m->probe_seg == m->cs + 1 ||
-        m->probe_halt != PROBE_WATCHING)
+    if (!sg->probe || m->probe_seg == m->cs + 1 || m->probe_halt != PROBE_WATCHING)
         return;
     /* the path came onto the move within this period, without a look at the input at its
      * start: look now, and if it is already as sought, back to the start (at rest there) */
@@ -103,9 +98,9 @@ void motion_probe_arm(struct motion *m)
     m->probe_halt = PROBE_HALTING;
 }
 
-void motion_probe_settle(struct motion *m)
+void motion_probe_settle_move(struct motion *m)
 {
-    if (!m->probe_seg || !m->run || m->probe_seg > m->run->nseg)
+    if (!m->run || m->probe_seg > m->run->nseg)
         return;
     const struct motion_seg *sg = &m->run->segs[m->probe_seg - 1];
     if (m->probe_halt == PROBE_HALTING && m->rate == 0 && motion_jerk_settled(m)) {

@@ -225,10 +225,7 @@ static void advance(struct motion *m, double dt)
         probe_parked(m);
         return;
     }
-    /* (the common case, no probe wired, no jerk limits, no synchronised move, costs no call
-     * into motion_probe.c, motion_jerk.c or motion_sync.c: each tests the same first) */
-    bool probe_halt = m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED ||
-                      (m->probe_wired && motion_probe_watch(m));
+    bool probe_halt = motion_probe_watch(m);
     if (m->waiting) {  /* held for the spindle: pause and abort end the wait at rest */
         if (m->state == MOTION_RUNNING)
             follow_knots(m);
@@ -274,8 +271,7 @@ static void advance(struct motion *m, double dt)
     }
     follow_knots(m);
     p = m->run;                  /* a streamed program may have gone on into the next chunk */
-    if (m->probe_wired)
-        motion_probe_arm(m);
+    motion_probe_arm(m);
     if (m->step_until_seg && m->cs >= m->step_until_seg && m->state == MOTION_RUNNING) {
         m->step_until_seg = 0;   /* the block is done: pause on the path */
         m->state = MOTION_PAUSING;
@@ -330,8 +326,7 @@ static int evaluate(struct motion *m)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
     motion_plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
-    if (sg->sync)                      /* a synchronised move: where the spindle has it */
-        motion_sync_at(m, &s, &vp);
+    motion_sync_at(m, &s, &vp);        /* a synchronised move: where the spindle has it */
     if (m->state == MOTION_DONE) {
         s = sg->len;
         vp = 0;
@@ -572,12 +567,11 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         pass_ios(m);
         /* (a streamed end holds no move; at rest on a probe's trip the pose holds) */
         int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m) : KINS_OK;
-        if (st == KINS_OK && m->jerk)
+        if (st == KINS_OK)
             motion_jerk_follow(m);
-        else if (st != KINS_OK)
+        else
             motion_jerk_restore(m);
-        if (m->probe_seg)
-            motion_probe_settle(m);
+        motion_probe_settle(m);
         if (st != KINS_OK) {
             motion_set_msg(m, "%s:%d: the kinematics failed on the planned path "
                      "(%s); machine stopped", m->file ? m->file : "program", m->line,

@@ -467,11 +467,11 @@ bool motion_sync_advance(struct motion *m, double dt)
     return true;
 }
 
-bool motion_sync_at(const struct motion *m, double *s, double *v)
+bool motion_sync_position(const struct motion *m, const struct motion_seg *sg, double *s,
+                          double *v)
 {
-    const struct motion_seg *sg = &m->run->segs[m->cs];
     const struct motion_sync *y = &m->sync;
-    if (!sg->sync || sg->kind != SEG_LINE || y->phase == SYNC_IDLE)
+    if (sg->kind != SEG_LINE || y->phase == SYNC_IDLE)
         return false;
     bool here = y->run == m->run && y->seg == m->cs;
     if (here && (y->phase == SYNC_CHAIN || y->phase == SYNC_LEFT))
