@@ -283,15 +283,23 @@ static void tip_flush(struct sim *s)
 static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind kind,
                                          const struct motion_out *out);
 
+/* The largest tip deviation measured in place in the move being followed, mm, handed on
+ * (the next move starts from nothing). */
+static double move_tip_taken(struct sim *s)
+{
+    double d = sqrt(s->move_tip2);
+    s->move_tip2 = 0;
+    return d;
+}
+
 /* The end of the move being followed, in order with the measures: its tip warning, with the
  * largest deviation measured in place. A straight move that follows at once ends it with
  * its own MOVE instead (one slot for both). */
 static void tip_end_move(struct sim *s, const struct motion_out *out)
 {
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_FLUSH, out);
-    q->value2 = sqrt(s->move_tip2);
+    q->value2 = move_tip_taken(s);
     check_defer_commit(s->dq);
-    s->move_tip2 = 0;
 }
 
 /* The straight feed being followed: its tip line (from the kinematics' tool at its ends, or
@@ -336,9 +344,8 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_MOVE, out);
     q->value = out->path_tol_mm;             /* the warning's line, file and tolerance */
     q->ok = flush;                           /* the move before ends here: its largest */
-    q->value2 = sqrt(s->move_tip2);          /* deviation in place */
+    q->value2 = move_tip_taken(s);           /* deviation in place */
     check_defer_commit(s->dq);
-    s->move_tip2 = 0;
 }
 
 /* A deviation's tip d at program line `line`, in order, into the figures. */
@@ -358,14 +365,9 @@ static void tip_period(struct sim *s, const struct motion_out *out)
     tip_move(s, out);
     if (!s->tip_line || !s->tip_swing)
         return;
-    double tip[3], w[3], u = 0, e2 = 0;
+    double tip[3];
     tip_of(s, out, out->pose, tip);
-    for (int i = 0; i < 3; i++)    /* (motion_dist_seg's distance, kept squared: the root of
-                                    * the largest square is the largest root) */
-        w[i] = tip[i] - s->tip_t0[i], u += w[i] * s->tip_d[i];
-    u = s->tip_n2 > 0 ? fmin(1, fmax(0, u / s->tip_n2)) : 0;
-    for (int i = 0; i < 3; i++)
-        e2 += (w[i] - u * s->tip_d[i]) * (w[i] - u * s->tip_d[i]);
+    double e2 = motion_dist2_seg(tip, s->tip_t0, s->tip_d, s->tip_n2);
     if (e2 > s->move_tip2)
         s->move_tip2 = e2;
     if (e2 > s->tip_max2)

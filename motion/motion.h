@@ -401,6 +401,10 @@ bool motion_pose_known(const struct motion *m);
 void motion_set_wait_at_speed(struct motion *m, bool on);
 /* Distance of point p from the segment a..b (X Y Z, mm); from a when the two coincide. */
 double motion_dist_seg(const double p[3], const double a[3], const double b[3]);
+/* Its square, for the segment from a along d, with n2 = |d|^2 given (a caller that measures
+ * many points against one segment, and keeps the largest: the root of the largest square is
+ * the largest root). */
+double motion_dist2_seg(const double p[3], const double a[3], const double d[3], double n2);
 /* Off: motion_step computes the leg positions alone, joint_vel and pose_vel read 0 (a check
  * that differences successive set points; a fifth less time per period). On by default. */
 void motion_set_rates(struct motion *m, bool on);

@@ -30,15 +30,23 @@ static int holdable(const struct motion_merge *g, const struct canon_cmd *c)
     return c->end[0] != g->at[0] || c->end[1] != g->at[1] || c->end[2] != g->at[2];
 }
 
-double motion_dist_seg(const double p[3], const double a[3], const double b[3])
+double motion_dist2_seg(const double p[3], const double a[3], const double d[3], double n2)
 {
-    double d[3], w[3], n2 = 0, u = 0, e2 = 0;
+    double w[3], u = 0, e2 = 0;
     for (int i = 0; i < 3; i++)
-        d[i] = b[i] - a[i], w[i] = p[i] - a[i], n2 += d[i] * d[i], u += w[i] * d[i];
+        w[i] = p[i] - a[i], u += w[i] * d[i];
     u = n2 > 0 ? fmin(1, fmax(0, u / n2)) : 0;
     for (int i = 0; i < 3; i++)
         e2 += (w[i] - u * d[i]) * (w[i] - u * d[i]);
-    return sqrt(e2);
+    return e2;
+}
+
+double motion_dist_seg(const double p[3], const double a[3], const double b[3])
+{
+    double d[3], n2 = 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = b[i] - a[i], n2 += d[i] * d[i];
+    return sqrt(motion_dist2_seg(p, a, d, n2));
 }
 
 /* Whether holdable feed c joins the run: same feed and file, room left, and every end of the
