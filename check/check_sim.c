@@ -570,12 +570,14 @@ static void measures(struct sim *s, const struct motion_out *out)
         deviation(s, out);
         s->next_dev_s = t + s->o->deviation_every_s;
     }
-    /* what is ready, without waiting, of the periods whose legs are tested (a leg's problem
-     * comes before the measures of its period and after) */
-    long before = s->bn ? s->bfirst : LONG_MAX;
-    const struct check_defer_slot *o, *q;
-    while ((o = check_defer_oldest(s->dq)) && o->period < before &&
-           (q = check_defer_next(s->dq, 0)))
+    /* what is ready, without waiting, once the legs' batch is tested (a leg's problem comes
+     * before the measures of its period and after): between batches nothing more could be
+     * applied but what became ready meanwhile, and a look at the helper's claims each period
+     * cost more than it saved (a cache line the other thread writes) */
+    if (s->bn)
+        return;
+    const struct check_defer_slot *q;
+    while (check_defer_oldest(s->dq) && (q = check_defer_next(s->dq, 0)))
         apply(s, q);
 }
 
