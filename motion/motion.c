@@ -112,6 +112,7 @@ static void rewind_plan(struct motion *m)
     atomic_store(&m->probe_seq, 0);
     motion_sync_index_withdraw(m);
     m->sync.phase = SYNC_IDLE;
+    m->seg_at = NULL;
     m->line = m->run && m->run->nseg ? m->run->segs[0].line : 0;
     m->file = m->run && m->run->nseg ? m->run->segs[0].file : NULL;
 }

@@ -122,6 +122,7 @@ static void scatter(struct motion *m, const double *x, const struct motion_jerk_
     m->path_vel = x[o++];
     m->dist_mm = x[o];
     m->line = mt->line, m->seg_kind = mt->seg_kind, m->tcp = mt->tcp, m->file = mt->file;
+    m->seg_at = NULL;          /* (the leader's segment values are taken again) */
     m->tool_len_mm = mt->tool_len_mm;
     m->path_tol_mm = mt->path_tol_mm;
     memcpy(m->seg_from, mt->seg_from, sizeof m->seg_from);

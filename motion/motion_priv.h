@@ -329,6 +329,9 @@ struct motion {
     int seg_kind;            /* it is a line (1), an arc (2), a stop (0) ... */
     double seg_from[KINS_POSE_DIM], seg_to[KINS_POSE_DIM]; /* ... from and to these poses */
     double path_tol_mm;      /* ... rounded by at most this (motion_out) */
+    const struct motion_seg *seg_at; /* the segment those (and line, file) were taken from:
+                              * evaluate() takes them again only on another one (NULL
+                              * wherever the plan run changes: rewind, a chunk entered) */
     double joint_cmd[KINS_MAX_JOINTS];
     double joint_vel[KINS_MAX_JOINTS];
     double ferror[KINS_MAX_JOINTS];

@@ -134,6 +134,7 @@ static void enter_chunk(struct motion *m, struct motion_chunk *c, struct motion_
     m->waited_at_seg = 0;
     m->chunk = n;
     m->run = &n->plan;
+    m->seg_at = NULL;
     motion_probe_reset(m);
     if (c)
         atomic_store_explicit(&c->retired, 1, memory_order_release);
@@ -319,6 +320,20 @@ static void advance(struct motion *m, double dt)
     }
 }
 
+/* What the status reports of the segment being followed, taken once per segment. */
+static void seg_values(struct motion *m, const struct motion_seg *sg)
+{
+    m->seg_at = sg;
+    m->tcp = sg->tcp;
+    m->tool_len_mm = sg->tool_len_mm;
+    m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
+    memcpy(m->seg_from, sg->start, sizeof m->seg_from);
+    memcpy(m->seg_to, sg->end, sizeof m->seg_to);
+    m->path_tol_mm = fmax(m->cfg.kin_tol_mm, motion_jerk_round_mm(m, sg));
+    m->line = sg->line;
+    m->file = sg->file;
+}
+
 /* Pose, rates and legs at the current plan time. */
 static int evaluate(struct motion *m)
 {
@@ -340,12 +355,8 @@ static int evaluate(struct motion *m)
         motion_seg_tangent(p, sg, s, dp);
     else
         memset(dp, 0, sizeof dp);
-    m->tcp = sg->tcp;
-    m->tool_len_mm = sg->tool_len_mm;
-    m->seg_kind = sg->kind > SEG_ARC ? 0 : sg->feed == 0 ? 3 : sg->kind == SEG_LINE ? 1 : 2;
-    memcpy(m->seg_from, sg->start, sizeof m->seg_from);
-    memcpy(m->seg_to, sg->end, sizeof m->seg_to);
-    m->path_tol_mm = fmax(m->cfg.kin_tol_mm, motion_jerk_round_mm(m, sg));
+    if (sg != m->seg_at)
+        seg_values(m, sg);
     if (sg->tcp && vr == 0) {
         kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
@@ -360,8 +371,6 @@ static int evaluate(struct motion *m)
             m->pose_vel[i] = dp[i] * vr;
     }
     m->path_vel = v;
-    m->line = sg->line;
-    m->file = sg->file;
     m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
     if (vr == 0) {
         memset(m->joint_vel, 0, sizeof m->joint_vel);

@@ -189,6 +189,36 @@ START_TEST(test_brief_record)
 }
 END_TEST
 
+/* The status's segment values (line, the move's ends, its kind) are taken once per segment:
+ * a second program loaded into the same instance, whose plan may lie where the first's did,
+ * reports its own from its first period on. */
+START_TEST(test_segment_values_per_program)
+{
+    struct tm_machine a;
+    open_hexapod(&a);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {20, 0, 645, 0, 0, 0},
+           e2[6] = {0, 20, 645, 0, 0, 0};
+    struct motion_out o;
+    for (int run = 0; run < 2; run++) {
+        struct canon_prog p;
+        canon_prog_init(&p);
+        memcpy(p.start, s0, sizeof s0);
+        tm_add(&p, CANON_FEED, run ? 7 : 3, run ? e2 : e1, 1500, 0);
+        load_start(a.m, &p);
+        long n = 0;
+        do {
+            ck_assert_int_eq(motion_step(a.m, DT, &o), MOTION_OK);
+            ck_assert_int_eq(o.line, run ? 7 : 3);
+            ck_assert(!memcmp(o.seg_to, run ? e2 : e1, sizeof o.seg_to));
+            ck_assert_int_eq(o.seg_kind, 1);
+        } while (o.state == MOTION_RUNNING && ++n < 100000);
+        ck_assert_int_eq(o.state, MOTION_DONE);
+        canon_prog_free(&p);
+    }
+    tm_close(&a);
+}
+END_TEST
+
 /* Largest distance of the run's XYZ from a circle of radius r about c in the plane normal n,
  * and largest distance from that plane (for a planar arc). */
 struct arc_check { double c[3], n[3], r, max_rad_err, max_plane_err; };
@@ -506,6 +536,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_triangle_and_rapid);
     tcase_add_test(tc, test_trapezoid_hexapod);
     tcase_add_test(tc, test_brief_record);
+    tcase_add_test(tc, test_segment_values_per_program);
     tcase_add_test(tc, test_arcs);
     tcase_add_test(tc, test_helix);
     tcase_add_test(tc, test_dwell);
