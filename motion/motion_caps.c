@@ -149,9 +149,9 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
 
 /* The set-point period: drives move their legs linearly over it (with jerk limits, the
  * chord that cuts a curve as much as the chords and the moving average together). */
-static double setpoint_period(const struct motion_config *c)
+static double setpoint_period(const struct motion *m)
 {
-    return motion_chord_period(c);
+    return m->chord_period_s;          /* motion_chord_period(&m->cfg) */
 }
 
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
@@ -174,7 +174,7 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
         dmax = sqrt(8 * motion_round_tol_mm(m, sg) / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
         dmax = motion_min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
-    return dmax / setpoint_period(c);
+    return dmax / setpoint_period(m);
 }
 
 /* See motion_priv.h. A set-point chord of length d that touches an arc spans a C1 path whose
@@ -215,7 +215,7 @@ double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
     }
     if (c->kin_tol_deg > 0 && kabc + ang > 1e-30)
         d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
-    return d / setpoint_period(c);
+    return d / setpoint_period(m);
 }
 
 /* Reports a leg out of range at a sample, naming file, line, leg, amount and pose. */
@@ -477,7 +477,7 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     double dx = 0, da = 0, v = HUGE_VAL;
     /* a jump of the direction by dx at speed v: a set-point chord across it cuts the corner
      * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8 */
-    Ts += motion_jerk_window_s(c) / 2;
+    Ts += m->jerk_window_s / 2;
     for (int i = 0; i < 3; i++)
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);

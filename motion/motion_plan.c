@@ -340,7 +340,7 @@ static double stop_rest_s(const struct motion *m, size_t j)
     const struct motion_config *c = &m->cfg;
     double T = (stops_need_rest(c) ? c->setpoint_period_s > 0 ? c->setpoint_period_s
                                                                : c->servo_period_s : 0) +
-               motion_jerk_window_s(c);
+               m->jerk_window_s;
     double rested = 0, u0[KINS_POSE_DIM], u1[KINS_POSE_DIM], du = 0;
     size_t k = j + 1;
     for (; k < p->nseg && p->segs[k].kind > SEG_ARC; k++) {

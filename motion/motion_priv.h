@@ -227,6 +227,8 @@ enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOM
 /* The motion instance. */
 struct motion {
     struct motion_config cfg;
+    double jerk_window_s;    /* motion_jerk_window_s(&cfg) and motion_chord_period(&cfg), */
+    double chord_period_s;   /* taken once (every knot's caps use them) */
     struct kins *kins;       /* borrowed */
     struct kins_tool_frame tf; /* the machine's tool, for tool centre point control */
     int have_tf;             /* the kinematics has a tool frame */
