@@ -458,7 +458,21 @@ double motion_chord_period(const struct motion_config *c);
  * position and speed there (true when on one). */
 int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
                       size_t errlen);
-bool motion_sync_advance(struct motion *m, double dt);
+/* (The ideal spindle's period, when it turns or was told to, and a synchronised line's
+ * follower: the calls behind the two first tests.) */
+void motion_sync_spindle(struct motion *m, double dt);
+bool motion_sync_advance_line(struct motion *m, const struct motion_seg *sg, double dt);
+static inline bool motion_sync_advance(struct motion *m, double dt)
+{
+    if (m->spindle_ideal && (m->io.dir * m->io.rpm != 0 || m->ideal_rps != 0))
+        motion_sync_spindle(m, dt);
+    const struct motion_seg *sg = &m->run->segs[m->cs];
+    if (!sg->sync || sg->kind != SEG_LINE) {
+        m->sync.phase = SYNC_IDLE;
+        return false;
+    }
+    return motion_sync_advance_line(m, sg, dt);
+}
 /* The time synchronised segment j of p takes beyond its travel at S x K, for the plan's
  * time: the wait for the index at a run's first move, and a tap's spindle reversals with
  * the run-on travelled back (the executor's clock skips it, motion_step.c). */

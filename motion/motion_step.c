@@ -103,9 +103,13 @@ static int settle_here(struct motion *m)
 /* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
 static int pause_here(struct motion *m)
 {
+    const struct motion_seg *sg = &m->run->segs[m->cs];
+    if (sg->kind != SEG_PAUSE && sg->kind != SEG_WAIT) {
+        m->waiting = 0;                /* (what the two below come to on any other) */
+        return 0;
+    }
     if (settle_here(m) || wait_here(m))
         return 1;
-    const struct motion_seg *sg = &m->run->segs[m->cs];
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
         return 0;
     m->paused_at_seg = m->cs + 1;

@@ -203,7 +203,7 @@ double motion_sync_extra_s(const struct motion *m, const struct motion_plan *p, 
 
 /* The ideal spindle of a check: it reaches the commanded speed at [SPINDLE_SYNC]
  * ACCELERATION (at once when that is not given) and turns. */
-static void ideal_spindle(struct motion *m, double dt)
+void motion_sync_spindle(struct motion *m, double dt)
 {
     if (!m->spindle_ideal || atomic_load_explicit(&m->spindle_wired, memory_order_relaxed))
         return;
@@ -422,15 +422,9 @@ static void sync_tap(struct motion *m, const struct motion_seg *sg, double d_t, 
     }
 }
 
-bool motion_sync_advance(struct motion *m, double dt)
+bool motion_sync_advance_line(struct motion *m, const struct motion_seg *sg, double dt)
 {
-    ideal_spindle(m, dt);
-    const struct motion_seg *sg = &m->run->segs[m->cs];
     struct motion_sync *y = &m->sync;
-    if (!sg->sync || sg->kind != SEG_LINE) {
-        y->phase = SYNC_IDLE;
-        return false;
-    }
     bool here = y->run == m->run && y->seg == m->cs;
     if (here && (y->phase == SYNC_CHAIN || y->phase == SYNC_LEFT))
         return false;                 /* left at its end: the plan's clock goes on */
