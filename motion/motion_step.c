@@ -100,14 +100,24 @@ static int settle_here(struct motion *m)
     return 1;
 }
 
-/* At the start of an M0/M1 segment not yet honoured: stop there and pause. */
-static int pause_here(struct motion *m)
+static __attribute__((noinline)) int pause_or_wait_here(struct motion *m,
+                                                       const struct motion_seg *sg);
+
+/* At the start of an M0/M1 segment not yet honoured: stop there and pause (and at a wait's,
+ * wait: wait_here). Only those two segments call out of the period's path. */
+static inline int pause_here(struct motion *m)
 {
     const struct motion_seg *sg = &m->run->segs[m->cs];
     if (sg->kind != SEG_PAUSE && sg->kind != SEG_WAIT) {
         m->waiting = 0;                /* (what the two below come to on any other) */
         return 0;
     }
+    return pause_or_wait_here(m, sg);
+}
+
+/* pause_here on a pause or a wait segment sg. */
+static int pause_or_wait_here(struct motion *m, const struct motion_seg *sg)
+{
     if (settle_here(m) || wait_here(m))
         return 1;
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
