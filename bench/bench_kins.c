@@ -216,6 +216,35 @@ static struct figure bench_inverse(struct bench *B)
     return f;
 }
 
+/* Best-of-RUNS ns per pose of kins_inverse4 (four poses a call) beside kins_inverse one at
+ * a time, chunked as bench_inverse: .ns the four at once, .naive_ns one at a time. */
+static struct figure bench_inverse4(struct bench *B)
+{
+    struct figure f = { 0, 0, 0, 0, 0 };
+    double joints[4][KINS_MAX_JOINTS];
+    int st[4];
+    for (int from = 0; from < NPOSE; from += CHUNK) {
+        double best = 1e99, one_best = 1e99;
+        for (int run = 0; run < RUNS; run++) {
+            double t0 = now_ns();
+            for (int n = from; n + 4 <= from + CHUNK; n += 4) {
+                kins_inverse4(B->k, (const double(*)[KINS_POSE_DIM])B->poses[n], joints, st);
+                B->sink += joints[3][5];
+            }
+            double t1 = now_ns();
+            for (int n = from; n < from + CHUNK; n++)
+                kins_inverse(B->k, B->poses[n], B->legs[n]);
+            double t2 = now_ns();
+            B->sink += B->legs[from][3];
+            best = fmin(best, t1 - t0);
+            one_best = fmin(one_best, t2 - t1);
+        }
+        f.ns += best / NPOSE;
+        f.naive_ns += one_best / NPOSE;
+    }
+    return f;
+}
+
 /* Forward solves of legs[from..to); warm: each starts from the previous result (the first
  * from the path pose before it), else from home. Returns total iterations of ours or, with
  * naive set, of the baseline. */
@@ -342,6 +371,7 @@ int main(void)
     if (bench_setup(&B, c, &top_speed) != 0)
         return 1;
     struct figure inv = bench_inverse(&B);
+    struct figure inv4 = bench_inverse4(&B);
     struct figure warm = bench_forward(&B, 1);
     struct figure cold = bench_forward(&B, 0);
 
@@ -350,6 +380,8 @@ int main(void)
     printf("path: %d samples at 1 ms, top speed %.0f mm/min\n", NPATH, top_speed);
     printf("%-34s %10s %10s %8s\n", "", "hexcnc", "naive", "ratio");
     bench_row("inverse, ns/pose", inv.ns, inv.naive_ns);
+    printf("%-34s %10.1f %10s %7.1fx  (one at a time: %.1f ns)\n", "  four at once (inverse4)",
+           inv4.ns, "", inv4.naive_ns / inv4.ns, inv4.naive_ns);
     bench_row("forward warm (1 kHz path), ns", warm.ns, warm.naive_ns);
     printf("%-34s %10.2f %10.2f\n", "  mean iterations", warm.iters, warm.naive_iters);
     printf("%-34s %10d\n", "  max iterations", warm.max_iters);

@@ -416,6 +416,7 @@ const struct kins_ops kins_hexapod_ops = {
     .inverse_path = hexapod_inverse_path,
     .jacobian = hexapod_jacobian,
     .condition_matrix = hexapod_condition_matrix,
+    .inverse4 = hexapod_inverse4,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

@@ -67,6 +67,11 @@ int hexapod_read_workspace(struct hexapod *h, const struct kins_config *cfg, cha
 int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *err,
                       size_t errlen);
 
+/* Four inverses at once, bit for bit hexapod_inverse's (hexapod_batch.c); the kins_ops
+ * inverse4 entry. */
+void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                      double (*joints)[KINS_MAX_JOINTS], int *status);
+
 /* Forward kinematics by Newton-Raphson (hexapod_fwd.c); the kins_ops forward entry. */
 int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
                     struct kins_fwd_info *info);

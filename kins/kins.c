@@ -176,3 +176,14 @@ int kins_describe(struct kins *k, const double *pose, char *msg, size_t len)
         return KINS_OK;
     return k->ops->describe(k, pose, msg, len);
 }
+
+void kins_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                   double (*joints)[KINS_MAX_JOINTS], int *status)
+{
+    if (k->ops->inverse4) {
+        k->ops->inverse4(k, pose, joints, status);
+        return;
+    }
+    for (int l = 0; l < 4; l++)
+        status[l] = k->ops->inverse(k, pose[l], joints[l]);
+}

@@ -1,11 +1,11 @@
 # kins/: kinematics models behind struct kins_ops, linked into the library for tests and
 # tools, and built as lib/kins/<name>.so for loading by name ([KINS] KINEMATICS).
-KINS_HEXAPOD_SRCS := kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c \
+KINS_HEXAPOD_SRCS := kins/hexapod.c kins/hexapod_batch.c kins/hexapod_fwd.c kins/hexapod_geom.c \
                      kins/hexapod_workspace.c kins/kins_cfg.c \
                      common/config_value.c
 KINS_TRIVIAL_SRCS := kins/trivial.c kins/kins_cfg.c common/config_value.c
 
-LIB_SRCS += kins/kins.c kins/kins_tcp.c kins/kins_cfg.c kins/hexapod.c kins/hexapod_fwd.c kins/hexapod_geom.c \
+LIB_SRCS += kins/kins.c kins/kins_tcp.c kins/kins_cfg.c kins/hexapod.c kins/hexapod_batch.c kins/hexapod_fwd.c kins/hexapod_geom.c \
             kins/hexapod_workspace.c \
             kins/trivial.c
 LIB_CXXSRCS += kins/kins_svd.cpp

@@ -213,6 +213,57 @@ START_TEST(test_sincos3)
 }
 END_TEST
 
+/* Four inverses at once (kins_inverse4) give the single inverse's joints and status bit for
+ * bit: poses within the short series' angles, beyond it, beyond the series' range (pi/4),
+ * mixed within one call, legs out of range, a pose that is not a number or is infinite, a
+ * platform below its base joints, and a workspace limit beyond the assembly's (every lane
+ * then goes to the single inverse). */
+START_TEST(test_inverse4)
+{
+    struct kins *k = make_tmu();
+    struct hexapod *h = (struct hexapod *)k;
+    srand48(11);
+    long lanes = 0, ok = 0;
+    for (int n = 0; n < 40000; n++) {
+        double pose[4][KINS_POSE_DIM], got[4][KINS_MAX_JOINTS], want[4][KINS_MAX_JOINTS];
+        int st[4];
+        memset(got, 0, sizeof got);
+        memset(want, 0, sizeof want);
+        for (int l = 0; l < 4; l++) {
+            int kind = (int)(drand48() * 8);
+            double deg = kind < 4 ? 14.0 : kind < 6 ? 45.0 : 55.0;
+            for (int i = 0; i < 3; i++)
+                pose[l][i] = (2 * drand48() - 1) * 120.0;
+            pose[l][KINS_Z] += 645.0;
+            for (int i = 3; i < 6; i++)
+                pose[l][i] = (2 * drand48() - 1) * deg;
+            if (kind == 7 && n % 3 == 0)
+                pose[l][(int)(drand48() * 6)] = n % 2 ? NAN : -INFINITY;
+            if (kind == 7 && n % 3 == 1)
+                pose[l][KINS_Z] = n % 2 ? 1100.0 : -200.0;   /* out of reach, or below */
+        }
+        if (n == 0)                 /* the home pose, and the series' own boundaries */
+            for (int l = 0; l < 4; l++) {
+                double home[6] = { 0, 0, 645, 0, 0, 0 };
+                memcpy(pose[l], home, sizeof home);
+                pose[l][3 + l % 3] = l < 2 ? 45.0 : l == 2 ? -14.323944878270581 : 0;
+            }
+        h->ws_extra = n % 500 == 499;
+        kins_inverse4(k, (const double(*)[KINS_POSE_DIM])pose, got, st);
+        for (int l = 0; l < 4; l++) {
+            int w = kins_inverse(k, pose[l], want[l]);
+            ck_assert_int_eq(st[l], w);
+            ck_assert_msg(!memcmp(got[l], want[l], sizeof got[l]), "pose %d lane %d", n, l);
+            lanes++;
+            ok += w == KINS_OK;
+        }
+    }
+    h->ws_extra = false;
+    ck_assert(ok > lanes / 2 && ok < lanes);     /* both kinds of lane were there */
+    kins_free(k);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("kins_shortcuts");
@@ -221,6 +272,7 @@ int main(void)
     tcase_add_test(tc, test_inverse_path);
     tcase_add_test(tc, test_jacobian);
     tcase_add_test(tc, test_sincos3);
+    tcase_add_test(tc, test_inverse4);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
