@@ -656,6 +656,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     memset(&out, 0, sizeof out);
     motion_set_rates(mc->motion, false);   /* rates come from differences of set points */
     motion_set_brief(mc->motion, true);    /* (and the record holds what the pass reads) */
+    motion_set_ahead(mc->motion, true);    /* (four periods' legs at once where it can) */
     for (long n = 0; n < max_periods; n++) {
         if (feed && motion_stream_starving(mc->motion)) {
             if (!feed->wait(feed->ctx))
@@ -683,6 +684,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     }
     motion_set_rates(mc->motion, true);
     motion_set_brief(mc->motion, false);
+    motion_set_ahead(mc->motion, false);
     legs_batch(&s);
     legs_figures(&s);
     if (s.tip_line)

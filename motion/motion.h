@@ -413,6 +413,10 @@ void motion_set_rates(struct motion *m, bool on);
  * time_elapsed_s, distance_done_mm, distance_total_mm) and leaves the rest of the record as
  * it was: on dense code the record was a tenth of a check's period. Off by default. */
 void motion_set_brief(struct motion *m, bool on);
+/* On (with rates off): the executor computes the path's pose and legs four periods at a
+ * time where the plan's pace lets it see them coming, the same bits as period by period
+ * (motion_ahead.c): a check's pass, not a machine's servo thread. Off by default. */
+void motion_set_ahead(struct motion *m, bool on);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
 /* Tool changes: whether programs planned from now on stop at M6 until the changer is done,
  * and the changer's answer to request seq (the tool is then in the spindle). */

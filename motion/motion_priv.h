@@ -225,6 +225,24 @@ enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOM
                          HOME_LATCH, HOME_SETTLE, HOME_FINAL, HOME_DONE };
 
 /* The motion instance. */
+/* The look-ahead of a check's executor (motion_ahead.c): the next periods' path position,
+ * pose and legs, each keyed by the state it is a function of. */
+#define MOTION_AHEAD 4
+struct motion_ahead_at {
+    size_t ci, cs;           /* the key: interval, segment and plan clock (of run) */
+    double tau_s;
+    double s, vp;            /* motion_plan_at's position and speed there */
+};
+struct motion_ahead {
+    const struct motion_plan *run;
+    struct motion_ahead_at at[MOTION_AHEAD];
+    double pose[MOTION_AHEAD][KINS_POSE_DIM];       /* motion_seg_pose's */
+    double joints[MOTION_AHEAD][KINS_MAX_JOINTS];   /* kins_inverse's, and its status */
+    int status[MOTION_AHEAD];
+    int n, next;             /* entries filled, the next one to take */
+    long fills, taken;       /* fills, and entries taken after the first of a fill */
+};
+
 struct motion {
     struct motion_config cfg;
     double jerk_window_s;    /* motion_jerk_window_s(&cfg) and motion_chord_period(&cfg), */
@@ -282,6 +300,8 @@ struct motion {
     int no_rates;            /* motion_set_rates(m, false): legs only, no rates (a check
                               * differences the set points itself) */
     int brief;               /* motion_set_brief(m, true): the output record's first part */
+    int ahead_on;            /* motion_set_ahead(m, true): evaluate() looks ahead */
+    struct motion_ahead ahead;
     int wait_at_speed;       /* plan a wait for the spindle after M3/M4/S (motion_hal: the
                               * at-speed input is wired) */
     int at_speed;            /* the spindle's at-speed input this period */
@@ -420,6 +440,10 @@ static inline void motion_probe_settle(struct motion *m)
     if (m->probe_seg)
         motion_probe_settle_move(m);
 }
+
+/* The period's entry of the look-ahead (motion_ahead.c), filling it with this period and
+ * the next ones where it has none; NULL on a segment it leaves to evaluate(). */
+const struct motion_ahead_at *motion_ahead(struct motion *m, double dt);
 
 /* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
 #define MOTION_JERK_MAX_S 1.0

@@ -348,22 +348,32 @@ static void seg_values(struct motion *m, const struct motion_seg *sg)
     m->file = sg->file;
 }
 
-/* Pose, rates and legs at the current plan time. */
-static int evaluate(struct motion *m)
+/* Pose, rates and legs at the current plan time (a check's, from the look-ahead's entry
+ * when it has one: motion_ahead.c). */
+static int evaluate(struct motion *m, double dt)
 {
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
-    motion_plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
-    motion_sync_at(m, &s, &vp);        /* a synchronised move: where the spindle has it */
-    if (m->state == MOTION_DONE) {
-        s = sg->len;
-        vp = 0;
+    const struct motion_ahead_at *e = m->ahead_on && m->no_rates && m->state != MOTION_DONE
+                                      ? motion_ahead(m, dt) : NULL;
+    if (e) {
+        s = e->s, vp = e->vp;
+    } else {
+        motion_plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
+        motion_sync_at(m, &s, &vp);    /* a synchronised move: where the spindle has it */
+        if (m->state == MOTION_DONE) {
+            s = sg->len;
+            vp = 0;
+        }
     }
     double v = vp * m->rate;
     if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
         v = 0;
-    motion_seg_pose(p, sg, s, m->prog_pose);
+    if (e)
+        memcpy(m->prog_pose, m->ahead.pose[e - m->ahead.at], sizeof m->prog_pose);
+    else
+        motion_seg_pose(p, sg, s, m->prog_pose);
     double vr = m->no_rates ? 0 : v;   /* the speed the rates are computed for */
     if (vr != 0)
         motion_seg_tangent(p, sg, s, dp);
@@ -388,7 +398,11 @@ static int evaluate(struct motion *m)
     m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
     if (vr == 0) {
         memset(m->joint_vel, 0, sizeof m->joint_vel);
-        return kins_inverse(m->kins, m->pose, m->joint_cmd);
+        int j = e ? (int)(e - m->ahead.at) : 0;
+        if (!e || m->ahead.status[j] != KINS_OK)   /* (a failure as it comes, written or not) */
+            return kins_inverse(m->kins, m->pose, m->joint_cmd);
+        memcpy(m->joint_cmd, m->ahead.joints[j], (size_t)m->nj * sizeof *m->joint_cmd);
+        return KINS_OK;
     }
     int st = kins_inverse_rates(m->kins, m->pose, m->pose_vel, m->joint_cmd, m->joint_vel);
     if (st != KINS_OK)
@@ -589,7 +603,7 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         pass_marks(m);
         pass_ios(m);
         /* (a streamed end holds no move; at rest on a probe's trip the pose holds) */
-        int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m) : KINS_OK;
+        int st = m->run->nseg && m->probe_halt != PROBE_PARKED ? evaluate(m, period_s) : KINS_OK;
         if (st == KINS_OK)
             motion_jerk_follow(m);
         else

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "motion/motion_priv.h"
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
@@ -183,6 +184,73 @@ START_TEST(test_brief_record)
     motion_set_brief(b.m, false);            /* off again: the whole record */
     ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
     ck_assert(ob.time_remaining_s == 0 && ob.path_vel == 0);
+    canon_prog_free(&p);
+    tm_close(&a);
+    tm_close(&b);
+}
+END_TEST
+
+/* The check's look-ahead (motion_set_ahead: four periods' poses and legs at once) changes
+ * nothing a period gives: two machines side by side, rates off in both, the look-ahead on
+ * in one, through blended and exact-stop five-axis feeds, an arc, a dwell and an M0, with
+ * the feed override raised and lowered again and a pause and a resume on the way: pose,
+ * legs and status equal bit for bit in every period, and at the plan's pace the periods
+ * took the entries filled before them. */
+START_TEST(test_ahead_same_bits)
+{
+    struct tm_machine a, b;
+    open_hexapod(&a);
+    open_hexapod(&b);
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
+           e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
+           c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, e4[6] = {5, 5, 645, 0, 0, 0};
+    memcpy(p.start, s0, sizeof s0);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
+                           .value = 0.01, .ivalue = 640};
+    ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
+    tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
+    tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
+    tm_arc(&p, 5, e3, c3, n3, 1, 1800);
+    tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
+    tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
+    tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
+    load_start(a.m, &p);
+    load_start(b.m, &p);
+    motion_set_rates(a.m, false);
+    motion_set_rates(b.m, false);
+    motion_set_ahead(b.m, true);
+    struct motion_out oa, ob;
+    memset(&oa, 0, sizeof oa);
+    long n = 0, paused = 0;
+    do {
+        if (n == 700 || n == 1100)
+            ck_assert(motion_set_feed_override(a.m, n == 700 ? 1.5 : 1.0) == MOTION_OK &&
+                      motion_set_feed_override(b.m, n == 700 ? 1.5 : 1.0) == MOTION_OK);
+        if (n == 1500)
+            ck_assert(motion_pause(a.m) == MOTION_OK && motion_pause(b.m) == MOTION_OK);
+        if (oa.state == MOTION_PAUSED && n > 1500) {       /* the pause, and then the M0 */
+            paused++;
+            ck_assert(motion_resume(a.m) == MOTION_OK && motion_resume(b.m) == MOTION_OK);
+        }
+        ck_assert_int_eq(motion_step(a.m, DT, &oa), MOTION_OK);
+        ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
+        ck_assert(!memcmp(oa.pose, ob.pose, sizeof oa.pose));
+        ck_assert(!memcmp(oa.joint_pos, ob.joint_pos, sizeof oa.joint_pos));
+        ck_assert(oa.path_vel == ob.path_vel && oa.distance_done_mm == ob.distance_done_mm);
+        ck_assert_int_eq(oa.line, ob.line);
+        ck_assert_int_eq(oa.state, ob.state);
+    } while ((oa.state == MOTION_RUNNING || oa.state == MOTION_PAUSING ||
+              oa.state == MOTION_PAUSED) && ++n < 200000);
+    ck_assert_int_eq(oa.state, MOTION_DONE);
+    ck_assert_int_ge(paused, 2);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(ob.pose[i], e4[i], 1e-9);
+    /* at the plan's pace three periods in four take an entry filled before them */
+    ck_assert_msg(b.m->ahead.taken > 2 * b.m->ahead.fills && b.m->ahead.taken > n / 2,
+                  "%ld periods: %ld fills, %ld taken", n, b.m->ahead.fills, b.m->ahead.taken);
+    ck_assert_int_eq(a.m->ahead.fills, 0);
     canon_prog_free(&p);
     tm_close(&a);
     tm_close(&b);
@@ -537,6 +605,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_trapezoid_hexapod);
     tcase_add_test(tc, test_brief_record);
     tcase_add_test(tc, test_segment_values_per_program);
+    tcase_add_test(tc, test_ahead_same_bits);
     tcase_add_test(tc, test_arcs);
     tcase_add_test(tc, test_helix);
     tcase_add_test(tc, test_dwell);
