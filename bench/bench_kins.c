@@ -245,6 +245,43 @@ static struct figure bench_inverse4(struct bench *B)
     return f;
 }
 
+/* Best-of-RUNS ns per sample of kins_inverse_path4 (four samples a call) beside
+ * inverse_path one at a time (the planner's knots), on the random poses with fixed first and
+ * second derivatives of a five-axis move: .ns four at once, .naive_ns one at a time. */
+static struct figure bench_inverse_path4(struct bench *B)
+{
+    struct figure f = { 0, 0, 0, 0, 0 };
+    double dp[4][KINS_POSE_DIM] = { { 0.6, -0.5, 0.1, 0.2, -0.1, 0.3 } };
+    double d2p[4][KINS_POSE_DIM] = { { 0.01, 0.02, 0, -0.01, 0.005, 0.002 } };
+    for (int l = 1; l < 4; l++)
+        memcpy(dp[l], dp[0], sizeof dp[l]), memcpy(d2p[l], d2p[0], sizeof d2p[l]);
+    double L[4][KINS_MAX_JOINTS], dL[4][KINS_MAX_JOINTS], d2L[4][KINS_MAX_JOINTS];
+    int st[4];
+    for (int from = 0; from < NPOSE; from += CHUNK) {
+        double best = 1e99, one_best = 1e99;
+        for (int run = 0; run < RUNS; run++) {
+            double t0 = now_ns();
+            for (int n = from; n + 4 <= from + CHUNK; n += 4) {
+                kins_inverse_path4(B->k, (const double(*)[KINS_POSE_DIM])B->poses[n],
+                                   (const double(*)[KINS_POSE_DIM])dp,
+                                   (const double(*)[KINS_POSE_DIM])d2p, L, dL, d2L, st);
+                B->sink += d2L[3][5];
+            }
+            double t1 = now_ns();
+            for (int n = from; n < from + CHUNK; n++) {
+                B->k->ops->inverse_path(B->k, B->poses[n], dp[0], d2p[0], L[0], dL[0], d2L[0]);
+                B->sink += d2L[0][4];
+            }
+            double t2 = now_ns();
+            best = fmin(best, t1 - t0);
+            one_best = fmin(one_best, t2 - t1);
+        }
+        f.ns += best / NPOSE;
+        f.naive_ns += one_best / NPOSE;
+    }
+    return f;
+}
+
 /* Forward solves of legs[from..to); warm: each starts from the previous result (the first
  * from the path pose before it), else from home. Returns total iterations of ours or, with
  * naive set, of the baseline. */
@@ -372,6 +409,7 @@ int main(void)
         return 1;
     struct figure inv = bench_inverse(&B);
     struct figure inv4 = bench_inverse4(&B);
+    struct figure path4 = bench_inverse_path4(&B);
     struct figure warm = bench_forward(&B, 1);
     struct figure cold = bench_forward(&B, 0);
 
@@ -382,6 +420,9 @@ int main(void)
     bench_row("inverse, ns/pose", inv.ns, inv.naive_ns);
     printf("%-34s %10.1f %10s %7.1fx  (one at a time: %.1f ns)\n", "  four at once (inverse4)",
            inv4.ns, "", inv4.naive_ns / inv4.ns, inv4.naive_ns);
+    printf("%-34s %10.1f %10s %7.1fx  (one at a time: %.1f ns)\n",
+           "inverse_path, four at once, ns", path4.ns, "", path4.naive_ns / path4.ns,
+           path4.naive_ns);
     bench_row("forward warm (1 kHz path), ns", warm.ns, warm.naive_ns);
     printf("%-34s %10.2f %10.2f\n", "  mean iterations", warm.iters, warm.naive_iters);
     printf("%-34s %10d\n", "  max iterations", warm.max_iters);

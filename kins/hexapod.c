@@ -417,6 +417,7 @@ const struct kins_ops kins_hexapod_ops = {
     .jacobian = hexapod_jacobian,
     .condition_matrix = hexapod_condition_matrix,
     .inverse4 = hexapod_inverse4,
+    .inverse_path4 = hexapod_inverse_path4,
     .describe = hexapod_describe,
     .tool_frame = hexapod_tool_frame,
 };

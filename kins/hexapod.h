@@ -72,6 +72,13 @@ int hexapod_configure(struct hexapod *h, const struct kins_config *cfg, char *er
 void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
                       double (*joints)[KINS_MAX_JOINTS], int *status);
 
+/* Four of the planner's samples at once, bit for bit hexapod's inverse_path (the kins_ops
+ * inverse_path4 entry, hexapod_batch.c). */
+void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                           const double (*dp)[KINS_POSE_DIM], const double (*d2p)[KINS_POSE_DIM],
+                           double (*joints)[KINS_MAX_JOINTS], double (*dL)[KINS_MAX_JOINTS],
+                           double (*d2L)[KINS_MAX_JOINTS], int *status);
+
 /* Forward kinematics by Newton-Raphson (hexapod_fwd.c); the kins_ops forward entry. */
 int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
                     struct kins_fwd_info *info);

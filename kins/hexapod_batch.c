@@ -125,3 +125,96 @@ void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
         status[l] = KINS_OK;
     }
 }
+
+/* a x b of vectors, as cross3. */
+#define CROSS_V(a, b, o)                                                                         \
+    do {                                                                                         \
+        (o)[0] = (a)[1] * (b)[2] - (a)[2] * (b)[1];                                              \
+        (o)[1] = (a)[2] * (b)[0] - (a)[0] * (b)[2];                                              \
+        (o)[2] = (a)[0] * (b)[1] - (a)[1] * (b)[0];                                              \
+    } while (0)
+
+/* The planner's samples four at a time: hexapod_inverse_path's operations on vectors, as
+ * hexapod_inverse4 does the inverse's (the kins_ops inverse_path4 entry). */
+__attribute__((target_clones("avx2", "default")))
+void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                           const double (*dp)[KINS_POSE_DIM], const double (*d2p)[KINS_POSE_DIM],
+                           double (*joints)[KINS_MAX_JOINTS], double (*dL)[KINS_MAX_JOINTS],
+                           double (*d2L)[KINS_MAX_JOINTS], int *status)
+{
+    const struct hexapod *h = (const struct hexapod *)k;
+    v4d x[KINS_POSE_DIM], d1[KINS_POSE_DIM], d2[KINS_POSE_DIM];
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        for (int l = 0; l < 4; l++)
+            x[j][l] = pose[l][j], d1[j][l] = dp[l][j], d2[j][l] = d2p[l][j];
+    v4d z = SPLAT(0.0);                       /* poses and their derivatives: numbers */
+    for (int j = 0; j < KINS_POSE_DIM; j++)
+        z = z + x[j] * 0.0 + d1[j] * 0.0 + d2[j] * 0.0;
+    v4l bad = ~(z == 0);
+    v4d sa, ca, sb, cb, sc, cc;
+    v4d xa = x[KINS_A] * HEXAPOD_RAD_PER_DEG, xb = x[KINS_B] * HEXAPOD_RAD_PER_DEG;
+    v4d xc = x[KINS_C] * HEXAPOD_RAD_PER_DEG;
+    SINCOS_LANES(xa, sa, ca, bad);
+    SINCOS_LANES(xb, sb, cb, bad);
+    SINCOS_LANES(xc, sc, cc, bad);
+    v4d r[3][3] = { { cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa },
+                    { sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa },
+                    { -sb, cb * sa, cb * ca } };
+    v4d e_a[3] = { cc * cb, sc * cb, -sb }, e_b[3] = { -sc, cc, SPLAT(0.0) };
+    v4l plain = r[2][2] > 0;
+    const double zz[3] = { 0, 0, 1 };
+    v4d a1 = d1[KINS_A] * HEXAPOD_RAD_PER_DEG, b1 = d1[KINS_B] * HEXAPOD_RAD_PER_DEG;
+    v4d c1 = d1[KINS_C] * HEXAPOD_RAD_PER_DEG, a2 = d2[KINS_A] * HEXAPOD_RAD_PER_DEG;
+    v4d b2 = d2[KINS_B] * HEXAPOD_RAD_PER_DEG, c2 = d2[KINS_C] * HEXAPOD_RAD_PER_DEG;
+    v4d zv[3] = { SPLAT(zz[0]), SPLAT(zz[1]), SPLAT(zz[2]) };
+    v4d w[3], wd[3], zeb[3], spin[3], spin_ea[3];
+    CROSS_V(zv, e_b, zeb);
+    for (int j = 0; j < 3; j++)
+        spin[j] = c1 * zz[j] + b1 * e_b[j];
+    CROSS_V(spin, e_a, spin_ea);
+    for (int j = 0; j < 3; j++) {
+        w[j] = a1 * e_a[j] + b1 * e_b[j] + c1 * zz[j];
+        wd[j] = a2 * e_a[j] + b2 * e_b[j] + c2 * zz[j] + b1 * c1 * zeb[j] + a1 * spin_ea[j];
+    }
+    v4d len[HEXAPOD_LEGS], l1v[HEXAPOD_LEGS], l2v[HEXAPOD_LEGS];
+    for (int i = 0; i < HEXAPOD_LEGS; i++) {
+        const double *p = h->p_mm[i], *b = h->b_mm[i];
+        v4d rp[3], v[3], u[3], wr[3], wwr[3], wdr[3], v1[3], v2[3];
+        for (int j = 0; j < 3; j++)
+            rp[j] = r[j][0] * p[0] + r[j][1] * p[1] + r[j][2] * p[2];
+        for (int j = 0; j < 3; j++)
+            v[j] = x[KINS_X + j] + rp[j] - b[j];
+        v4d q = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        for (int l = 0; l < 4; l++)
+            q[l] = sqrt(q[l]);
+        v4d inv = 1.0 / q;
+        for (int j = 0; j < 3; j++)
+            u[j] = v[j] * inv;
+        len[i] = q - h->offset_mm[i];
+        bad |= (len[i] < k->joint_min[i]) | (len[i] > k->joint_max[i]);
+        plain &= x[KINS_Z] + rp[2] - b[2] > 0;
+        CROSS_V(w, rp, wr);
+        CROSS_V(w, wr, wwr);
+        CROSS_V(wd, rp, wdr);
+        for (int j = 0; j < 3; j++) {
+            v1[j] = d1[KINS_X + j] + wr[j];
+            v2[j] = d2[KINS_X + j] + wdr[j] + wwr[j];
+        }
+        v4d l1 = u[0] * v1[0] + u[1] * v1[1] + u[2] * v1[2];
+        v4d vv = v1[0] * v1[0] + v1[1] * v1[1] + v1[2] * v1[2];
+        l1v[i] = l1;
+        l2v[i] = (vv - l1 * l1) / q + u[0] * v2[0] + u[1] * v2[1] + u[2] * v2[2];
+    }
+    if (h->ws_extra)
+        plain = (v4l){ 0, 0, 0, 0 };
+    for (int l = 0; l < 4; l++) {
+        if (bad[l] || !plain[l]) {
+            status[l] = k->ops->inverse_path(k, pose[l], dp[l], d2p[l], joints[l], dL[l],
+                                             d2L[l]);
+            continue;
+        }
+        for (int i = 0; i < HEXAPOD_LEGS; i++)
+            joints[l][i] = len[i][l], dL[l][i] = l1v[i][l], d2L[l][i] = l2v[i][l];
+        status[l] = KINS_OK;
+    }
+}

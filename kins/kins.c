@@ -187,3 +187,18 @@ void kins_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
     for (int l = 0; l < 4; l++)
         status[l] = k->ops->inverse(k, pose[l], joints[l]);
 }
+
+void kins_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                        const double (*dpose)[KINS_POSE_DIM],
+                        const double (*d2pose)[KINS_POSE_DIM], double (*joints)[KINS_MAX_JOINTS],
+                        double (*djoints)[KINS_MAX_JOINTS], double (*d2joints)[KINS_MAX_JOINTS],
+                        int *status)
+{
+    if (k->ops->inverse_path4) {
+        k->ops->inverse_path4(k, pose, dpose, d2pose, joints, djoints, d2joints, status);
+        return;
+    }
+    for (int l = 0; l < 4; l++)
+        status[l] = k->ops->inverse_path(k, pose[l], dpose[l], d2pose[l], joints[l], djoints[l],
+                                         d2joints[l]);
+}

@@ -124,6 +124,13 @@ struct kins_ops {
      * faster than four calls. NULL: kins_inverse4() calls inverse four times. */
     void (*inverse4)(struct kins *k, const double (*pose)[KINS_POSE_DIM],
                      double (*joints)[KINS_MAX_JOINTS], int *status);
+    /* Optional, with inverse_path: inverse_path of four samples at once, each exactly as
+     * inverse_path gives it. NULL: kins_inverse_path4() calls inverse_path four times. */
+    void (*inverse_path4)(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                          const double (*dpose)[KINS_POSE_DIM],
+                          const double (*d2pose)[KINS_POSE_DIM],
+                          double (*joints)[KINS_MAX_JOINTS], double (*djoints)[KINS_MAX_JOINTS],
+                          double (*d2joints)[KINS_MAX_JOINTS], int *status);
 };
 
 /* Base of every instance; concrete models embed it first. */
@@ -164,6 +171,12 @@ static inline int kins_inverse(struct kins *k, const double *pose, double *joint
 /* Four inverses, pose[4] to joints[4] and status[4] (see kins_ops.inverse4). */
 void kins_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
                    double (*joints)[KINS_MAX_JOINTS], int *status);
+/* Four inverse_path samples (see kins_ops.inverse_path4; the model has inverse_path). */
+void kins_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                        const double (*dpose)[KINS_POSE_DIM],
+                        const double (*d2pose)[KINS_POSE_DIM], double (*joints)[KINS_MAX_JOINTS],
+                        double (*djoints)[KINS_MAX_JOINTS], double (*d2joints)[KINS_MAX_JOINTS],
+                        int *status);
 static inline int kins_forward(struct kins *k, const double *joints, double *pose,
                                struct kins_fwd_info *info)
 { return k->ops->forward(k, joints, pose, info); }

@@ -264,6 +264,59 @@ START_TEST(test_inverse4)
 }
 END_TEST
 
+/* Four of the planner's samples at once (kins_inverse_path4) give inverse_path's joints,
+ * first and second derivatives and status bit for bit: poses and derivatives at random,
+ * angles and their rates exactly 0 on every other lane (the sign of a zero must come out
+ * the same), angles beyond the series' range, legs out of range, derivatives that are not
+ * numbers, and a workspace limit beyond the assembly's. */
+START_TEST(test_inverse_path4)
+{
+    struct kins *k = make_tmu();
+    struct hexapod *h = (struct hexapod *)k;
+    srand48(13);
+    long lanes = 0, ok = 0;
+    for (int n = 0; n < 40000; n++) {
+        double pose[4][6], dp[4][6], d2p[4][6];
+        double L[2][4][KINS_MAX_JOINTS], dL[2][4][KINS_MAX_JOINTS], d2L[2][4][KINS_MAX_JOINTS];
+        int st[4];
+        memset(L, 0, sizeof L), memset(dL, 0, sizeof dL), memset(d2L, 0, sizeof d2L);
+        for (int l = 0; l < 4; l++) {
+            int kind = (int)(drand48() * 8);
+            double deg = kind < 5 ? 14.0 : kind < 7 ? 45.0 : 55.0;
+            for (int i = 0; i < 6; i++) {
+                pose[l][i] = (2 * drand48() - 1) * (i < 3 ? 120.0 : deg);
+                dp[l][i] = (2 * drand48() - 1) * (i < 3 ? 1.0 : 0.5);
+                d2p[l][i] = (2 * drand48() - 1) * (i < 3 ? 0.5 : 0.2);
+                if (i >= 3 && (l + n) % 2 == 0 && drand48() < 0.5)
+                    pose[l][i] = dp[l][i] = d2p[l][i] = 0.0;
+            }
+            pose[l][KINS_Z] += 645.0;
+            if (kind == 7 && n % 3 == 0)
+                d2p[l][(int)(drand48() * 6)] = NAN;
+            if (kind == 7 && n % 3 == 1)
+                pose[l][KINS_Z] = 1100.0;
+        }
+        h->ws_extra = n % 500 == 499;
+        kins_inverse_path4(k, (const double(*)[6])pose, (const double(*)[6])dp,
+                           (const double(*)[6])d2p, L[0], dL[0], d2L[0], st);
+        for (int l = 0; l < 4; l++) {
+            int w = k->ops->inverse_path(k, pose[l], dp[l], d2p[l], L[1][l], dL[1][l],
+                                         d2L[1][l]);
+            ck_assert_int_eq(st[l], w);
+            ck_assert_msg(!memcmp(L[0][l], L[1][l], sizeof L[0][l]) &&
+                          !memcmp(dL[0][l], dL[1][l], sizeof dL[0][l]) &&
+                          !memcmp(d2L[0][l], d2L[1][l], sizeof d2L[0][l]),
+                          "sample %d lane %d", n, l);
+            lanes++;
+            ok += w == KINS_OK;
+        }
+    }
+    h->ws_extra = false;
+    ck_assert(ok > lanes / 2 && ok < lanes);
+    kins_free(k);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("kins_shortcuts");
@@ -273,6 +326,7 @@ int main(void)
     tcase_add_test(tc, test_jacobian);
     tcase_add_test(tc, test_sincos3);
     tcase_add_test(tc, test_inverse4);
+    tcase_add_test(tc, test_inverse_path4);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
