@@ -43,6 +43,93 @@ static int sample_at(struct motion *m, const struct motion_seg *sg, double s,
     return st;
 }
 
+/*
+ * The planner's look-ahead over knots. all_caps samples every knot of the plan in order
+ * (segment_caps: the knots of each move, moves that are not lines or arcs skipped). Where a
+ * knot's sample is not there yet, it and the next three are sampled together: their poses
+ * and derivatives one by one (motion_seg_derivs), the kinematics of all four in one
+ * kins_inverse_path4 call, under half the time of four (bench_kins). An entry is keyed by its
+ * segment and its place s on it, and what it holds is the function of those that sample_at
+ * computes, to the bit; a request with another key (a sample between knots, a move under
+ * G43.4) is sampled alone as before.
+ */
+void motion_knot_ahead(struct motion *m, bool on)
+{
+    m->kahead.on = on && !m->kahead.off && m->kins->ops->inverse_path;
+    m->kahead.n = m->kahead.next = 0;
+}
+
+/* Fills the look-ahead from the knot at s of sg on; false when s is no knot of sg or sg is
+ * one sample_at takes another way (under G43.4). */
+static bool knot_fill(struct motion *m, const struct motion_seg *sg, double s)
+{
+    struct motion_knot_ahead *a = &m->kahead;
+    const struct motion_plan *p = &m->plan;
+    size_t k = sg->k0, j = (size_t)(sg - p->segs);
+    while (k < sg->k0 + sg->nk && p->ks[k] != s)
+        k++;
+    if (k == sg->k0 + sg->nk || sg->tcp)
+        return false;
+    double pose[MOTION_AHEAD][KINS_POSE_DIM], dp[MOTION_AHEAD][KINS_POSE_DIM];
+    double d2p[MOTION_AHEAD][KINS_POSE_DIM], L[MOTION_AHEAD][KINS_MAX_JOINTS];
+    double dL[MOTION_AHEAD][KINS_MAX_JOINTS], d2L[MOTION_AHEAD][KINS_MAX_JOINTS];
+    int n = 0;
+    while (n < MOTION_AHEAD) {
+        const struct motion_seg *g = &p->segs[j];
+        a->sg[n] = g, a->s[n] = p->ks[k];
+        motion_seg_derivs(p, g, p->ks[k], pose[n], dp[n], d2p[n]);
+        n++;
+        if (++k == g->k0 + g->nk) {    /* on into the next line or arc (segment_caps) */
+            while (++j < p->nseg && p->segs[j].kind > SEG_ARC)
+                ;
+            if (j == p->nseg || p->segs[j].tcp)
+                break;
+            k = p->segs[j].k0;
+        }
+    }
+    for (int l = n; l < MOTION_AHEAD; l++) {    /* (lanes without a knot: one it can take) */
+        memcpy(pose[l], pose[0], sizeof pose[l]);
+        memcpy(dp[l], dp[0], sizeof dp[l]);
+        memcpy(d2p[l], d2p[0], sizeof d2p[l]);
+    }
+    kins_inverse_path4(m->kins, (const double(*)[KINS_POSE_DIM])pose,
+                       (const double(*)[KINS_POSE_DIM])dp, (const double(*)[KINS_POSE_DIM])d2p,
+                       L, dL, d2L, a->status);
+    for (int l = 0; l < n; l++) {
+        struct motion_sample *o = &a->S[l];
+        o->tcp = 0;
+        o->tool_len_mm = a->sg[l]->tool_len_mm;
+        o->q_state = 0;
+        memcpy(o->pose, pose[l], sizeof o->pose);
+        memcpy(o->dp, dp[l], sizeof o->dp);
+        memcpy(o->d2p, d2p[l], sizeof o->d2p);
+        memcpy(o->L, L[l], sizeof o->L);
+        memcpy(o->dL, dL[l], sizeof o->dL);
+        memcpy(o->d2L, d2L[l], sizeof o->d2L);
+    }
+    a->n = n, a->next = 0;
+    a->fills++;
+    return true;
+}
+
+/* sample_at for a knot, from the look-ahead. */
+static int sample_knot(struct motion *m, const struct motion_seg *sg, double s,
+                       struct motion_sample *o)
+{
+    struct motion_knot_ahead *a = &m->kahead;
+    if (!(a->next < a->n && a->sg[a->next] == sg && a->s[a->next] == s)) {
+        if (!a->on || !knot_fill(m, sg, s))
+            return sample_at(m, sg, s, o);
+    } else {
+        a->taken++;
+    }
+    int j = a->next++;
+    if (a->status[j] != KINS_OK)       /* (a failure as sample_at has it, written or not) */
+        return sample_at(m, sg, s, o);
+    *o = a->S[j];
+    return KINS_OK;
+}
+
 /* Inverts a 6x6 matrix by Gauss-Jordan elimination with partial pivoting (a is destroyed);
  * -1 when it is singular. */
 int motion_invert6(double a[6][6], double inv[6][6])
@@ -411,7 +498,7 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
      * ulp or so wider than fine_h (len i / n against len / n): that is the knots' spacing,
      * not a reason to sample every interval again in between. */
     double h = sg->fine_h > 0 && hs > sg->fine_h * (1 + FINE_SLACK) ? sg->fine_h : hs;
-    int st = reach_check(m, sg, S, h, sample_at(m, sg, s, S), err, errlen);
+    int st = reach_check(m, sg, S, h, sample_knot(m, sg, s, S), err, errlen);
     if (st)
         return st;
     double vm, am, vl, kabc = 0;   /* |d2(A B C)/ds2|: the path's, 0 but on blend arcs */

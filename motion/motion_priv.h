@@ -233,6 +233,31 @@ struct motion_ahead_at {
     double tau_s;
     double s, vp;            /* motion_plan_at's position and speed there */
 };
+/* One path sample through the kinematics: pose, its s-derivative, legs and their
+ * first and second s-derivatives. */
+struct motion_sample {
+    int tcp;                 /* the segment's tool centre point control and tool length */
+    double tool_len_mm;
+    double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
+    double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
+    int q_state;             /* q below: 0 not yet taken, 1 taken, -1 the Jacobian is singular */
+    double q[KINS_POSE_DIM]; /* the pose's curvature as the legs see it, J^-1 d2L (the
+                              * kinematic-error and chord caps both use it: taken once) */
+};
+
+/* The planner's look-ahead over knots (motion_caps.c): while all_caps samples the knots
+ * in order, the next ones' samples four at a time (kins_inverse_path4), each keyed by its
+ * segment and place on it. */
+struct motion_knot_ahead {
+    int on;                  /* all_caps is sampling the plan's knots in order */
+    int off;                 /* never (a test compares plans made with and without) */
+    int n, next;             /* entries filled, the next one to take */
+    const struct motion_seg *sg[MOTION_AHEAD];
+    double s[MOTION_AHEAD];
+    int status[MOTION_AHEAD];
+    struct motion_sample S[MOTION_AHEAD];
+    long fills, taken;       /* fills, and entries taken after the first of a fill */
+};
 struct motion_ahead {
     const struct motion_plan *run;
     struct motion_ahead_at at[MOTION_AHEAD];
@@ -302,6 +327,7 @@ struct motion {
     int brief;               /* motion_set_brief(m, true): the output record's first part */
     int ahead_on;            /* motion_set_ahead(m, true): evaluate() looks ahead */
     struct motion_ahead ahead;
+    struct motion_knot_ahead kahead;
     int wait_at_speed;       /* plan a wait for the spindle after M3/M4/S (motion_hal: the
                               * at-speed input is wired) */
     int at_speed;            /* the spindle's at-speed input this period */
@@ -601,17 +627,9 @@ static inline double motion_round_tol_mm(const struct motion *m, const struct mo
  * acceleration instead of sharing it with a jump that saves next to no time. */
 #define STOP_EQUIV_PERIODS 2.0
 
-/* One path sample through the kinematics: pose, its s-derivative, legs and their
- * first and second s-derivatives. */
-struct motion_sample {
-    int tcp;                 /* the segment's tool centre point control and tool length */
-    double tool_len_mm;
-    double pose[KINS_POSE_DIM], dp[KINS_POSE_DIM], d2p[KINS_POSE_DIM];
-    double L[KINS_MAX_JOINTS], dL[KINS_MAX_JOINTS], d2L[KINS_MAX_JOINTS];
-    int q_state;             /* q below: 0 not yet taken, 1 taken, -1 the Jacobian is singular */
-    double q[KINS_POSE_DIM]; /* the pose's curvature as the legs see it, J^-1 d2L (the
-                              * kinematic-error and chord caps both use it: taken once) */
-};
+/* all_caps samples the knots in order from here (on) or no longer (off): the planner's
+ * look-ahead over knots (motion_caps.c). */
+void motion_knot_ahead(struct motion *m, bool on);
 
 /* Whether the operator asked to stop planning; if so err says where (motion_caps.c). */
 bool motion_cancelled(const struct motion *m, const char *file, int line, char *err,

@@ -257,6 +257,60 @@ START_TEST(test_ahead_same_bits)
 }
 END_TEST
 
+/* The planner's look-ahead over knots (four knots' kinematics at once) changes no plan: two
+ * machines plan the same program, dense blended five-axis feeds, an arc, a dwell and exact
+ * stops, the look-ahead off in one; every knot's place, speeds, caps and every interval's
+ * acceleration are equal bit for bit, and the look-ahead's entries were taken. */
+START_TEST(test_knot_ahead_same_plan)
+{
+    struct tm_machine a, b;
+    open_hexapod(&a);
+    open_hexapod(&b);
+    b.m->kahead.off = 1;
+    struct canon_prog p;
+    canon_prog_init(&p);
+    double at[6] = {0, 0, 645, 0, 0, 0}, c3[3], n3[3] = {0, 0, 1};
+    memcpy(p.start, at, sizeof at);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
+                           .value = 0.01, .ivalue = 640};
+    ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
+    for (int i = 0; i < 300; i++) {             /* a curve of 0.5 mm chords, turning */
+        double t = i * 0.02;
+        at[0] = 20 * sin(t), at[1] = 15 * sin(1.7 * t), at[2] = 645 + 2 * sin(0.5 * t);
+        at[3] = 3 * sin(t), at[4] = 6 + 2 * cos(0.8 * t), at[5] = 4 * sin(0.3 * t);
+        tm_add(&p, CANON_FEED, 3 + i, at, 2000, 0);
+    }
+    memcpy(c3, at, sizeof c3);
+    c3[1] += 5;
+    double e3[6];
+    memcpy(e3, at, sizeof e3);
+    e3[1] += 10;
+    tm_arc(&p, 400, e3, c3, n3, 1, 1800);
+    tm_add(&p, CANON_DWELL, 401, NULL, 0, 0.1);
+    e3[0] += 8, e3[5] += 2;
+    tm_add(&p, CANON_FEED, 402, e3, 1500, 0);
+    load_start(a.m, &p);
+    load_start(b.m, &p);
+    const struct motion_plan *pa = &a.m->plan, *pb = &b.m->plan;
+    ck_assert_uint_eq(pa->nknot, pb->nknot);
+    size_t nk = pa->nknot;
+    ck_assert(!memcmp(pa->ks, pb->ks, nk * sizeof *pa->ks));
+    ck_assert(!memcmp(pa->kv, pb->kv, nk * sizeof *pa->kv));
+    ck_assert(!memcmp(pa->kt, pb->kt, nk * sizeof *pa->kt));
+    ck_assert(!memcmp(pa->krho, pb->krho, nk * sizeof *pa->krho));
+    ck_assert(!memcmp(pa->iacc, pb->iacc, nk * sizeof *pa->iacc));
+    ck_assert(!memcmp(pa->irho, pb->irho, nk * sizeof *pa->irho));
+    ck_assert(!memcmp(pa->ivp, pb->ivp, nk * sizeof *pa->ivp));
+    ck_assert(pa->total_time_s == pb->total_time_s);
+    ck_assert_msg(a.m->kahead.taken > 2 * a.m->kahead.fills && a.m->kahead.taken > (long)nk / 2,
+                  "%zu knots: %ld fills, %ld taken", nk, a.m->kahead.fills, a.m->kahead.taken);
+    ck_assert_int_eq(b.m->kahead.fills, 0);
+    canon_prog_free(&p);
+    tm_close(&a);
+    tm_close(&b);
+}
+END_TEST
+
 /* The status's segment values (line, the move's ends, its kind) are taken once per segment:
  * a second program loaded into the same instance, whose plan may lie where the first's did,
  * reports its own from its first period on. */
@@ -606,6 +660,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_brief_record);
     tcase_add_test(tc, test_segment_values_per_program);
     tcase_add_test(tc, test_ahead_same_bits);
+    tcase_add_test(tc, test_knot_ahead_same_plan);
     tcase_add_test(tc, test_arcs);
     tcase_add_test(tc, test_helix);
     tcase_add_test(tc, test_dwell);
