@@ -144,6 +144,7 @@ static inline void leg_diffs(double L, double Lp, double vp, double ap, double i
  * finite (the kinematics refuse a pose that is not): with that said to the compiler, the
  * extremes' loop becomes the vector max and min. */
 __attribute__((optimize("finite-math-only", "no-signed-zeros")))
+__attribute__((target_clones("avx2", "default")))   /* (four lanes where there are AVX2) */
 static int leg_batch(struct sim *restrict s, int i, int n, double end[3])
 {
     const double *L = s->Lb[i], T = s->inv_T;
