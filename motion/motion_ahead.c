@@ -1,6 +1,8 @@
 /* motion_ahead.c: a check's executor evaluates the path four periods at a time. */
+#include <stdbool.h>
 #include <string.h>
 
+#include "common/sincos4.h"
 #include "motion/motion_priv.h"
 
 /*
@@ -17,6 +19,42 @@
  * how much is computed at once, never what. The machine's own servo thread does not use it
  * (a period there must not take four periods' work).
  */
+
+/* motion_seg_pose at the four places s[] of segment sg, on vectors: its operations in its
+ * order, so the same bits; false (nothing written) when an arc's angle lies beyond the
+ * series' range, where motion_seg_pose calls the C library. */
+__attribute__((target_clones("avx2", "default")))
+static bool seg_pose4(const struct motion_plan *p, const struct motion_seg *sg, const double *s,
+                      double (*pose)[KINS_POSE_DIM])
+{
+    v4d sv = { s[0], s[1], s[2], s[3] }, q[KINS_POSE_DIM];
+    v4d u = sg->len > 0 ? sv / sg->len : SPLAT(0.0);
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        q[i] = sg->start[i] + u * (sg->end[i] - sg->start[i]);
+    if (sg->kind == SEG_ARC) {
+        const struct motion_arc *a = &p->arcs[sg->arc];
+        v4d ang = a->sweep_rad * u, r = a->r0_mm + a->dr_mm * u, h = a->h0_mm + a->dh_mm * u;
+        v4d sn, c;
+        v4l bad = { 0, 0, 0, 0 };
+        SINCOS_LANES(ang, sn, c, bad);
+        if (bad[0] | bad[1] | bad[2] | bad[3])
+            return false;
+        for (int i = 0; i < 3; i++)
+            q[i] = a->center[i] + r * (c * a->e1[i] + sn * a->e2[i]) + h * a->n[i];
+        if (a->abc_cubic) {            /* (abc_cubic's d = 0) */
+            v4d u2 = u * u, u3 = u2 * u;
+            v4d h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = 3 * u2 - 2 * u3;
+            v4d h11 = u3 - u2;
+            for (int k = 0; k < 3; k++)
+                q[3 + k] = h00 * sg->start[3 + k] + h10 * a->abc_m0[k] +
+                           h01 * sg->end[3 + k] + h11 * a->abc_m1[k];
+        }
+    }
+    for (int l = 0; l < 4; l++)
+        for (int i = 0; i < KINS_POSE_DIM; i++)
+            pose[l][i] = q[i][l];
+    return true;
+}
 
 /* Fills the entries from the present state on: returns the first, or NULL when the present
  * segment is one it leaves to evaluate() (synchronised, under G43.4). */
@@ -35,7 +73,6 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
         double ap;
         e->ci = ci, e->cs = cs, e->tau_s = tau;
         motion_plan_at(p, ci, tau, &e->s, &e->vp, &ap, &m->phases);
-        motion_seg_pose(p, sg, e->s, a->pose[n]);
         if (++n == MOTION_AHEAD)
             break;
         tau += dt;                     /* advance() at the plan's pace */
@@ -51,6 +88,13 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
     a->next = 0;
     if (n == 0)
         return NULL;
+    double sv[MOTION_AHEAD];
+    for (int j = 0; j < n; j++)
+        sv[j] = a->at[j].s;
+    if (n < MOTION_AHEAD || a->at[0].cs != a->at[n - 1].cs ||
+        !seg_pose4(p, &p->segs[a->at[0].cs], sv, a->pose))
+        for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
+            motion_seg_pose(p, &p->segs[a->at[j].cs], a->at[j].s, a->pose[j]);
     for (int j = n; j < MOTION_AHEAD; j++)      /* (lanes without a period: a pose the */
         memcpy(a->pose[j], a->pose[0], sizeof a->pose[j]);   /* kinematics can take) */
     a->run = p;

@@ -192,7 +192,8 @@ END_TEST
 
 /* The check's look-ahead (motion_set_ahead: four periods' poses and legs at once) changes
  * nothing a period gives: two machines side by side, rates off in both, the look-ahead on
- * in one, through blended and exact-stop five-axis feeds, an arc, a dwell and an M0, with
+ * in one, through blended and exact-stop five-axis feeds, an arc, dense code whose blend
+ * arcs turn A B C (four periods' poses on one segment as vectors), a dwell and an M0, with
  * the feed override raised and lowered again and a pause and a resume on the way: pose,
  * legs and status equal bit for bit in every period, and at the plan's pace the periods
  * took the entries filled before them. */
@@ -213,6 +214,14 @@ START_TEST(test_ahead_same_bits)
     tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
     tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
     tm_arc(&p, 5, e3, c3, n3, 1, 1800);
+    double at[6];
+    for (int i = 0; i < 120; i++) {             /* dense code: blend arcs turning A B C */
+        double t = i * 0.05;
+        at[0] = e3[0] + 12 * sin(t), at[1] = e3[1] + 9 * sin(1.7 * t), at[2] = e3[2];
+        at[3] = e3[3] + 3 * sin(t), at[4] = e3[4] + 2 * cos(0.8 * t) - 2;
+        at[5] = e3[5] + 4 * sin(0.3 * t);
+        tm_add(&p, CANON_FEED, 5, at, 2000, 0);
+    }
     tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
     tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
     tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
