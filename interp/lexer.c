@@ -41,10 +41,33 @@ static int read_comment(struct interp *in, const char *raw, size_t len, size_t *
     return 0;
 }
 
+/* What normalise does with a byte: copy it (lowercased), skip it, or look at it (a comment,
+ * the end of the line, a NUL). */
+enum { NORM_COPY, NORM_SKIP, NORM_LOOK };
+static const unsigned char norm_class[256] = {
+    [' '] = NORM_SKIP, ['\t'] = NORM_SKIP, ['\r'] = NORM_SKIP,
+    ['('] = NORM_LOOK, [';'] = NORM_LOOK, ['\0'] = NORM_LOOK,
+};
+
 /* Builds in->norm: the line without blanks and comments, lowercased, columns remembered. */
 static int normalise(struct interp *in, const char *raw, size_t len, size_t i, int *count)
 {
     int n = 0;
+    if (len - i < INTERP_LINE_MAX - 1) {
+        /* the common line, short enough that no test of the length is needed, copied until
+         * the first byte to look at (a dense CAM block has none) */
+        for (; i < len; i++) {
+            unsigned char c = (unsigned char)raw[i];
+            int k = norm_class[c];
+            if (k == NORM_SKIP)
+                continue;
+            if (k == NORM_LOOK)
+                break;
+            in->norm[n] = (char)(c >= 'A' && c <= 'Z' ? c + ('a' - 'A') : c);
+            in->normcol[n] = (int)i + 1;
+            n++;
+        }
+    }
     for (; i < len; i++) {
         char c = raw[i];
         if (c == ' ' || c == '\t' || c == '\r')
