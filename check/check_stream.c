@@ -101,8 +101,9 @@ static void *produce(void *arg)
     return NULL;
 }
 
-/* The servo pass is short of plan: waits for the producer. 1 to go on, 0 when no more plan
- * will come (the producer ended without finishing the stream). */
+/* The servo pass is short of plan: waits for the producer, computing its own measures
+ * meanwhile (the planner's thread then finds fewer to take from its planning). 1 to go on,
+ * 0 when no more plan will come (the producer ended without finishing the stream). */
 static int feed_wait(void *ctx)
 {
     struct producer *p = ctx;
@@ -110,7 +111,8 @@ static int feed_wait(void *ctx)
     while (motion_stream_starving(m)) {
         if (atomic_load(&p->done))
             return !motion_stream_starving(m);
-        pause_us(50);
+        if (!check_defer_work(p->defer))
+            pause_us(50);
     }
     return 1;
 }
