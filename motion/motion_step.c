@@ -401,7 +401,8 @@ static int evaluate(struct motion *m, double dt)
         int j = e ? (int)(e - m->ahead.at) : 0;
         if (!e || m->ahead.status[j] != KINS_OK)   /* (a failure as it comes, written or not) */
             return kins_inverse(m->kins, m->pose, m->joint_cmd);
-        memcpy(m->joint_cmd, m->ahead.joints[j], (size_t)m->nj * sizeof *m->joint_cmd);
+        for (int i = 0; i < m->nj; i++)        /* (inverse writes nj: the rest stays) */
+            m->joint_cmd[i] = m->ahead.joints[j][i];
         return KINS_OK;
     }
     int st = kins_inverse_rates(m->kins, m->pose, m->pose_vel, m->joint_cmd, m->joint_vel);
