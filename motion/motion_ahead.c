@@ -11,7 +11,9 @@
  * and of the next three as the plan's own pace would reach them (the clock one period on
  * each, the knots followed as follow_knots does), the legs of all four in one
  * kins_inverse4 call: the inverse kinematics of four poses at once take under half the time
- * of four single ones (bench_kins). Each entry is keyed by what it is a function of, the
+ * of four single ones (bench_kins). Four periods in one interval of the plan take their
+ * positions as vectors (plan_at4), four on one segment their poses (seg_pose4), lane by lane
+ * the scalar functions' operations. Each entry is keyed by what it is a function of, the
  * plan run, its interval and segment, and the plan clock; a period whose state has that key
  * takes the entry, any other (an override, a pause, a chunk switched, a stop) computes its
  * own and four more. Position, pose and legs are pure functions of the key, so an entry is
@@ -56,6 +58,40 @@ static bool seg_pose4(const struct motion_plan *p, const struct motion_seg *sg, 
     return true;
 }
 
+/* motion_plan_at at the four plan times tau[] of interval ci (position into s[], speed
+ * into v[]), on vectors: each lane's phase taken as motion_plan_at takes it, by the same
+ * operations in the same order, so the same bits. */
+__attribute__((target_clones("avx2", "default")))
+static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, double *s,
+                     double *v, struct motion_phase_memo *mp)
+{
+    double ds = p->ks[ci + 1] - p->ks[ci];
+    double v0 = p->kv[ci], v1 = p->kv[ci + 1], vp = p->ivp[ci], acc = p->iacc[ci];
+    if (!(ds > 0) || !(p->kt[ci + 1] > p->kt[ci])) {
+        for (int l = 0; l < 4; l++)
+            s[l] = p->ks[ci], v[l] = v0;
+        return;
+    }
+    if (mp->v0 != v0 || mp->v1 != v1 || mp->vp != vp || mp->acc != acc || mp->ds != ds) {
+        motion_phases(v0, v1, vp, acc, ds, &mp->ta, &mp->tc, &mp->td);
+        mp->sa = (vp * vp - v0 * v0) / (2 * acc);
+        mp->v0 = v0, mp->v1 = v1, mp->vp = vp, mp->acc = acc, mp->ds = ds;
+    }
+    double ta = mp->ta, tc = mp->tc, td = mp->td, sa = mp->sa;
+    v4d d = (v4d){ tau[0], tau[1], tau[2], tau[3] } - p->kt[ci];
+    v4d dc = SELECT(d > ta + tc + td, SPLAT(ta + tc + td), d);
+    d = SELECT(d < 0, SPLAT(0.0), dc);
+    v4l ramp_up = d < ta, cruise = d < ta + tc;
+    v4d e = d - ta - tc;
+    v4d vv = SELECT(ramp_up, v0 + acc * d, SELECT(cruise, SPLAT(vp), vp - acc * e));
+    v4d sv = SELECT(ramp_up, v0 * d + 0.5 * acc * d * d,
+                    SELECT(cruise, sa + vp * (d - ta),
+                           sa + vp * tc + vp * e - 0.5 * acc * e * e));
+    sv = p->ks[ci] + SELECT(sv > ds, SPLAT(ds), sv);
+    for (int l = 0; l < 4; l++)
+        s[l] = sv[l], v[l] = vv[l];
+}
+
 /* Fills the entries from the present state on: returns the first, or NULL when the present
  * segment is one it leaves to evaluate() (synchronised, under G43.4). */
 static const struct motion_ahead_at *fill(struct motion *m, double dt)
@@ -70,9 +106,7 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
         if (sg->sync || sg->tcp)
             break;
         struct motion_ahead_at *e = &a->at[n];
-        double ap;
         e->ci = ci, e->cs = cs, e->tau_s = tau;
-        motion_plan_at(p, ci, tau, &e->s, &e->vp, &ap, &m->phases);
         if (++n == MOTION_AHEAD)
             break;
         tau += dt;                     /* advance() at the plan's pace */
@@ -88,9 +122,21 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
     a->next = 0;
     if (n == 0)
         return NULL;
-    double sv[MOTION_AHEAD];
-    for (int j = 0; j < n; j++)
-        sv[j] = a->at[j].s;
+    double sv[MOTION_AHEAD], vv[MOTION_AHEAD], tv[MOTION_AHEAD];
+    if (n == MOTION_AHEAD && a->at[0].ci == a->at[n - 1].ci) {    /* one interval */
+        for (int j = 0; j < n; j++)
+            tv[j] = a->at[j].tau_s;
+        plan_at4(p, a->at[0].ci, tv, sv, vv, &m->phases);
+        for (int j = 0; j < n; j++)
+            a->at[j].s = sv[j], a->at[j].vp = vv[j];
+    } else {
+        for (int j = 0; j < n; j++) {
+            struct motion_ahead_at *e = &a->at[j];
+            double ap;
+            motion_plan_at(p, e->ci, e->tau_s, &e->s, &e->vp, &ap, &m->phases);
+            sv[j] = e->s;
+        }
+    }
     if (n < MOTION_AHEAD || a->at[0].cs != a->at[n - 1].cs ||
         !seg_pose4(p, &p->segs[a->at[0].cs], sv, a->pose))
         for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
