@@ -216,61 +216,42 @@ static struct figure bench_inverse(struct bench *B)
     return f;
 }
 
-/* Best-of-RUNS ns per pose of kins_inverse4 (four poses a call) beside kins_inverse one at
- * a time, chunked as bench_inverse: .ns the four at once, .naive_ns one at a time. */
-static struct figure bench_inverse4(struct bench *B)
-{
-    struct figure f = { 0, 0, 0, 0, 0 };
-    double joints[4][KINS_MAX_JOINTS];
-    int st[4];
-    for (int from = 0; from < NPOSE; from += CHUNK) {
-        double best = 1e99, one_best = 1e99;
-        for (int run = 0; run < RUNS; run++) {
-            double t0 = now_ns();
-            for (int n = from; n + 4 <= from + CHUNK; n += 4) {
-                kins_inverse4(B->k, (const double(*)[KINS_POSE_DIM])B->poses[n], joints, st);
-                B->sink += joints[3][5];
-            }
-            double t1 = now_ns();
-            for (int n = from; n < from + CHUNK; n++)
-                kins_inverse(B->k, B->poses[n], B->legs[n]);
-            double t2 = now_ns();
-            B->sink += B->legs[from][3];
-            best = fmin(best, t1 - t0);
-            one_best = fmin(one_best, t2 - t1);
-        }
-        f.ns += best / NPOSE;
-        f.naive_ns += one_best / NPOSE;
-    }
-    return f;
-}
-
-/* Best-of-RUNS ns per sample of kins_inverse_path4 (four samples a call) beside
- * inverse_path one at a time (the planner's knots), on the random poses with fixed first and
- * second derivatives of a five-axis move: .ns four at once, .naive_ns one at a time. */
-static struct figure bench_inverse_path4(struct bench *B)
+/* Best-of-RUNS ns per pose of the four-at-once calls beside the same call one pose at a
+ * time, chunked as bench_inverse: kins_inverse4 against kins_inverse or, with path set,
+ * kins_inverse_path4 against inverse_path (the planner's samples, on the random poses with
+ * the first and second derivatives of a five-axis move). .ns four at once, .naive_ns one at
+ * a time. */
+static struct figure bench_four(struct bench *B, int path)
 {
     struct figure f = { 0, 0, 0, 0, 0 };
     double dp[4][KINS_POSE_DIM] = { { 0.6, -0.5, 0.1, 0.2, -0.1, 0.3 } };
     double d2p[4][KINS_POSE_DIM] = { { 0.01, 0.02, 0, -0.01, 0.005, 0.002 } };
     for (int l = 1; l < 4; l++)
         memcpy(dp[l], dp[0], sizeof dp[l]), memcpy(d2p[l], d2p[0], sizeof d2p[l]);
-    double L[4][KINS_MAX_JOINTS], dL[4][KINS_MAX_JOINTS], d2L[4][KINS_MAX_JOINTS];
+    double L[4][KINS_MAX_JOINTS] = { { 0 } }, dL[4][KINS_MAX_JOINTS] = { { 0 } };
+    double d2L[4][KINS_MAX_JOINTS] = { { 0 } };
     int st[4];
     for (int from = 0; from < NPOSE; from += CHUNK) {
         double best = 1e99, one_best = 1e99;
         for (int run = 0; run < RUNS; run++) {
             double t0 = now_ns();
             for (int n = from; n + 4 <= from + CHUNK; n += 4) {
-                kins_inverse_path4(B->k, (const double(*)[KINS_POSE_DIM])B->poses[n],
-                                   (const double(*)[KINS_POSE_DIM])dp,
-                                   (const double(*)[KINS_POSE_DIM])d2p, L, dL, d2L, st);
-                B->sink += d2L[3][5];
+                const double(*q)[KINS_POSE_DIM] = (const double(*)[KINS_POSE_DIM])B->poses[n];
+                if (path)
+                    kins_inverse_path4(B->k, q, (const double(*)[KINS_POSE_DIM])dp,
+                                       (const double(*)[KINS_POSE_DIM])d2p, L, dL, d2L, st);
+                else
+                    kins_inverse4(B->k, q, L, st);
+                B->sink += L[3][5] + d2L[3][5];
             }
             double t1 = now_ns();
             for (int n = from; n < from + CHUNK; n++) {
-                B->k->ops->inverse_path(B->k, B->poses[n], dp[0], d2p[0], L[0], dL[0], d2L[0]);
-                B->sink += d2L[0][4];
+                if (path)
+                    B->k->ops->inverse_path(B->k, B->poses[n], dp[0], d2p[0], L[0], dL[0],
+                                            d2L[0]);
+                else
+                    kins_inverse(B->k, B->poses[n], L[0]);
+                B->sink += L[0][4] + d2L[0][4];
             }
             double t2 = now_ns();
             best = fmin(best, t1 - t0);
@@ -408,8 +389,8 @@ int main(void)
     if (bench_setup(&B, c, &top_speed) != 0)
         return 1;
     struct figure inv = bench_inverse(&B);
-    struct figure inv4 = bench_inverse4(&B);
-    struct figure path4 = bench_inverse_path4(&B);
+    struct figure inv4 = bench_four(&B, 0);
+    struct figure path4 = bench_four(&B, 1);
     struct figure warm = bench_forward(&B, 1);
     struct figure cold = bench_forward(&B, 0);
 

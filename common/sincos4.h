@@ -19,11 +19,10 @@ typedef int64_t v4l __attribute__((vector_size(32)));
 /* Lane by lane: a where mask (all ones), else b. */
 #define SELECT(mask, a, b) ((v4d)(((v4l)(a) & (mask)) | ((v4l)(b) & ~(mask))))
 
-/* The series of sincos3_short and sincos3_one on a vector, Horner as written there. */
-#define SINCOS_SHORT(x, s, c)                                                                    \
+/* The series of sincos3_short and sincos3_one on a vector, Horner as written there: the
+ * last five steps, from q and p at the x^11 and x^12 terms, are both series' own. */
+#define SINCOS_TAIL(x, z_, q_, p_, s, c)                                                         \
     do {                                                                                         \
-        v4d z_ = (x) * (x);                                                                      \
-        v4d q_ = SPLAT(-2.505210838544172e-08), p_ = SPLAT(-2.08767569878681e-09);              \
         q_ = q_ * z_ + 2.7557319223985893e-06, p_ = p_ * z_ + 2.7557319223985888e-07;           \
         q_ = q_ * z_ - 0.00019841269841269841, p_ = p_ * z_ - 2.4801587301587302e-05;           \
         q_ = q_ * z_ + 0.0083333333333333332, p_ = p_ * z_ + 0.0013888888888888889;             \
@@ -33,6 +32,13 @@ typedef int64_t v4l __attribute__((vector_size(32)));
         (c) = 1.0 - p_ * z_;                                                                     \
     } while (0)
 
+#define SINCOS_SHORT(x, s, c)                                                                    \
+    do {                                                                                         \
+        v4d z_ = (x) * (x);                                                                      \
+        v4d q_ = SPLAT(-2.505210838544172e-08), p_ = SPLAT(-2.08767569878681e-09);              \
+        SINCOS_TAIL(x, z_, q_, p_, s, c);                                                        \
+    } while (0)
+
 #define SINCOS_ONE(x, s, c)                                                                      \
     do {                                                                                         \
         v4d z_ = (x) * (x);                                                                      \
@@ -40,13 +46,7 @@ typedef int64_t v4l __attribute__((vector_size(32)));
         q_ = q_ * z_ - 7.6471637318198164e-13, p_ = p_ * z_ - 4.7794773323873853e-14;           \
         q_ = q_ * z_ + 1.6059043836821613e-10, p_ = p_ * z_ + 1.1470745597729725e-11;           \
         q_ = q_ * z_ - 2.505210838544172e-08, p_ = p_ * z_ - 2.08767569878681e-09;              \
-        q_ = q_ * z_ + 2.7557319223985893e-06, p_ = p_ * z_ + 2.7557319223985888e-07;           \
-        q_ = q_ * z_ - 0.00019841269841269841, p_ = p_ * z_ - 2.4801587301587302e-05;           \
-        q_ = q_ * z_ + 0.0083333333333333332, p_ = p_ * z_ + 0.0013888888888888889;             \
-        q_ = q_ * z_ - 0.16666666666666666, p_ = p_ * z_ - 0.041666666666666664;                \
-        q_ = q_ * z_ + 1.0, p_ = p_ * z_ + 0.5;                                                  \
-        (s) = q_ * (x);                                                                          \
-        (c) = 1.0 - p_ * z_;                                                                     \
+        SINCOS_TAIL(x, z_, q_, p_, s, c);                                                        \
     } while (0)
 
 /* sincos1 of each lane, as a mask of the lanes it could not take (beyond pi/4, or not a

@@ -23,6 +23,42 @@
  */
 
 
+/* The platform's rotation at four poses x[] (hexapod_pose_frame's angles, sincos3's series,
+ * hexapod_rot_from_sc's products), and the sine and cosine of C; lanes beyond the series'
+ * range (pi/4) or not a number into *bad. (Pointers, not vectors by value: the functions
+ * are inlined into both builds of their callers.) */
+static inline __attribute__((always_inline)) void rot4(const v4d *x, v4d (*r)[3], v4d *sc_out,
+                                                       v4d *cc_out, v4l *bad)
+{
+    v4d sa, ca, sb, cb, sc, cc;
+    v4d xa = x[KINS_A] * HEXAPOD_RAD_PER_DEG, xb = x[KINS_B] * HEXAPOD_RAD_PER_DEG;
+    v4d xc = x[KINS_C] * HEXAPOD_RAD_PER_DEG;
+    SINCOS_LANES(xa, sa, ca, *bad);
+    SINCOS_LANES(xb, sb, cb, *bad);
+    SINCOS_LANES(xc, sc, cc, *bad);
+    r[0][0] = cc * cb, r[0][1] = cc * sb * sa - sc * ca, r[0][2] = cc * sb * ca + sc * sa;
+    r[1][0] = sc * cb, r[1][1] = sc * sb * sa + cc * ca, r[1][2] = sc * sb * ca - cc * sa;
+    r[2][0] = -sb, r[2][1] = cb * sa, r[2][2] = cb * ca;
+    *sc_out = sc, *cc_out = cc;
+}
+
+/* Leg i at four poses (hexapod_legs_eval's): the rotated platform joint rp[], the leg's
+ * vector v[] and its length *len. */
+static inline __attribute__((always_inline)) void leg4(const struct hexapod *h, int i,
+                                                       const v4d *x, v4d (*r)[3], v4d *rp,
+                                                       v4d *v, v4d *len)
+{
+    const double *p = h->p_mm[i], *b = h->b_mm[i];
+    for (int j = 0; j < 3; j++)
+        rp[j] = r[j][0] * p[0] + r[j][1] * p[1] + r[j][2] * p[2];
+    for (int j = 0; j < 3; j++)
+        v[j] = x[KINS_X + j] + rp[j] - b[j];
+    v4d q = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    for (int l = 0; l < 4; l++)
+        q[l] = sqrt(q[l]);                /* (sqrtpd: correctly rounded, as sqrtsd) */
+    *len = q;
+}
+
 __attribute__((target_clones("avx2", "default")))
 void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
                       double (*joints)[KINS_MAX_JOINTS], int *status)
@@ -36,31 +72,15 @@ void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
     for (int j = 0; j < KINS_POSE_DIM; j++)   /* value is infinite or not a number */
         z = z + x[j] * 0.0;
     v4l bad = ~(z == 0);
-    v4d sa, ca, sb, cb, sc, cc;
-    v4d xa = x[KINS_A] * HEXAPOD_RAD_PER_DEG, xb = x[KINS_B] * HEXAPOD_RAD_PER_DEG;
-    v4d xc = x[KINS_C] * HEXAPOD_RAD_PER_DEG;
-    SINCOS_LANES(xa, sa, ca, bad);
-    SINCOS_LANES(xb, sb, cb, bad);
-    SINCOS_LANES(xc, sc, cc, bad);
-    v4d r00 = cc * cb, r01 = cc * sb * sa - sc * ca, r02 = cc * sb * ca + sc * sa;
-    v4d r10 = sc * cb, r11 = sc * sb * sa + cc * ca, r12 = sc * sb * ca - cc * sa;
-    v4d r20 = -sb, r21 = cb * sa, r22 = cb * ca;
-    v4l plain = r22 > 0;
-    v4d len[HEXAPOD_LEGS];
+    v4d r[3][3], sc, cc, len[HEXAPOD_LEGS];
+    rot4(x, r, &sc, &cc, &bad);
+    v4l plain = r[2][2] > 0;
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        const double *p = h->p_mm[i], *b = h->b_mm[i];
-        v4d rp0 = r00 * p[0] + r01 * p[1] + r02 * p[2];
-        v4d rp1 = r10 * p[0] + r11 * p[1] + r12 * p[2];
-        v4d rp2 = r20 * p[0] + r21 * p[1] + r22 * p[2];
-        v4d v0 = x[KINS_X] + rp0 - b[0];
-        v4d v1 = x[KINS_Y] + rp1 - b[1];
-        v4d v2 = x[KINS_Z] + rp2 - b[2];
-        v4d q = v0 * v0 + v1 * v1 + v2 * v2;
-        for (int l = 0; l < 4; l++)
-            q[l] = sqrt(q[l]);                /* (sqrtpd: correctly rounded, as sqrtsd) */
+        v4d rp[3], v[3], q;
+        leg4(h, i, x, r, rp, v, &q);
         len[i] = q - h->offset_mm[i];
         bad |= (len[i] < k->joint_min[i]) | (len[i] > k->joint_max[i]);
-        plain &= x[KINS_Z] + rp2 - b[2] > 0;
+        plain &= x[KINS_Z] + rp[2] - h->b_mm[i][2] > 0;
     }
     if (h->ws_extra)
         plain = (v4l){ 0, 0, 0, 0 };
@@ -100,16 +120,9 @@ void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
     for (int j = 0; j < KINS_POSE_DIM; j++)
         z = z + x[j] * 0.0 + d1[j] * 0.0 + d2[j] * 0.0;
     v4l bad = ~(z == 0);
-    v4d sa, ca, sb, cb, sc, cc;
-    v4d xa = x[KINS_A] * HEXAPOD_RAD_PER_DEG, xb = x[KINS_B] * HEXAPOD_RAD_PER_DEG;
-    v4d xc = x[KINS_C] * HEXAPOD_RAD_PER_DEG;
-    SINCOS_LANES(xa, sa, ca, bad);
-    SINCOS_LANES(xb, sb, cb, bad);
-    SINCOS_LANES(xc, sc, cc, bad);
-    v4d r[3][3] = { { cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa },
-                    { sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa },
-                    { -sb, cb * sa, cb * ca } };
-    v4d e_a[3] = { cc * cb, sc * cb, -sb }, e_b[3] = { -sc, cc, SPLAT(0.0) };
+    v4d r[3][3], sc, cc;
+    rot4(x, r, &sc, &cc, &bad);
+    v4d e_a[3] = { r[0][0], r[1][0], r[2][0] }, e_b[3] = { -sc, cc, SPLAT(0.0) };
     v4l plain = r[2][2] > 0;
     const double zz[3] = { 0, 0, 1 };
     v4d a1 = d1[KINS_A] * HEXAPOD_RAD_PER_DEG, b1 = d1[KINS_B] * HEXAPOD_RAD_PER_DEG;
@@ -127,21 +140,14 @@ void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
     }
     v4d len[HEXAPOD_LEGS], l1v[HEXAPOD_LEGS], l2v[HEXAPOD_LEGS];
     for (int i = 0; i < HEXAPOD_LEGS; i++) {
-        const double *p = h->p_mm[i], *b = h->b_mm[i];
-        v4d rp[3], v[3], u[3], wr[3], wwr[3], wdr[3], v1[3], v2[3];
-        for (int j = 0; j < 3; j++)
-            rp[j] = r[j][0] * p[0] + r[j][1] * p[1] + r[j][2] * p[2];
-        for (int j = 0; j < 3; j++)
-            v[j] = x[KINS_X + j] + rp[j] - b[j];
-        v4d q = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        for (int l = 0; l < 4; l++)
-            q[l] = sqrt(q[l]);
+        v4d rp[3], v[3], q, u[3], wr[3], wwr[3], wdr[3], v1[3], v2[3];
+        leg4(h, i, x, r, rp, v, &q);
         v4d inv = 1.0 / q;
         for (int j = 0; j < 3; j++)
             u[j] = v[j] * inv;
         len[i] = q - h->offset_mm[i];
         bad |= (len[i] < k->joint_min[i]) | (len[i] > k->joint_max[i]);
-        plain &= x[KINS_Z] + rp[2] - b[2] > 0;
+        plain &= x[KINS_Z] + rp[2] - h->b_mm[i][2] > 0;
         CROSS_V(w, rp, wr);
         CROSS_V(w, wr, wwr);
         CROSS_V(wd, rp, wdr);

@@ -213,73 +213,26 @@ START_TEST(test_sincos3)
 }
 END_TEST
 
-/* Four inverses at once (kins_inverse4) give the single inverse's joints and status bit for
- * bit: poses within the short series' angles, beyond it, beyond the series' range (pi/4),
- * mixed within one call, legs out of range, a pose that is not a number or is infinite, a
- * platform below its base joints, and a workspace limit beyond the assembly's (every lane
- * then goes to the single inverse). */
-START_TEST(test_inverse4)
+/* Four at once give what one at a time gives, bit for bit: kins_inverse4 the inverse's
+ * joints and status, kins_inverse_path4 inverse_path's joints, first and second derivatives
+ * and status. Lanes at random: angles within the short series' range, beyond it, beyond the
+ * series' own (pi/4), mixed within one call; angles and their rates exactly 0 on some lanes
+ * (the sign of a zero must come out the same); legs out of range, a platform below its base
+ * joints, a pose or a derivative that is not a number or is infinite; and a workspace limit
+ * beyond the assembly's (every lane then goes to the single call). */
+START_TEST(test_four_at_once)
 {
     struct kins *k = make_tmu();
     struct hexapod *h = (struct hexapod *)k;
     srand48(11);
     long lanes = 0, ok = 0;
     for (int n = 0; n < 40000; n++) {
-        double pose[4][KINS_POSE_DIM], got[4][KINS_MAX_JOINTS], want[4][KINS_MAX_JOINTS];
-        int st[4];
-        memset(got, 0, sizeof got);
-        memset(want, 0, sizeof want);
-        for (int l = 0; l < 4; l++) {
-            int kind = (int)(drand48() * 8);
-            double deg = kind < 4 ? 14.0 : kind < 6 ? 45.0 : 55.0;
-            for (int i = 0; i < 3; i++)
-                pose[l][i] = (2 * drand48() - 1) * 120.0;
-            pose[l][KINS_Z] += 645.0;
-            for (int i = 3; i < 6; i++)
-                pose[l][i] = (2 * drand48() - 1) * deg;
-            if (kind == 7 && n % 3 == 0)
-                pose[l][(int)(drand48() * 6)] = n % 2 ? NAN : -INFINITY;
-            if (kind == 7 && n % 3 == 1)
-                pose[l][KINS_Z] = n % 2 ? 1100.0 : -200.0;   /* out of reach, or below */
-        }
-        if (n == 0)                 /* the home pose, and the series' own boundaries */
-            for (int l = 0; l < 4; l++) {
-                double home[6] = { 0, 0, 645, 0, 0, 0 };
-                memcpy(pose[l], home, sizeof home);
-                pose[l][3 + l % 3] = l < 2 ? 45.0 : l == 2 ? -14.323944878270581 : 0;
-            }
-        h->ws_extra = n % 500 == 499;
-        kins_inverse4(k, (const double(*)[KINS_POSE_DIM])pose, got, st);
-        for (int l = 0; l < 4; l++) {
-            int w = kins_inverse(k, pose[l], want[l]);
-            ck_assert_int_eq(st[l], w);
-            ck_assert_msg(!memcmp(got[l], want[l], sizeof got[l]), "pose %d lane %d", n, l);
-            lanes++;
-            ok += w == KINS_OK;
-        }
-    }
-    h->ws_extra = false;
-    ck_assert(ok > lanes / 2 && ok < lanes);     /* both kinds of lane were there */
-    kins_free(k);
-}
-END_TEST
-
-/* Four of the planner's samples at once (kins_inverse_path4) give inverse_path's joints,
- * first and second derivatives and status bit for bit: poses and derivatives at random,
- * angles and their rates exactly 0 on every other lane (the sign of a zero must come out
- * the same), angles beyond the series' range, legs out of range, derivatives that are not
- * numbers, and a workspace limit beyond the assembly's. */
-START_TEST(test_inverse_path4)
-{
-    struct kins *k = make_tmu();
-    struct hexapod *h = (struct hexapod *)k;
-    srand48(13);
-    long lanes = 0, ok = 0;
-    for (int n = 0; n < 40000; n++) {
         double pose[4][6], dp[4][6], d2p[4][6];
         double L[2][4][KINS_MAX_JOINTS], dL[2][4][KINS_MAX_JOINTS], d2L[2][4][KINS_MAX_JOINTS];
-        int st[4];
+        double J[2][4][KINS_MAX_JOINTS];
+        int st[4], st4[4];
         memset(L, 0, sizeof L), memset(dL, 0, sizeof dL), memset(d2L, 0, sizeof d2L);
+        memset(J, 0, sizeof J);
         for (int l = 0; l < 4; l++) {
             int kind = (int)(drand48() * 8);
             double deg = kind < 5 ? 14.0 : kind < 7 ? 45.0 : 55.0;
@@ -291,28 +244,35 @@ START_TEST(test_inverse_path4)
                     pose[l][i] = dp[l][i] = d2p[l][i] = 0.0;
             }
             pose[l][KINS_Z] += 645.0;
-            if (kind == 7 && n % 3 == 0)
+            if (kind == 7 && n % 4 == 0)
+                pose[l][(int)(drand48() * 6)] = n % 8 ? NAN : -INFINITY;
+            if (kind == 7 && n % 4 == 1)
                 d2p[l][(int)(drand48() * 6)] = NAN;
-            if (kind == 7 && n % 3 == 1)
-                pose[l][KINS_Z] = 1100.0;
+            if (kind == 7 && n % 4 == 2)
+                pose[l][KINS_Z] = n % 8 == 2 ? 1100.0 : -200.0;   /* out of reach, or below */
         }
         h->ws_extra = n % 500 == 499;
-        kins_inverse_path4(k, (const double(*)[6])pose, (const double(*)[6])dp,
-                           (const double(*)[6])d2p, L[0], dL[0], d2L[0], st);
+        const double(*P)[6] = (const double(*)[6])pose;
+        kins_inverse4(k, P, J[0], st4);
+        kins_inverse_path4(k, P, (const double(*)[6])dp, (const double(*)[6])d2p, L[0], dL[0],
+                           d2L[0], st);
         for (int l = 0; l < 4; l++) {
+            int w4 = kins_inverse(k, pose[l], J[1][l]);
             int w = k->ops->inverse_path(k, pose[l], dp[l], d2p[l], L[1][l], dL[1][l],
                                          d2L[1][l]);
+            ck_assert_int_eq(st4[l], w4);
             ck_assert_int_eq(st[l], w);
+            ck_assert_msg(!memcmp(J[0][l], J[1][l], sizeof J[0][l]), "inverse %d lane %d", n, l);
             ck_assert_msg(!memcmp(L[0][l], L[1][l], sizeof L[0][l]) &&
                           !memcmp(dL[0][l], dL[1][l], sizeof dL[0][l]) &&
                           !memcmp(d2L[0][l], d2L[1][l], sizeof d2L[0][l]),
                           "sample %d lane %d", n, l);
             lanes++;
-            ok += w == KINS_OK;
+            ok += w4 == KINS_OK;
         }
     }
     h->ws_extra = false;
-    ck_assert(ok > lanes / 2 && ok < lanes);
+    ck_assert(ok > lanes / 2 && ok < lanes);     /* both kinds of lane were there */
     kins_free(k);
 }
 END_TEST
@@ -325,8 +285,7 @@ int main(void)
     tcase_add_test(tc, test_inverse_path);
     tcase_add_test(tc, test_jacobian);
     tcase_add_test(tc, test_sincos3);
-    tcase_add_test(tc, test_inverse4);
-    tcase_add_test(tc, test_inverse_path4);
+    tcase_add_test(tc, test_four_at_once);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

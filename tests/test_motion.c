@@ -136,19 +136,26 @@ START_TEST(test_trapezoid_hexapod)
 }
 END_TEST
 
+/* Two TMU hexapods side by side and an empty program for both, starting at s0. */
+static void two_machines(struct tm_machine *a, struct tm_machine *b, struct canon_prog *p,
+                         const double s0[6])
+{
+    open_hexapod(a);
+    open_hexapod(b);
+    canon_prog_init(p);
+    memcpy(p->start, s0, 6 * sizeof *s0);
+}
+
 /* motion_set_brief: the record's brief part is the same, bit for bit, as with the whole record
  * (two machines run the same five-axis program side by side), the rest is left as it was,
  * and the executor's own course does not change: both end together in the same place. */
 START_TEST(test_brief_record)
 {
     struct tm_machine a, b;
-    open_hexapod(&a);
-    open_hexapod(&b);
     struct canon_prog p;
-    canon_prog_init(&p);
     double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
            e2[6] = {-10, 15, 640, -2, 4, -6};
-    memcpy(p.start, s0, sizeof s0);
+    two_machines(&a, &b, &p, s0);
     tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
     tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
     load_start(a.m, &p);
@@ -190,6 +197,28 @@ START_TEST(test_brief_record)
 }
 END_TEST
 
+/* n feeds along a wandering five-axis curve from `from` (chords of about 0.5 mm at t step
+ * 0.02, A B C turning), the end pose into at: dense CAM code, blended by a G64 before. */
+static void add_curve(struct canon_prog *p, const double from[6], int n, double step, int line,
+                      double at[6])
+{
+    for (int i = 0; i < n; i++) {
+        double t = i * step;
+        at[0] = from[0] + 20 * sin(t), at[1] = from[1] + 15 * sin(1.7 * t);
+        at[2] = from[2] + 2 * sin(0.5 * t), at[3] = from[3] + 3 * sin(t);
+        at[4] = from[4] + 2 * cos(0.8 * t) - 2, at[5] = from[5] + 4 * sin(0.3 * t);
+        tm_add(p, CANON_FEED, line, at, 2000, 0);
+    }
+}
+
+/* A look-ahead's entries were taken: more than twice as often as it filled, by at least
+ * `least` periods or knots. */
+static void ahead_taken(long taken, long fills, long least)
+{
+    ck_assert_msg(taken > 2 * fills && taken > least, "%ld fills, %ld taken (at least %ld)",
+                  fills, taken, least);
+}
+
 /* The check's look-ahead (motion_set_ahead: four periods' poses and legs at once) changes
  * nothing a period gives: two machines side by side, rates off in both, the look-ahead on
  * in one, through blended and exact-stop five-axis feeds, an arc, dense code whose blend
@@ -200,14 +229,11 @@ END_TEST
 START_TEST(test_ahead_same_bits)
 {
     struct tm_machine a, b;
-    open_hexapod(&a);
-    open_hexapod(&b);
     struct canon_prog p;
-    canon_prog_init(&p);
     double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
            e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
            c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, e4[6] = {5, 5, 645, 0, 0, 0};
-    memcpy(p.start, s0, sizeof s0);
+    two_machines(&a, &b, &p, s0);
     struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
                            .value = 0.01, .ivalue = 640};
     ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
@@ -215,13 +241,7 @@ START_TEST(test_ahead_same_bits)
     tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
     tm_arc(&p, 5, e3, c3, n3, 1, 1800);
     double at[6];
-    for (int i = 0; i < 120; i++) {             /* dense code: blend arcs turning A B C */
-        double t = i * 0.05;
-        at[0] = e3[0] + 12 * sin(t), at[1] = e3[1] + 9 * sin(1.7 * t), at[2] = e3[2];
-        at[3] = e3[3] + 3 * sin(t), at[4] = e3[4] + 2 * cos(0.8 * t) - 2;
-        at[5] = e3[5] + 4 * sin(0.3 * t);
-        tm_add(&p, CANON_FEED, 5, at, 2000, 0);
-    }
+    add_curve(&p, e3, 120, 0.05, 5, at);        /* dense code: blend arcs turning A B C */
     tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
     tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
     tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
@@ -257,8 +277,7 @@ START_TEST(test_ahead_same_bits)
     for (int i = 0; i < 6; i++)
         ck_assert_double_eq_tol(ob.pose[i], e4[i], 1e-9);
     /* at the plan's pace three periods in four take an entry filled before them */
-    ck_assert_msg(b.m->ahead.taken > 2 * b.m->ahead.fills && b.m->ahead.taken > n / 2,
-                  "%ld periods: %ld fills, %ld taken", n, b.m->ahead.fills, b.m->ahead.taken);
+    ahead_taken(b.m->ahead.taken, b.m->ahead.fills, n / 2);
     ck_assert_int_eq(a.m->ahead.fills, 0);
     canon_prog_free(&p);
     tm_close(&a);
@@ -273,22 +292,15 @@ END_TEST
 START_TEST(test_knot_ahead_same_plan)
 {
     struct tm_machine a, b;
-    open_hexapod(&a);
-    open_hexapod(&b);
-    b.m->kahead.off = 1;
     struct canon_prog p;
-    canon_prog_init(&p);
-    double at[6] = {0, 0, 645, 0, 0, 0}, c3[3], n3[3] = {0, 0, 1};
-    memcpy(p.start, at, sizeof at);
+    double s0[6] = {0, 0, 645, 0, 0, 0}, at[6], c3[3], n3[3] = {0, 0, 1};
+    two_machines(&a, &b, &p, s0);
+    b.m->kahead.off = 1;
     struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
                            .value = 0.01, .ivalue = 640};
     ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
-    for (int i = 0; i < 300; i++) {             /* a curve of 0.5 mm chords, turning */
-        double t = i * 0.02;
-        at[0] = 20 * sin(t), at[1] = 15 * sin(1.7 * t), at[2] = 645 + 2 * sin(0.5 * t);
-        at[3] = 3 * sin(t), at[4] = 6 + 2 * cos(0.8 * t), at[5] = 4 * sin(0.3 * t);
-        tm_add(&p, CANON_FEED, 3 + i, at, 2000, 0);
-    }
+    double c6[6] = {0, 0, 645, 0, 8, 0};
+    add_curve(&p, c6, 300, 0.02, 3, at);        /* a curve of 0.5 mm chords, turning */
     memcpy(c3, at, sizeof c3);
     c3[1] += 5;
     double e3[6];
@@ -311,8 +323,7 @@ START_TEST(test_knot_ahead_same_plan)
     ck_assert(!memcmp(pa->irho, pb->irho, nk * sizeof *pa->irho));
     ck_assert(!memcmp(pa->ivp, pb->ivp, nk * sizeof *pa->ivp));
     ck_assert(pa->total_time_s == pb->total_time_s);
-    ck_assert_msg(a.m->kahead.taken > 2 * a.m->kahead.fills && a.m->kahead.taken > (long)nk / 2,
-                  "%zu knots: %ld fills, %ld taken", nk, a.m->kahead.fills, a.m->kahead.taken);
+    ahead_taken(a.m->kahead.taken, a.m->kahead.fills, (long)nk / 2);
     ck_assert_int_eq(b.m->kahead.fills, 0);
     canon_prog_free(&p);
     tm_close(&a);
