@@ -1,16 +1,16 @@
-/* hexapod_batch.c: the inverse of four poses at once, lane by lane the same operations as
- * hexapod_inverse, so the same bits (the kins_ops inverse4 entry). */
+/* hexapod_batch.c: the inverse and the planner's samples of four poses at once, lane by
+ * lane the same operations as hexapod_inverse and hexapod_inverse_path, so the same bits
+ * (the kins_ops inverse4 and inverse_path4 entries). */
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 
 #include "kins/hexapod.h"
 #include "common/sincos4.h"
 #include "kins/hexapod_math.h"
 
 /*
- * A caller with several poses ahead (the check's servo-rate pass, motion_step.c) gives four
- * at a time: each number below is a vector of the four poses' values, and each operation is
+ * A caller with several poses ahead (a check's executor, motion_ahead.c; the planner's
+ * knots, motion_caps.c) gives four at a time: each number below is a vector of the four poses' values, and each operation is
  * the scalar one of hexapod_inverse (hexapod_pose_frame, sincos3, hexapod_rot_from_sc,
  * hexapod_legs_eval, hexapod_ws_plain), in the same order: C rounds every operation to double
  * and contracts none (ISO C, -ffp-contract=off), in a vector lane as in a register of its
@@ -21,7 +21,6 @@
  * joints. On a processor with AVX2 the vectors are one register each (the function is
  * built twice, and the loader picks); elsewhere two SSE2 halves.
  */
-
 
 /* The platform's rotation at four poses x[] (hexapod_pose_frame's angles, sincos3's series,
  * hexapod_rot_from_sc's products), and the sine and cosine of C; lanes beyond the series'
