@@ -72,11 +72,7 @@ static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, 
             s[l] = p->ks[ci], v[l] = v0;
         return;
     }
-    if (mp->v0 != v0 || mp->v1 != v1 || mp->vp != vp || mp->acc != acc || mp->ds != ds) {
-        motion_phases(v0, v1, vp, acc, ds, &mp->ta, &mp->tc, &mp->td);
-        mp->sa = (vp * vp - v0 * v0) / (2 * acc);
-        mp->v0 = v0, mp->v1 = v1, mp->vp = vp, mp->acc = acc, mp->ds = ds;
-    }
+    motion_phase_memo_take(mp, v0, v1, vp, acc, ds);
     double ta = mp->ta, tc = mp->tc, td = mp->td, sa = mp->sa;
     v4d d = (v4d){ tau[0], tau[1], tau[2], tau[3] } - p->kt[ci];
     v4d dc = SELECT(d > ta + tc + td, SPLAT(ta + tc + td), d);
@@ -92,9 +88,9 @@ static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, 
         s[l] = sv[l], v[l] = vv[l];
 }
 
-/* Fills the entries from the present state on: returns the first, or NULL when the present
- * segment is one it leaves to evaluate() (synchronised, under G43.4). */
-static const struct motion_ahead_at *fill(struct motion *m, double dt)
+/* Fills the entries from the present state on: returns the first's index (0), or -1 when
+ * the present segment is one it leaves to evaluate() (synchronised, under G43.4). */
+static int fill(struct motion *m, double dt)
 {
     struct motion_ahead *a = &m->ahead;
     const struct motion_plan *p = m->run;
@@ -121,7 +117,7 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
     a->n = n;
     a->next = 0;
     if (n == 0)
-        return NULL;
+        return -1;
     double sv[MOTION_AHEAD], vv[MOTION_AHEAD], tv[MOTION_AHEAD];
     if (n == MOTION_AHEAD && a->at[0].ci == a->at[n - 1].ci) {    /* one interval */
         for (int j = 0; j < n; j++)
@@ -146,18 +142,17 @@ static const struct motion_ahead_at *fill(struct motion *m, double dt)
     a->run = p;
     a->fills++;
     kins_inverse4(m->kins, (const double(*)[KINS_POSE_DIM])a->pose, a->joints, a->status);
-    return &a->at[a->next++];
+    return a->next++;
 }
 
-const struct motion_ahead_at *motion_ahead(struct motion *m, double dt)
+int motion_ahead(struct motion *m, double dt)
 {
     struct motion_ahead *a = &m->ahead;
     if (a->next < a->n && a->run == m->run) {
         const struct motion_ahead_at *e = &a->at[a->next];
         if (e->ci == m->ci && e->cs == m->cs && e->tau_s == m->tau_s) {
-            a->next++;
             a->taken++;
-            return e;
+            return a->next++;
         }
     }
     /* the next periods are foreseen at the plan's own pace only (anywhere else the clock
@@ -166,7 +161,7 @@ const struct motion_ahead_at *motion_ahead(struct motion *m, double dt)
         m->rapid_cmd != 1 || m->waiting || m->probe_halt == PROBE_HALTING ||
         m->probe_halt == PROBE_PARKED) {
         a->n = a->next = 0;
-        return NULL;
+        return -1;
     }
     return fill(m, dt);
 }

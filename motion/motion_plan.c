@@ -161,19 +161,6 @@ static void apply_chord_caps(struct motion_plan *p, const struct motion_seg *sg,
 /* Caps at every knot (see segment_caps); interval caps into ivp and irho (hard); a knot's
  * speed suits both neighbouring intervals; joints between segments get their speed. */
 static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
-                             struct acc_line *ln, char *err, size_t errlen);
-
-/* all_caps_in_order, with the planner's look-ahead over its knots (motion_caps.c). */
-static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_line *ln,
-                    char *err, size_t errlen)
-{
-    motion_knot_ahead(m, true);
-    int st = all_caps_in_order(m, gain, zcap, ln, err, errlen);
-    motion_knot_ahead(m, false);
-    return st;
-}
-
-static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
                              struct acc_line *ln, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
@@ -225,6 +212,16 @@ static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
         p->info.samples += sg->nk;
     }
     return MOTION_OK;
+}
+
+/* all_caps_in_order, with the planner's look-ahead over its knots (motion_caps.c). */
+static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_line *ln,
+                    char *err, size_t errlen)
+{
+    motion_knot_ahead(m, true);
+    int st = all_caps_in_order(m, gain, zcap, ln, err, errlen);
+    motion_knot_ahead(m, false);
+    return st;
 }
 
 /* Whether the override may run the interval from knot a to b above 1: it moves (both knots'

@@ -224,7 +224,6 @@ struct motion_manual {
 enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOME_BACKOFF,
                          HOME_LATCH, HOME_SETTLE, HOME_FINAL, HOME_DONE };
 
-/* The motion instance. */
 /* The look-ahead of a check's executor (motion_ahead.c): the next periods' path position,
  * pose and legs, each keyed by the state it is a function of. */
 #define MOTION_AHEAD 4
@@ -268,6 +267,7 @@ struct motion_ahead {
     long fills, taken;       /* fills, and entries taken after the first of a fill */
 };
 
+/* The motion instance. */
 struct motion {
     struct motion_config cfg;
     double jerk_window_s;    /* motion_jerk_window_s(&cfg) and motion_chord_period(&cfg), */
@@ -424,6 +424,19 @@ static inline void motion_phases(double v0, double v1, double vp, double a, doub
     *tc = sc > 0 && vp > 0 ? sc / vp : 0;
 }
 
+/* The phases of an interval from v0 (knot) through vp (its peak) to v1 (knot) over ds at
+ * acceleration acc into *mp, and the path done at the cruise's start (sa), unless *mp holds
+ * them for these inputs already (motion_plan_at and the look-ahead's plan_at4). */
+static inline void motion_phase_memo_take(struct motion_phase_memo *mp, double v0, double v1,
+                                          double vp, double acc, double ds)
+{
+    if (mp->v0 != v0 || mp->v1 != v1 || mp->vp != vp || mp->acc != acc || mp->ds != ds) {
+        motion_phases(v0, v1, vp, acc, ds, &mp->ta, &mp->tc, &mp->td);
+        mp->sa = (vp * vp - v0 * v0) / (2 * acc);
+        mp->v0 = v0, mp->v1 = v1, mp->vp = vp, mp->acc = acc, mp->ds = ds;
+    }
+}
+
 /* motion_stream.c, for motion.c's attach: the stream's executor and its start pose. */
 void motion_stream_bind(struct motion_stream *s, struct motion *m);
 const double *motion_stream_start(const struct motion_stream *s);
@@ -467,9 +480,10 @@ static inline void motion_probe_settle(struct motion *m)
         motion_probe_settle_move(m);
 }
 
-/* The period's entry of the look-ahead (motion_ahead.c), filling it with this period and
- * the next ones where it has none; NULL on a segment it leaves to evaluate(). */
-const struct motion_ahead_at *motion_ahead(struct motion *m, double dt);
+/* The index of the period's entry in the look-ahead (motion_ahead.c), filling it with this
+ * period and the next ones where it has none; -1 where it leaves the period to evaluate()
+ * (a synchronised move, G43.4, off the plan's own pace). */
+int motion_ahead(struct motion *m, double dt);
 
 /* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
 #define MOTION_JERK_MAX_S 1.0

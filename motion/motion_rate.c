@@ -26,11 +26,7 @@ void motion_plan_at(const struct motion_plan *p, size_t ci, double tau, double *
         *a = 0;
         return;
     }
-    if (mp->v0 != v0 || mp->v1 != v1 || mp->vp != vp || mp->acc != acc || mp->ds != ds) {
-        motion_phases(v0, v1, vp, acc, ds, &mp->ta, &mp->tc, &mp->td);
-        mp->sa = (vp * vp - v0 * v0) / (2 * acc);
-        mp->v0 = v0, mp->v1 = v1, mp->vp = vp, mp->acc = acc, mp->ds = ds;
-    }
+    motion_phase_memo_take(mp, v0, v1, vp, acc, ds);
     double ta = mp->ta, tc = mp->tc, td = mp->td;
     d = d < 0 ? 0 : d > ta + tc + td ? ta + tc + td : d;
     if (d < ta) {

@@ -355,10 +355,9 @@ static int evaluate(struct motion *m, double dt)
     const struct motion_plan *p = m->run;
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
-    const struct motion_ahead_at *e = m->ahead_on && m->no_rates && m->state != MOTION_DONE
-                                      ? motion_ahead(m, dt) : NULL;
-    if (e) {
-        s = e->s, vp = e->vp;
+    int j = m->ahead_on && m->no_rates && m->state != MOTION_DONE ? motion_ahead(m, dt) : -1;
+    if (j >= 0) {
+        s = m->ahead.at[j].s, vp = m->ahead.at[j].vp;
     } else {
         motion_plan_at(p, m->ci, m->tau_s, &s, &vp, &ap, &m->phases);
         motion_sync_at(m, &s, &vp);    /* a synchronised move: where the spindle has it */
@@ -370,8 +369,8 @@ static int evaluate(struct motion *m, double dt)
     double v = vp * m->rate;
     if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
         v = 0;
-    if (e)
-        memcpy(m->prog_pose, m->ahead.pose[e - m->ahead.at], sizeof m->prog_pose);
+    if (j >= 0)
+        memcpy(m->prog_pose, m->ahead.pose[j], sizeof m->prog_pose);
     else
         motion_seg_pose(p, sg, s, m->prog_pose);
     double vr = m->no_rates ? 0 : v;   /* the speed the rates are computed for */
@@ -398,8 +397,8 @@ static int evaluate(struct motion *m, double dt)
     m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
     if (vr == 0) {
         memset(m->joint_vel, 0, sizeof m->joint_vel);
-        int j = e ? (int)(e - m->ahead.at) : 0;
-        if (!e || m->ahead.status[j] != KINS_OK)   /* (a failure as it comes, written or not) */
+        if (j < 0 || m->ahead.status[j] != KINS_OK)   /* (a failure as it comes, written or
+                                                      * not) */
             return kins_inverse(m->kins, m->pose, m->joint_cmd);
         for (int i = 0; i < m->nj; i++)        /* (inverse writes nj: the rest stays) */
             m->joint_cmd[i] = m->ahead.joints[j][i];
