@@ -265,6 +265,7 @@ struct motion_ahead {
     int status[MOTION_AHEAD];
     int n, next;             /* entries filled, the next one to take */
     long fills, taken;       /* fills, and entries taken after the first of a fill */
+    long calm;               /* periods motion_step took the short way (calm_period) */
 };
 
 /* The motion instance. */

@@ -348,6 +348,27 @@ static void seg_values(struct motion *m, const struct motion_seg *sg)
     m->file = sg->file;
 }
 
+/* The look-ahead's entry j (motion_ahead.c) as the period's pose and legs, where the period
+ * computes no rates and segment sg is no G43.4 move: what evaluate() would compute. (Out of
+ * line, as report() is: inlined into motion_step's branches, whose every test GCC guesses
+ * even, their copies counted as rare and were built as string moves, `rep movs`, slow for a
+ * few bytes: a check took 1.4 times as long.) */
+static __attribute__((noinline)) void entry_values(struct motion *m, const struct motion_seg *sg,
+                                                  int j)
+{
+    double s = m->ahead.at[j].s;
+    memcpy(m->prog_pose, m->ahead.pose[j], sizeof m->prog_pose);
+    memcpy(m->pose, m->prog_pose, sizeof m->pose);
+    memset(m->pose_vel, 0, sizeof m->pose_vel);
+    m->path_vel = m->ahead.at[j].vp * m->rate;
+    if (m->state == MOTION_PAUSED || m->state == MOTION_IDLE)
+        m->path_vel = 0;
+    m->dist_mm = sg->dist0_mm + (sg->len > 0 ? s * sg->xyz_len_mm / sg->len : 0);
+    memset(m->joint_vel, 0, sizeof m->joint_vel);
+    for (int i = 0; i < m->nj; i++)        /* (inverse writes nj: the rest stays) */
+        m->joint_cmd[i] = m->ahead.joints[j][i];
+}
+
 /* Pose, rates and legs at the current plan time (a check's, from the look-ahead's entry
  * when it has one: motion_ahead.c). */
 static int evaluate(struct motion *m, double dt)
@@ -356,6 +377,12 @@ static int evaluate(struct motion *m, double dt)
     const struct motion_seg *sg = &p->segs[m->cs];
     double s, vp, ap, dp[KINS_POSE_DIM];
     int j = m->ahead_on && m->no_rates && m->state != MOTION_DONE ? motion_ahead(m, dt) : -1;
+    if (sg != m->seg_at)
+        seg_values(m, sg);
+    if (j >= 0 && !sg->tcp && m->ahead.status[j] == KINS_OK) {
+        entry_values(m, sg, j);         /* (fill leaves out G43.4 moves: this is a check's) */
+        return KINS_OK;
+    }
     if (j >= 0) {
         s = m->ahead.at[j].s, vp = m->ahead.at[j].vp;
     } else {
@@ -378,8 +405,6 @@ static int evaluate(struct motion *m, double dt)
         motion_seg_tangent(p, sg, s, dp);
     else
         memset(dp, 0, sizeof dp);
-    if (sg != m->seg_at)
-        seg_values(m, sg);
     if (sg->tcp && vr == 0) {
         kins_tcp_to_pose(&m->tf, sg->tool_len_mm, m->prog_pose, m->pose);
         memset(m->pose_vel, 0, sizeof m->pose_vel);
@@ -581,11 +606,99 @@ static void stream_watch(struct motion *m)
     atomic_store_explicit(&m->stream_wait, wait, memory_order_release);
 }
 
+/* The period's output record (only its first part where the record is brief). */
+static __attribute__((noinline)) void report(struct motion *m, struct motion_out *out)
+{
+    /* (with jerk limits the spindle gets a command when the average reaches it: the wait
+     * for it at speed counts from then, not from when the executor passed it) */
+    const struct motion_spindle *sp = m->jerk ? &m->io_out : &m->io;
+    if (sp->dir != m->io.dir || sp->rpm != m->io.rpm || sp->mist != m->io.mist ||
+        sp->flood != m->io.flood)
+        m->io_age = 0;
+    int index_out = m->index_out;
+    m->index_out = 0;
+    memcpy(out->pose, m->pose, sizeof out->pose);
+    out->tcp = m->loaded && m->tcp;
+    out->tool_len_mm = out->tcp ? m->tool_len_mm : 0;
+    out->seg_kind = m->loaded ? m->seg_kind : 0;
+    memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
+    memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
+    out->path_tol_mm = m->path_tol_mm;
+    memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
+    out->line = m->line;
+    out->file = m->file;
+    out->state = m->state;
+    out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
+    out->time_elapsed_s = m->elapsed_s;
+    out->distance_done_mm = m->dist_mm;
+    out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
+    if (m->brief)
+        return;
+    memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
+    memcpy(out->prog_pose, out->tcp ? m->prog_pose : m->pose, sizeof out->prog_pose);
+    memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
+    for (int i = 0; i < KINS_MAX_JOINTS; i++)   /* (all: a fixed count is vectorised; */
+        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];  /* unused ones are 0) */
+    memcpy(out->joint_fb, m->joint_fb, sizeof out->joint_fb);
+    memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
+    out->njoints = m->nj;
+    out->path_vel = m->path_vel;
+    out->time_remaining_s = remaining(m);
+    out->feed_override = m->rate;
+    out->settings_done = m->marks_base + m->marks_done;
+    out->spindle = *sp;
+    out->spindle_index = index_out;
+    out->waiting = m->waiting;
+    out->tool = m->tool;
+    out->outputs = m->jerk ? m->outputs_out : m->outputs;
+    out->probe_input = m->probe_in;
+}
+
+/* A check's period at the plan's own pace that stays within its interval of the plan, with
+ * the look-ahead's entry for it ready (motion_ahead.c): motion_step's work for it without
+ * the tests that cannot come true there (no probe, wait, pause, jerk average, synchronised
+ * or G43.4 move, stepped block, override, chunk hand-over or end of the plan). Any other
+ * period is motion_step's (false, nothing done). Every value is the one the full path
+ * computes (test_ahead_same_bits compares them period by period). */
+static inline bool calm_period(struct motion *m, double dt, struct motion_out *out)
+{
+    struct motion_ahead *a = &m->ahead;
+    const struct motion_plan *p = m->run;
+    if (!m->brief || a->next >= a->n || a->run != p || m->state != MOTION_RUNNING)
+        return false;
+    const struct motion_ahead_at *e = &a->at[a->next];
+    const struct motion_seg *sg = &p->segs[m->cs];
+    double tau = m->tau_s + dt;              /* advance() at the plan's pace */
+    /* (the entry was filled at this clock in this interval: follow_knots stays in it) */
+    if ((e->ci != m->ci || e->cs != m->cs || e->tau_s != tau ||
+                         !(tau < p->total_time_s) || sg != m->seg_at || sg->kind > SEG_ARC ||
+                         a->status[a->next] != KINS_OK || m->rate != 1 ||
+                         m->override_cmd != 1 || m->rapid_cmd != 1 || m->waiting || m->jerk ||
+                         !m->no_rates || m->probe_wired || m->probe_seg ||
+                         m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED ||
+                         m->step_until_seg || !m->loaded || (m->streaming && !m->chunk)))
+        return false;
+    m->io_age++;
+    pass_ios(m);
+    m->elapsed_s += dt;
+    motion_sync_advance(m, dt);          /* (the ideal spindle turns; no synchronised move) */
+    m->tau_s = tau;
+    pass_marks(m);
+    pass_ios(m);
+    a->taken++, a->calm++;
+    entry_values(m, sg, a->next++);
+    stream_watch(m);
+    report(m, out);
+    return true;
+}
+
 /* One servo period (see motion.h). */
 int motion_step(struct motion *m, double period_s, struct motion_out *out)
 {
     if (!m || !out || !(period_s > 0))
         return MOTION_ERR_ARG;
+    if (m->ahead_on && calm_period(m, period_s, out))
+        return MOTION_OK;
     int ret = MOTION_OK;
     int moving = m->state == MOTION_RUNNING || m->state == MOTION_PAUSING ||
                  m->state == MOTION_STOPPING;
@@ -629,48 +742,6 @@ int motion_step(struct motion *m, double period_s, struct motion_out *out)
         motion_jerk_hold(m);
     }
     stream_watch(m);
-    /* (with jerk limits the spindle gets a command when the average reaches it: the wait
-     * for it at speed counts from then, not from when the executor passed it) */
-    const struct motion_spindle *sp = m->jerk ? &m->io_out : &m->io;
-    if (sp->dir != m->io.dir || sp->rpm != m->io.rpm || sp->mist != m->io.mist ||
-        sp->flood != m->io.flood)
-        m->io_age = 0;
-    int index_out = m->index_out;
-    m->index_out = 0;
-    memcpy(out->pose, m->pose, sizeof out->pose);
-    out->tcp = m->loaded && m->tcp;
-    out->tool_len_mm = out->tcp ? m->tool_len_mm : 0;
-    out->seg_kind = m->loaded ? m->seg_kind : 0;
-    memcpy(out->seg_from, m->seg_from, sizeof out->seg_from);
-    memcpy(out->seg_to, m->seg_to, sizeof out->seg_to);
-    out->path_tol_mm = m->path_tol_mm;
-    memcpy(out->joint_pos, m->joint_cmd, sizeof out->joint_pos);
-    out->line = m->line;
-    out->file = m->file;
-    out->state = m->state;
-    out->status = m->state == MOTION_FAULT ? m->fault_status : MOTION_OK;
-    out->time_elapsed_s = m->elapsed_s;
-    out->distance_done_mm = m->dist_mm;
-    out->distance_total_mm = m->streaming ? m->stream_info.length_mm : m->run->total_len_mm;
-    if (m->brief)
-        return ret;
-    memcpy(out->pose_vel, m->pose_vel, sizeof out->pose_vel);
-    memcpy(out->prog_pose, out->tcp ? m->prog_pose : m->pose, sizeof out->prog_pose);
-    memcpy(out->joint_vel, m->joint_vel, sizeof out->joint_vel);
-    for (int i = 0; i < KINS_MAX_JOINTS; i++)   /* (all: a fixed count is vectorised; */
-        out->motor_pos[i] = m->joint_cmd[i] + m->motor_offset[i];  /* unused ones are 0) */
-    memcpy(out->joint_fb, m->joint_fb, sizeof out->joint_fb);
-    memcpy(out->ferror_mm, m->ferror, sizeof out->ferror_mm);
-    out->njoints = m->nj;
-    out->path_vel = m->path_vel;
-    out->time_remaining_s = remaining(m);
-    out->feed_override = m->rate;
-    out->settings_done = m->marks_base + m->marks_done;
-    out->spindle = *sp;
-    out->spindle_index = index_out;
-    out->waiting = m->waiting;
-    out->tool = m->tool;
-    out->outputs = m->jerk ? m->outputs_out : m->outputs;
-    out->probe_input = m->probe_in;
+    report(m, out);
     return ret;
 }
