@@ -98,17 +98,23 @@ static void deviation(const struct check_defer *d, struct check_defer_slot *s)
     s->value2 = ang;
     if (s->tip_mode == CHECK_TIP_NONE)
         return;
-    double tm[3], t0[3], t1[3];
-    tip_at(d, s->tool_len_mm, P, tm);
-    if (s->tip_mode == CHECK_TIP_LINE) {
-        s->tip = motion_dist_seg(tm, s->t0, s->t1);
-    } else if (s->tip_mode == CHECK_TIP_AXIS) {
-        s->tip = dist_line(tm, s->t0, s->t1);
-    } else {
-        tip_at(d, s->tool_len_mm, p0, t0);
-        tip_at(d, s->tool_len_mm, p1, t1);
-        s->tip = motion_dist_seg(tm, t0, t1);
+    double tm[3];
+    if (s->tip_mode == CHECK_TIP_LINE || s->tip_mode == CHECK_TIP_AXIS) {
+        tip_at(d, s->tool_len_mm, P, tm);
+        s->tip = s->tip_mode == CHECK_TIP_LINE ? motion_dist_seg(tm, s->t0, s->t1)
+                                               : dist_line(tm, s->t0, s->t1);
+        return;
     }
+    /* the three tips in one call where it can (the same bits as one by one) */
+    double poses[4][KINS_POSE_DIM], tips[4][3];
+    memcpy(poses[0], P, sizeof poses[0]);
+    memcpy(poses[1], p0, sizeof poses[1]);
+    memcpy(poses[2], p1, sizeof poses[2]);
+    memcpy(poses[3], P, sizeof poses[3]);
+    if (!kins_tcp_tips4(&d->tf, s->tool_len_mm, (const double(*)[KINS_POSE_DIM])poses, tips))
+        for (int i = 0; i < 3; i++)
+            tip_at(d, s->tool_len_mm, poses[i], tips[i]);
+    s->tip = motion_dist_seg(tips[0], tips[1], tips[2]);
 }
 
 /* Computes slot s (a measure; the other kinds need nothing computed). */

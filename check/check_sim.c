@@ -59,6 +59,10 @@ struct sim {
     int tip_fresh;                     /* the move began this period */
     int tip_swing;                     /* the move turns A B C (the tip may leave the line
                                         * the platform follows) and is not under G43.4 */
+    double tip_pose[4][KINS_POSE_DIM]; /* periods whose tip is not measured yet (tips_held), */
+    int tip_pline[4];                  /* their lines and indices: four tips take one call */
+    long tip_pperiod[4];
+    int tip_n;
     double move_tip2;                  /* the square of the tip's largest deviation measured
                                         * in place in the move being followed (the next
                                         * MOVE or FLUSH carries it) */
@@ -284,6 +288,9 @@ static void tip_flush(struct sim *s)
 static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind kind,
                                          const struct motion_out *out);
 
+/* The tips of the periods held measured (defined with tip_period). */
+static void tips_held(struct sim *s);
+
 /* The largest tip deviation measured in place in the move being followed, mm, handed on
  * (the next move starts from nothing). */
 static double move_tip_taken(struct sim *s)
@@ -298,6 +305,7 @@ static double move_tip_taken(struct sim *s)
  * its own MOVE instead (one slot for both). */
 static void tip_end_move(struct sim *s, const struct motion_out *out)
 {
+    tips_held(s);
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_FLUSH, out);
     q->value2 = move_tip_taken(s);
     check_defer_commit(s->dq);
@@ -316,6 +324,7 @@ static void tip_move(struct sim *s, const struct motion_out *out)
     s->tip_fresh = 0;
     if (s->tip_line && !memcmp(s->tip_key, out->seg_from, sizeof s->tip_key))
         return;
+    tips_held(s);                      /* (the move before's, against its line) */
     s->tip_fresh = 1;
     int flush = s->tip_line;
     s->tip_line = 1;
@@ -358,21 +367,49 @@ static void tip_record(struct sim *s, int line, long period, double d)
         s->blk_tip_max = d;
 }
 
-/* Every period of a straight feed that turns A B C without G43.4: the commanded tip against
- * the line between the tip's positions at the move's ends. Measured here, in place: a
+/* The periods held by tip_period measured, in order: the commanded tip against the line
+ * between the tip's positions at the move's ends (all held periods are of the move being
+ * followed), four tips in one call where it can (kins_tcp_tips4: the same bits as one by
+ * one). Before anything reads the largest deviations or the move changes. */
+static void tips_held(struct sim *s)
+{
+    int n = s->tip_n;
+    if (!n)
+        return;
+    double tip[4][3];
+    for (int k = n; k < 4; k++)        /* (lanes without a period: one it can take) */
+        memcpy(s->tip_pose[k], s->tip_pose[0], sizeof s->tip_pose[k]);
+    if (!kins_tcp_tips4(&s->tf, s->tf.length_mm, (const double(*)[KINS_POSE_DIM])s->tip_pose,
+                        tip))
+        for (int k = 0; k < n; k++) {
+            double prog[KINS_POSE_DIM];
+            kins_tcp_from_pose(&s->tf, s->tf.length_mm, s->tip_pose[k], prog);
+            memcpy(tip[k], prog, sizeof tip[k]);
+        }
+    for (int k = 0; k < n; k++) {
+        double e2 = motion_dist2_seg(tip[k], s->tip_t0, s->tip_d, s->tip_n2);
+        if (e2 > s->move_tip2)
+            s->move_tip2 = e2;
+        if (e2 > s->tip_max2)
+            s->tip_max2 = e2, s->tip_max_line = s->tip_pline[k],
+            s->tip_max_period = s->tip_pperiod[k];
+    }
+    s->tip_n = 0;
+}
+
+/* Every period of a straight feed that turns A B C without G43.4 (tip_of's tool, the
+ * kinematics' own: no G43.4 length), held for tips_held. Measured here, in place: a
  * rotation and a distance cost less than a slot of the ring every period. */
 static void tip_period(struct sim *s, const struct motion_out *out)
 {
     tip_move(s, out);
     if (!s->tip_line || !s->tip_swing)
         return;
-    double tip[3];
-    tip_of(s, out, out->pose, tip);
-    double e2 = motion_dist2_seg(tip, s->tip_t0, s->tip_d, s->tip_n2);
-    if (e2 > s->move_tip2)
-        s->move_tip2 = e2;
-    if (e2 > s->tip_max2)
-        s->tip_max2 = e2, s->tip_max_line = out->line, s->tip_max_period = s->r->periods;
+    int k = s->tip_n;
+    memcpy(s->tip_pose[k], out->pose, sizeof s->tip_pose[k]);
+    s->tip_pline[k] = out->line, s->tip_pperiod[k] = s->r->periods;
+    if (++s->tip_n == 4)
+        tips_held(s);
 }
 
 /* The tip's figure: the larger of the two maxima, the earlier on a tie (in a period, the
@@ -689,7 +726,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     legs_batch(&s);
     legs_figures(&s);
     if (s.tip_line)
-        tip_end_move(&s, &out);
+        tip_end_move(&s, &out);        /* (with the tips held) */
     drain(&s);
     tip_figure(&s);
     check_defer_free(own);

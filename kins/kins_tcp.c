@@ -2,7 +2,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/sincos3.h"
+#include "common/sincos4.h"
 #include "kins/kins.h"
 
 #define DEG (M_PI / 180.0)
@@ -123,4 +123,43 @@ void kins_tcp_tool_dir(const struct kins_tool_frame *f, const double abc[3], dou
         mul(r, up, n);
     else
         mul_t(r, up, n);
+}
+
+/* kins_tcp_from_pose's tip for four poses at once (a check's tool tip in every period),
+ * lane by lane rot(), tip_on_tool() and mul() or mul_t() on vectors of four: the same
+ * operations in the same order, so the same bits (sincos4.h). */
+__attribute__((target_clones("avx2", "default")))
+int kins_tcp_tips4(const struct kins_tool_frame *f, double len_mm,
+                   const double (*pose)[KINS_POSE_DIM], double (*tip)[3])
+{
+    v4d x[KINS_POSE_DIM], s[3], c[3];
+    v4l bad = { 0, 0, 0, 0 };
+    for (int i = 0; i < KINS_POSE_DIM; i++)
+        x[i] = (v4d){ pose[0][i], pose[1][i], pose[2][i], pose[3][i] };
+    for (int j = 0; j < 3; j++) {
+        v4d a = x[3 + j] * DEG;
+        SINCOS_LANES(a, s[j], c[j], bad);
+    }
+    if (bad[0] | bad[1] | bad[2] | bad[3])
+        return 0;
+    v4d sa = s[0], ca = c[0], sb = s[1], cb = c[1], sc = s[2], cc = c[2], r[3][3], out[3];
+    r[0][0] = cc * cb, r[0][1] = cc * sb * sa - sc * ca, r[0][2] = cc * sb * ca + sc * sa;
+    r[1][0] = sc * cb, r[1][1] = sc * sb * sa + cc * ca, r[1][2] = sc * sb * ca - cc * sa;
+    r[2][0] = -sb, r[2][1] = cb * sa, r[2][2] = cb * ca;
+    double d[3];
+    tip_on_tool(f, len_mm, d);
+    if (f->on_platform) {
+        for (int i = 0; i < 3; i++)
+            out[i] = x[i] + (r[i][0] * d[0] + r[i][1] * d[1] + r[i][2] * d[2]);
+    } else {
+        v4d v[3];
+        for (int i = 0; i < 3; i++)
+            v[i] = d[i] - x[i];
+        for (int i = 0; i < 3; i++)
+            out[i] = r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2];
+    }
+    for (int l = 0; l < 4; l++)
+        for (int i = 0; i < 3; i++)
+            tip[l][i] = out[i][l];
+    return 1;
 }

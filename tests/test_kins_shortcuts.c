@@ -277,6 +277,49 @@ START_TEST(test_four_at_once)
 }
 END_TEST
 
+/* kins_tcp_tips4 gives each lane the bits kins_tcp_from_pose gives its pose, for a spindle
+ * on the platform and a tool on the frame, with tools of any length; it declines (writing
+ * nothing) exactly when some lane's angle lies beyond +-45 deg or is not a number. */
+START_TEST(test_tips_four_at_once)
+{
+    srand48(12);
+    long done = 0, declined = 0;
+    for (int n = 0; n < 40000; n++) {
+        struct kins_tool_frame f = { .on_platform = n % 2 };
+        double nn = 0;
+        for (int i = 0; i < 3; i++) {
+            f.gauge_mm[i] = (2 * drand48() - 1) * 200;
+            f.axis[i] = 2 * drand48() - 1, nn += f.axis[i] * f.axis[i];
+        }
+        for (int i = 0; i < 3; i++)
+            f.axis[i] /= sqrt(nn);
+        double len = drand48() * 150, pose[4][6], tip[4][3], want[4][6];
+        int beyond = 0;
+        for (int l = 0; l < 4; l++) {
+            int kind = (int)(drand48() * 8);
+            double deg = kind < 5 ? 14.0 : kind < 7 ? 44.9 : 55.0;
+            for (int i = 0; i < 6; i++)
+                pose[l][i] = (2 * drand48() - 1) * (i < 3 ? 120.0 : deg);
+            if (kind == 7 && n % 3 == 0)
+                pose[l][3 + (int)(drand48() * 3)] = n % 2 ? NAN : INFINITY;
+            for (int i = 3; i < 6; i++)
+                beyond |= !(fabs(pose[l][i]) <= 45.0);
+            kins_tcp_from_pose(&f, len, pose[l], want[l]);
+        }
+        memset(tip, 0x5a, sizeof tip);
+        int ok = kins_tcp_tips4(&f, len, (const double(*)[6])pose, tip);
+        ck_assert_int_eq(ok, !beyond);
+        for (int l = 0; l < 4; l++)
+            for (int i = 0; i < 3 && ok; i++)
+                ck_assert_msg(!memcmp(&tip[l][i], &want[l][i], sizeof tip[l][i]),
+                              "tip %d lane %d: %.17g, one at a time %.17g", n, l, tip[l][i],
+                              want[l][i]);
+        done += ok, declined += !ok;
+    }
+    ck_assert(done > 10000 && declined > 10000);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("kins_shortcuts");
@@ -286,6 +329,7 @@ int main(void)
     tcase_add_test(tc, test_jacobian);
     tcase_add_test(tc, test_sincos3);
     tcase_add_test(tc, test_four_at_once);
+    tcase_add_test(tc, test_tips_four_at_once);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
