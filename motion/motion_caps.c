@@ -70,9 +70,8 @@ static bool knot_fill(struct motion *m, const struct motion_seg *sg, double s)
         k++;
     if (k == sg->k0 + sg->nk || sg->tcp)
         return false;
-    double pose[MOTION_AHEAD][KINS_POSE_DIM], dp[MOTION_AHEAD][KINS_POSE_DIM];
-    double d2p[MOTION_AHEAD][KINS_POSE_DIM], L[MOTION_AHEAD][KINS_MAX_JOINTS];
-    double dL[MOTION_AHEAD][KINS_MAX_JOINTS], d2L[MOTION_AHEAD][KINS_MAX_JOINTS];
+    double (*pose)[KINS_POSE_DIM] = a->pose, (*dp)[KINS_POSE_DIM] = a->dp;
+    double (*d2p)[KINS_POSE_DIM] = a->d2p;
     int n = 0;
     while (n < MOTION_AHEAD) {
         const struct motion_seg *g = &p->segs[j];
@@ -94,19 +93,7 @@ static bool knot_fill(struct motion *m, const struct motion_seg *sg, double s)
     }
     kins_inverse_path4(m->kins, (const double(*)[KINS_POSE_DIM])pose,
                        (const double(*)[KINS_POSE_DIM])dp, (const double(*)[KINS_POSE_DIM])d2p,
-                       L, dL, d2L, a->status);
-    for (int l = 0; l < n; l++) {
-        struct motion_sample *o = &a->S[l];
-        o->tcp = 0;
-        o->tool_len_mm = a->sg[l]->tool_len_mm;
-        o->q_state = 0;
-        memcpy(o->pose, pose[l], sizeof o->pose);
-        memcpy(o->dp, dp[l], sizeof o->dp);
-        memcpy(o->d2p, d2p[l], sizeof o->d2p);
-        memcpy(o->L, L[l], sizeof o->L);
-        memcpy(o->dL, dL[l], sizeof o->dL);
-        memcpy(o->d2L, d2L[l], sizeof o->d2L);
-    }
+                       a->L, a->dL, a->d2L, a->status);
     a->n = n, a->next = 0;
     a->fills++;
     return true;
@@ -126,7 +113,15 @@ static int sample_knot(struct motion *m, const struct motion_seg *sg, double s,
     int j = a->next++;
     if (a->status[j] != KINS_OK)       /* (a failure as sample_at has it, written or not) */
         return sample_at(m, sg, s, o);
-    *o = a->S[j];
+    o->tcp = 0;                        /* (what sample_at writes, from the entry's arrays) */
+    o->tool_len_mm = sg->tool_len_mm;
+    o->q_state = 0;
+    memcpy(o->pose, a->pose[j], sizeof o->pose);
+    memcpy(o->dp, a->dp[j], sizeof o->dp);
+    memcpy(o->d2p, a->d2p[j], sizeof o->d2p);
+    memcpy(o->L, a->L[j], sizeof o->L);
+    memcpy(o->dL, a->dL[j], sizeof o->dL);
+    memcpy(o->d2L, a->d2L[j], sizeof o->d2L);
     return KINS_OK;
 }
 

@@ -254,7 +254,10 @@ struct motion_knot_ahead {
     const struct motion_seg *sg[MOTION_AHEAD];
     double s[MOTION_AHEAD];
     int status[MOTION_AHEAD];
-    struct motion_sample S[MOTION_AHEAD];
+    double pose[MOTION_AHEAD][KINS_POSE_DIM], dp[MOTION_AHEAD][KINS_POSE_DIM];
+    double d2p[MOTION_AHEAD][KINS_POSE_DIM];             /* motion_seg_derivs' */
+    double L[MOTION_AHEAD][KINS_MAX_JOINTS], dL[MOTION_AHEAD][KINS_MAX_JOINTS];
+    double d2L[MOTION_AHEAD][KINS_MAX_JOINTS];           /* kins_inverse_path4's */
     long fills, taken;       /* fills, and entries taken after the first of a fill */
 };
 struct motion_ahead {
