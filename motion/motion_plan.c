@@ -272,6 +272,16 @@ static double interval_ds(const struct motion_plan *p, size_t i, const struct mo
 /* Forward and backward passes over the knots: the fastest speeds that every cap and the
  * acceleration allow, starting and ending at rest; a ramp's acceleration is taken at its
  * faster end (ln), at least the interval's iacc (the limit at its hard caps). */
+/* motion_min2(cap, sqrt(w)), without the square root where the cap is certainly the
+ * smaller (cap^2 below w by a margin far beyond rounding: then cap < sqrt(w) exactly). Where
+ * caps bind, each knot of a pass then waits on no square root of the knot before it. */
+static inline double cap_or_root(double cap, double w)
+{
+    if (cap * cap < w * (1 - 1e-12))
+        return cap;
+    return motion_min2(cap, sqrt(w));
+}
+
 static void speed_passes(struct motion_plan *p, const struct acc_line *ln)
 {
     size_t n = p->nknot, j = 0;
@@ -292,14 +302,14 @@ static void speed_passes(struct motion_plan *p, const struct acc_line *ln)
         while (i >= p->segs[j].k0 + p->segs[j].nk) j++;
         double ds = interval_ds(p, i, &p->segs[j]), w = p->kv[i] * p->kv[i];
         w = ds > 0 ? motion_max2(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
-        p->kv[i + 1] = motion_min2(p->kv[i + 1], sqrt(w));
+        p->kv[i + 1] = cap_or_root(p->kv[i + 1], w);
     }
     j = p->nseg - 1;
     for (size_t i = n - 1; i-- > k0;) {
         while (i < p->segs[j].k0) j--;
         double ds = interval_ds(p, i, &p->segs[j]), w = p->kv[i + 1] * p->kv[i + 1];
         w = ds > 0 ? motion_max2(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
-        p->kv[i] = motion_min2(p->kv[i], sqrt(w));
+        p->kv[i] = cap_or_root(p->kv[i], w);
     }
     /* The previous window planned v_enter able to stop within its own tail, which this
      * window holds and extends under the same caps: the backward pass cannot ask for less
