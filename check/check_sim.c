@@ -7,6 +7,7 @@
 #include "check/check_defer.h"
 #include "check/check_priv.h"
 #include "check/plot.h"
+#include "common/simd.h"
 #include "kins/kins_svd.h"
 
 #define LIMIT_SLACK 1e-9     /* relative: a value counts as over its limit beyond this */
@@ -148,7 +149,7 @@ static inline void leg_diffs(double L, double Lp, double vp, double ap, double i
  * finite (the kinematics refuse a pose that is not): with that said to the compiler, the
  * extremes' loop becomes the vector max and min. */
 __attribute__((optimize("finite-math-only", "no-signed-zeros")))
-__attribute__((target_clones("avx2", "default")))   /* (four lanes where there are AVX2) */
+HEXCNC_CLONES                                      /* (four lanes where there are AVX2) */
 static int leg_batch(struct sim *restrict s, int i, int n, double end[3])
 {
     const double *L = s->Lb[i], T = s->inv_T;

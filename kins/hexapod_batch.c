@@ -4,8 +4,9 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "kins/hexapod.h"
+#include "common/simd.h"
 #include "common/sincos4.h"
+#include "kins/hexapod.h"
 #include "kins/hexapod_math.h"
 
 /*
@@ -58,9 +59,9 @@ static inline __attribute__((always_inline)) void leg4(const struct hexapod *h, 
     *len = q;
 }
 
-__attribute__((target_clones("avx2", "default")))
-void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
-                      double (*joints)[KINS_MAX_JOINTS], int *status)
+HEXCNC_AVX2
+static void inverse4_avx2(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                          double (*joints)[KINS_MAX_JOINTS], int *status)
 {
     const struct hexapod *h = (const struct hexapod *)k;
     v4d x[KINS_POSE_DIM];
@@ -104,11 +105,12 @@ void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
 
 /* The planner's samples four at a time: hexapod_inverse_path's operations on vectors, as
  * hexapod_inverse4 does the inverse's (the kins_ops inverse_path4 entry). */
-__attribute__((target_clones("avx2", "default")))
-void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
-                           const double (*dp)[KINS_POSE_DIM], const double (*d2p)[KINS_POSE_DIM],
-                           double (*joints)[KINS_MAX_JOINTS], double (*dL)[KINS_MAX_JOINTS],
-                           double (*d2L)[KINS_MAX_JOINTS], int *status)
+HEXCNC_AVX2
+static void inverse_path4_avx2(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                               const double (*dp)[KINS_POSE_DIM],
+                               const double (*d2p)[KINS_POSE_DIM],
+                               double (*joints)[KINS_MAX_JOINTS], double (*dL)[KINS_MAX_JOINTS],
+                               double (*d2L)[KINS_MAX_JOINTS], int *status)
 {
     const struct hexapod *h = (const struct hexapod *)k;
     v4d x[KINS_POSE_DIM], d1[KINS_POSE_DIM], d2[KINS_POSE_DIM];
@@ -171,4 +173,30 @@ void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
             joints[l][i] = len[i][l], dL[l][i] = l1v[i][l], d2L[l][i] = l2v[i][l];
         status[l] = KINS_OK;
     }
+}
+
+/* The kins_ops entries: the vectors where the processor has AVX2, else four single calls
+ * (common/simd.h). */
+void hexapod_inverse4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                      double (*joints)[KINS_MAX_JOINTS], int *status)
+{
+    if (hexcnc_avx2()) {
+        inverse4_avx2(k, pose, joints, status);
+        return;
+    }
+    for (int l = 0; l < 4; l++)
+        status[l] = k->ops->inverse(k, pose[l], joints[l]);
+}
+
+void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
+                           const double (*dp)[KINS_POSE_DIM], const double (*d2p)[KINS_POSE_DIM],
+                           double (*joints)[KINS_MAX_JOINTS], double (*dL)[KINS_MAX_JOINTS],
+                           double (*d2L)[KINS_MAX_JOINTS], int *status)
+{
+    if (hexcnc_avx2()) {
+        inverse_path4_avx2(k, pose, dp, d2p, joints, dL, d2L, status);
+        return;
+    }
+    for (int l = 0; l < 4; l++)
+        status[l] = k->ops->inverse_path(k, pose[l], dp[l], d2p[l], joints[l], dL[l], d2L[l]);
 }

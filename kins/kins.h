@@ -228,8 +228,8 @@ void kins_tcp_to_pose_vel(const struct kins_tool_frame *f, double len_mm,
 void kins_tcp_from_pose(const struct kins_tool_frame *f, double len_mm,
                         const double pose[KINS_POSE_DIM], double prog[KINS_POSE_DIM]);
 /* The tips (kins_tcp_from_pose's first three values) of four poses at once, the same bits;
- * 1; 0, nothing written, when an angle lies beyond +-45 deg or is not finite (the single
- * call takes those). */
+ * 1; 0, nothing written, when an angle lies beyond +-45 deg or is not finite, or the
+ * processor has no AVX2 (the single call takes those: common/simd.h). */
 int kins_tcp_tips4(const struct kins_tool_frame *f, double len_mm,
                    const double (*pose)[KINS_POSE_DIM], double (*tip)[3]);
 /* The tool's direction from the tip back to the spindle, unit, in the program's frame at

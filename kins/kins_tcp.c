@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "common/simd.h"
 #include "common/sincos4.h"
 #include "kins/kins.h"
 
@@ -128,9 +129,9 @@ void kins_tcp_tool_dir(const struct kins_tool_frame *f, const double abc[3], dou
 /* kins_tcp_from_pose's tip for four poses at once (a check's tool tip in every period),
  * lane by lane rot(), tip_on_tool() and mul() or mul_t() on vectors of four: the same
  * operations in the same order, so the same bits (sincos4.h). */
-__attribute__((target_clones("avx2", "default")))
-int kins_tcp_tips4(const struct kins_tool_frame *f, double len_mm,
-                   const double (*pose)[KINS_POSE_DIM], double (*tip)[3])
+HEXCNC_AVX2
+static int tips4_avx2(const struct kins_tool_frame *f, double len_mm,
+                      const double (*pose)[KINS_POSE_DIM], double (*tip)[3])
 {
     v4d x[KINS_POSE_DIM], s[3], c[3];
     v4l bad = { 0, 0, 0, 0 };
@@ -162,4 +163,10 @@ int kins_tcp_tips4(const struct kins_tool_frame *f, double len_mm,
         for (int i = 0; i < 3; i++)
             tip[l][i] = out[i][l];
     return 1;
+}
+
+int kins_tcp_tips4(const struct kins_tool_frame *f, double len_mm,
+                   const double (*pose)[KINS_POSE_DIM], double (*tip)[3])
+{
+    return hexcnc_avx2() && tips4_avx2(f, len_mm, pose, tip);   /* (common/simd.h) */
 }

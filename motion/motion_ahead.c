@@ -2,6 +2,7 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "common/simd.h"
 #include "common/sincos4.h"
 #include "motion/motion_priv.h"
 
@@ -25,7 +26,7 @@
 /* motion_seg_pose at the four places s[] of segment sg, on vectors: its operations in its
  * order, so the same bits; false (nothing written) when an arc's angle lies beyond the
  * series' range, where motion_seg_pose calls the C library. */
-__attribute__((target_clones("avx2", "default")))
+HEXCNC_AVX2
 static bool seg_pose4(const struct motion_plan *p, const struct motion_seg *sg, const double *s,
                       double (*pose)[KINS_POSE_DIM])
 {
@@ -61,7 +62,7 @@ static bool seg_pose4(const struct motion_plan *p, const struct motion_seg *sg, 
 /* motion_plan_at at the four plan times tau[] of interval ci (position into s[], speed
  * into v[]), on vectors: each lane's phase taken as motion_plan_at takes it, by the same
  * operations in the same order, so the same bits. */
-__attribute__((target_clones("avx2", "default")))
+HEXCNC_AVX2
 static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, double *s,
                      double *v, struct motion_phase_memo *mp)
 {
@@ -119,7 +120,8 @@ static int fill(struct motion *m, double dt)
     if (n == 0)
         return -1;
     double sv[MOTION_AHEAD], vv[MOTION_AHEAD], tv[MOTION_AHEAD];
-    if (n == MOTION_AHEAD && a->at[0].ci == a->at[n - 1].ci) {    /* one interval */
+    bool vec = hexcnc_avx2();          /* (else the scalar functions: common/simd.h) */
+    if (vec && n == MOTION_AHEAD && a->at[0].ci == a->at[n - 1].ci) {    /* one interval */
         for (int j = 0; j < n; j++)
             tv[j] = a->at[j].tau_s;
         plan_at4(p, a->at[0].ci, tv, sv, vv, &m->phases);
@@ -133,7 +135,7 @@ static int fill(struct motion *m, double dt)
             sv[j] = e->s;
         }
     }
-    if (n < MOTION_AHEAD || a->at[0].cs != a->at[n - 1].cs ||
+    if (!vec || n < MOTION_AHEAD || a->at[0].cs != a->at[n - 1].cs ||
         !seg_pose4(p, &p->segs[a->at[0].cs], sv, a->pose))
         for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
             motion_seg_pose(p, &p->segs[a->at[j].cs], a->at[j].s, a->pose[j]);

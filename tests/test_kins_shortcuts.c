@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/simd.h"
 #include "common/sincos3.h"
 #include "kins/hexapod.h"
 #include "kins/kins.h"
@@ -279,7 +280,8 @@ END_TEST
 
 /* kins_tcp_tips4 gives each lane the bits kins_tcp_from_pose gives its pose, for a spindle
  * on the platform and a tool on the frame, with tools of any length; it declines (writing
- * nothing) exactly when some lane's angle lies beyond +-45 deg or is not a number. */
+ * nothing) exactly when some lane's angle lies beyond +-45 deg or is not a number (or the
+ * processor has no AVX2). */
 START_TEST(test_tips_four_at_once)
 {
     srand48(12);
@@ -308,7 +310,7 @@ START_TEST(test_tips_four_at_once)
         }
         memset(tip, 0x5a, sizeof tip);
         int ok = kins_tcp_tips4(&f, len, (const double(*)[6])pose, tip);
-        ck_assert_int_eq(ok, !beyond);
+        ck_assert_int_eq(ok, !beyond && hexcnc_avx2());
         for (int l = 0; l < 4; l++)
             for (int i = 0; i < 3 && ok; i++)
                 ck_assert_msg(!memcmp(&tip[l][i], &want[l][i], sizeof tip[l][i]),
@@ -316,7 +318,8 @@ START_TEST(test_tips_four_at_once)
                               want[l][i]);
         done += ok, declined += !ok;
     }
-    ck_assert(done > 10000 && declined > 10000);
+    /* (without AVX2, or in the baseline build, every call declines: common/simd.h) */
+    ck_assert(hexcnc_avx2() ? done > 10000 && declined > 10000 : done == 0);
 }
 END_TEST
 
