@@ -98,8 +98,8 @@ static void deviation(const struct check_defer *d, struct check_defer_slot *s)
     s->value2 = ang;
     if (s->tip_mode == CHECK_TIP_NONE)
         return;
-    double tm[3];
     if (s->tip_mode == CHECK_TIP_LINE || s->tip_mode == CHECK_TIP_AXIS) {
+        double tm[3];
         tip_at(d, s->tool_len_mm, P, tm);
         s->tip = s->tip_mode == CHECK_TIP_LINE ? motion_dist_seg(tm, s->t0, s->t1)
                                                : dist_line(tm, s->t0, s->t1);

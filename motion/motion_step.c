@@ -380,7 +380,8 @@ static int evaluate(struct motion *m, double dt)
     if (sg != m->seg_at)
         seg_values(m, sg);
     if (j >= 0 && !sg->tcp && m->ahead.status[j] == KINS_OK) {
-        entry_values(m, sg, j);         /* (fill leaves out G43.4 moves: this is a check's) */
+        entry_values(m, sg, j);   /* (the look-ahead fills no G43.4 move; a lane that failed
+                                   * goes the whole way below, its error as it comes) */
         return KINS_OK;
     }
     if (j >= 0) {
@@ -670,13 +671,12 @@ static inline bool calm_period(struct motion *m, double dt, struct motion_out *o
     const struct motion_seg *sg = &p->segs[m->cs];
     double tau = m->tau_s + dt;              /* advance() at the plan's pace */
     /* (the entry was filled at this clock in this interval: follow_knots stays in it) */
-    if ((e->ci != m->ci || e->cs != m->cs || e->tau_s != tau ||
-                         !(tau < p->total_time_s) || sg != m->seg_at || sg->kind > SEG_ARC ||
-                         a->status[a->next] != KINS_OK || m->rate != 1 ||
-                         m->override_cmd != 1 || m->rapid_cmd != 1 || m->waiting || m->jerk ||
-                         !m->no_rates || m->probe_wired || m->probe_seg ||
-                         m->probe_halt == PROBE_HALTING || m->probe_halt == PROBE_PARKED ||
-                         m->step_until_seg || !m->loaded || (m->streaming && !m->chunk)))
+    if (e->ci != m->ci || e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
+        sg != m->seg_at || sg->kind > SEG_ARC || a->status[a->next] != KINS_OK ||
+        m->rate != 1 || m->override_cmd != 1 || m->rapid_cmd != 1 || m->waiting || m->jerk ||
+        !m->no_rates || m->probe_wired || m->probe_seg || m->probe_halt == PROBE_HALTING ||
+        m->probe_halt == PROBE_PARKED || m->step_until_seg || !m->loaded ||
+        (m->streaming && !m->chunk))
         return false;
     m->io_age++;
     pass_ios(m);
