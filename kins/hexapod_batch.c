@@ -11,22 +11,23 @@
 
 /*
  * A caller with several poses ahead (a check's executor, motion_ahead.c; the planner's
- * knots, motion_caps.c) gives four at a time: each number below is a vector of the four poses' values, and each operation is
- * the scalar one of hexapod_inverse (hexapod_pose_frame, sincos3, hexapod_rot_from_sc,
- * hexapod_legs_eval, hexapod_ws_plain), in the same order: C rounds every operation to double
- * and contracts none (ISO C, -ffp-contract=off), in a vector lane as in a register of its
- * own, so each lane's lengths are the scalar function's to the bit. test_kins_shortcuts
- * holds them to that. What the common case does not cover goes to hexapod_inverse itself,
- * lane by lane: a pose that is not a number or turns beyond the series' range (pi/4), a leg
- * out of range, a workspace limit beyond the assembly's, a platform not above its base
- * joints. On a processor with AVX2 the vectors are one register each (the function is
- * built twice, and the loader picks); elsewhere two SSE2 halves.
+ * knots, motion_caps.c) gives four at a time: each number below is a vector of the four
+ * poses' values, and each operation is the scalar one of hexapod_inverse
+ * (hexapod_pose_frame, sincos3, hexapod_rot_from_sc, hexapod_legs_eval, hexapod_ws_plain),
+ * in the same order: C rounds every operation to double and contracts none (ISO C,
+ * -ffp-contract=off), in a vector lane as in a register of its own, so each lane's lengths
+ * are the scalar function's to the bit. test_kins_shortcuts holds them to that. What the
+ * common case does not cover goes to hexapod_inverse itself, lane by lane: a pose that is
+ * not a number or turns beyond the series' range (pi/4), a leg out of range, a workspace
+ * limit beyond the assembly's, a platform not above its base joints. The vectors are built
+ * for AVX2 alone, one register each; a processor without it takes four single calls
+ * (common/simd.h).
  */
 
 /* The platform's rotation at four poses x[] (hexapod_pose_frame's angles, sincos3's series,
  * hexapod_rot_from_sc's products), and the sine and cosine of C; lanes beyond the series'
- * range (pi/4) or not a number into *bad. (Pointers, not vectors by value: the functions
- * are inlined into both builds of their callers.) */
+ * range (pi/4) or not a number into *bad. (Pointers, not vectors by value, and inlined
+ * always: into the AVX2 functions that call them.) */
 static inline __attribute__((always_inline)) void rot4(const v4d *x, v4d (*r)[3], v4d *sc_out,
                                                        v4d *cc_out, v4l *bad)
 {

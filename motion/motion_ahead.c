@@ -14,7 +14,8 @@
  * kins_inverse4 call: the inverse kinematics of four poses at once take under half the time
  * of four single ones (bench_kins). Four periods in one interval of the plan take their
  * positions as vectors (plan_at4), four on one segment their poses (seg_pose4), lane by lane
- * the scalar functions' operations. Each entry is keyed by what it is a function of, the
+ * the scalar functions' operations, where the processor has AVX2 (common/simd.h; else the
+ * scalar functions, the same bits). Each entry is keyed by what it is a function of, the
  * plan run, its interval and segment, and the plan clock; a period whose state has that key
  * takes the entry, any other (an override, a pause, a chunk switched, a stop) computes its
  * own and four more. Position, pose and legs are pure functions of the key, so an entry is

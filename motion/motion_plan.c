@@ -269,9 +269,6 @@ static double interval_ds(const struct motion_plan *p, size_t i, const struct mo
     return i + 1 < sg->k0 + sg->nk && i >= sg->k0 ? p->ks[i + 1] - p->ks[i] : 0;
 }
 
-/* Forward and backward passes over the knots: the fastest speeds that every cap and the
- * acceleration allow, starting and ending at rest; a ramp's acceleration is taken at its
- * faster end (ln), at least the interval's iacc (the limit at its hard caps). */
 /* motion_min2(cap, sqrt(w)), without the square root where the cap is certainly the
  * smaller (cap^2 below w by a margin far beyond rounding: then cap < sqrt(w) exactly). Where
  * caps bind, each knot of a pass then waits on no square root of the knot before it. */
@@ -282,6 +279,9 @@ static inline double cap_or_root(double cap, double w)
     return motion_min2(cap, sqrt(w));
 }
 
+/* Forward and backward passes over the knots: the fastest speeds that every cap and the
+ * acceleration allow, starting and ending at rest; a ramp's acceleration is taken at its
+ * faster end (ln), at least the interval's iacc (the limit at its hard caps). */
 static void speed_passes(struct motion_plan *p, const struct acc_line *ln)
 {
     size_t n = p->nknot, j = 0;
