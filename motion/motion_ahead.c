@@ -158,11 +158,7 @@ int motion_ahead(struct motion *m, double dt)
             return a->next++;
         }
     }
-    /* the next periods are foreseen at the plan's own pace only (anywhere else the clock
-     * follows the override's ramp, and four periods' work would be done for one) */
-    if (m->state != MOTION_RUNNING || m->rate != 1 || m->override_cmd != 1 ||
-        m->rapid_cmd != 1 || m->waiting || m->probe_halt == PROBE_HALTING ||
-        m->probe_halt == PROBE_PARKED) {
+    if (!motion_at_plan_pace(m)) {      /* (else four periods' work would be done for one) */
         a->n = a->next = 0;
         return -1;
     }

@@ -229,13 +229,6 @@ static void across_path(const struct motion_seg *sg, const struct motion_sample 
     *ang_deg = ang;
 }
 
-/* The set-point period: drives move their legs linearly over it (with jerk limits, the
- * chord that cuts a curve as much as the chords and the moving average together). */
-static double setpoint_period(const struct motion *m)
-{
-    return m->chord_period_s;          /* motion_chord_period(&m->cfg) */
-}
-
 /* The kinematic-error speed cap at a sample (the paper's interpolator). Drives move legs
  * linearly between set points T apart, so over a chord of path length d the legs sit off the
  * leg-space curve by d2L d^2 / 8 at mid-chord; through the inverse Jacobian that is a pose
@@ -256,7 +249,7 @@ static double kin_tol_cap(struct motion *m, const struct motion_seg *sg,
         dmax = sqrt(8 * motion_round_tol_mm(m, sg) / perp);
     if (ang > 1e-30 && c->kin_tol_deg > 0)
         dmax = motion_min2(dmax, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / ang));
-    return dmax / setpoint_period(m);
+    return dmax / m->chord_period_s;
 }
 
 /* See motion_priv.h. A set-point chord of length d that touches an arc spans a C1 path whose
@@ -297,7 +290,7 @@ double motion_chord_cap(struct motion *m, const struct motion_seg *sg,
     }
     if (c->kin_tol_deg > 0 && kabc + ang > 1e-30)
         d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / (kabc + ang)));
-    return d / setpoint_period(m);
+    return d / m->chord_period_s;
 }
 
 /* Reports a leg out of range at a sample, naming file, line, leg, amount and pose. */

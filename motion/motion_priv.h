@@ -274,8 +274,11 @@ struct motion_ahead {
 /* The motion instance. */
 struct motion {
     struct motion_config cfg;
-    double jerk_window_s;    /* motion_jerk_window_s(&cfg) and motion_chord_period(&cfg), */
-    double chord_period_s;   /* taken once (every knot's caps use them) */
+    double jerk_window_s;    /* motion_jerk_window_s(&cfg), taken once */
+    double chord_period_s;   /* motion_chord_period(&cfg), taken once (every knot's caps use
+                              * it): the set-point period, over which drives move their legs
+                              * linearly (with jerk limits, the chord that cuts a curve as
+                              * much as the chords and the moving average together) */
     struct kins *kins;       /* borrowed */
     struct kins_tool_frame tf; /* the machine's tool, for tool centre point control */
     int have_tf;             /* the kinematics has a tool frame */
@@ -488,6 +491,15 @@ static inline void motion_probe_settle(struct motion *m)
  * period and the next ones where it has none; -1 where it leaves the period to evaluate()
  * (a synchronised move, G43.4, off the plan's own pace). */
 int motion_ahead(struct motion *m, double dt);
+/* Whether the executor runs at the plan's own pace, where the look-ahead foresees the next
+ * periods (anywhere else the clock follows the override's ramp): running, at rate 1 with
+ * both overrides at 1, no wait for the spindle, no probe's trip bringing it to rest. */
+static inline bool motion_at_plan_pace(const struct motion *m)
+{
+    return m->state == MOTION_RUNNING && m->rate == 1 && m->override_cmd == 1 &&
+           m->rapid_cmd == 1 && !m->waiting && m->probe_halt != PROBE_HALTING &&
+           m->probe_halt != PROBE_PARKED;
+}
 
 /* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
 #define MOTION_JERK_MAX_S 1.0

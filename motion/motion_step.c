@@ -665,17 +665,15 @@ static inline bool calm_period(struct motion *m, double dt, struct motion_out *o
 {
     struct motion_ahead *a = &m->ahead;
     const struct motion_plan *p = m->run;
-    if (!m->brief || a->next >= a->n || a->run != p || m->state != MOTION_RUNNING)
+    if (!m->brief || a->next >= a->n || a->run != p || !motion_at_plan_pace(m))
         return false;
     const struct motion_ahead_at *e = &a->at[a->next];
     const struct motion_seg *sg = &p->segs[m->cs];
     double tau = m->tau_s + dt;              /* advance() at the plan's pace */
     /* (the entry was filled at this clock in this interval: follow_knots stays in it) */
     if (e->ci != m->ci || e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
-        sg != m->seg_at || sg->kind > SEG_ARC || a->status[a->next] != KINS_OK ||
-        m->rate != 1 || m->override_cmd != 1 || m->rapid_cmd != 1 || m->waiting || m->jerk ||
-        !m->no_rates || m->probe_wired || m->probe_seg || m->probe_halt == PROBE_HALTING ||
-        m->probe_halt == PROBE_PARKED || m->step_until_seg || !m->loaded ||
+        sg != m->seg_at || sg->kind > SEG_ARC || a->status[a->next] != KINS_OK || m->jerk ||
+        !m->no_rates || m->probe_wired || m->probe_seg || m->step_until_seg || !m->loaded ||
         (m->streaming && !m->chunk))
         return false;
     m->io_age++;
