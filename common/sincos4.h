@@ -1,8 +1,8 @@
 /* sincos4.h: sincos3.h's series on vectors of four doubles, lane by lane the same bits.
  *
- * Code that has four poses or four path places at once (hexapod_batch.c, motion_ahead.c)
- * computes them as vectors of four (GCC's vector extension: one AVX2 register, or two SSE2
- * ones). Each operation is the scalar one of sincos3.h in the same order, and C contracts
+ * Code that has four poses or four path places at once (hexapod_batch.c, motion_ahead.c,
+ * kins_tcp.c) computes them as vectors of four (GCC's vector extension: one AVX2 register;
+ * that code is built for AVX2 alone, common/simd.h). Each operation is the scalar one of sincos3.h in the same order, and C contracts
  * none (ISO C: -ffp-contract=off), so every lane holds the bits sincos1 gives for it.
  */
 #ifndef HEXCNC_SINCOS4_H
