@@ -539,20 +539,28 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
  * changes direction within one servo period there, so its jump may use JUMP_SHARE of one
  * period's acceleration on every axis (a quarter on every leg) while the moves on either
  * side give up that share of their path acceleration (all_caps); and the corner cut by the
- * set-point chord stays within the blend tolerance. 0 when the moves must stop between. */
+ * set-point chord (and the moving average of jerk limiting) stays within the blend
+ * tolerance, with jerk limits within the blend arcs' share of it (motion_blend.c): the
+ * average's rounding of the curves next to the joint has the rest. acc: the largest path
+ * acceleration the moves may have next to the joint. 0 when the moves must stop between. */
 double motion_junction_speed(struct motion *m, const struct motion_seg *a,
                              const struct motion_seg *b, const struct motion_sample *Ap,
-                             const struct motion_sample *Bp)
+                             const struct motion_sample *Bp, double acc)
 {
     const struct motion_config *c = &m->cfg;
     if (a->blend_tol_mm <= 0 || a->rotary != b->rotary || a->kind > SEG_ARC || b->kind > SEG_ARC)
         return 0;
     const struct motion_sample *A = Ap, *B = Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
-    double dx = 0, da = 0, v = HUGE_VAL;
+    double dx = 0, da = 0, v = HUGE_VAL, Tj = m->jerk_window_s;
+    double tol = a->blend_tol_mm * (Tj > 0 ? 1 - JERK_ROUND_SHARE : 1);
     /* a jump of the direction by dx at speed v: a set-point chord across it cuts the corner
-     * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8 */
-    Ts += m->jerk_window_s / 2;
+     * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8, and by
+     * acc Tj^2 dx / 48 more while the path slows into the corner and speeds up out of it
+     * (the mean of the distances from the corner over the window, v Tj / 4 + acc Tj^2 / 24,
+     * times dx / 2) */
+    double room = tol - acc * Tj * Tj * dx / 48;
+    Ts += Tj / 2;
     for (int i = 0; i < 3; i++)
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);
@@ -560,7 +568,7 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
         da = motion_max2(da, fabs(B->dp[i] - A->dp[i]));
     if (dx > 1e-12) {
         v = motion_min2(v, JUMP_SHARE * c->max_lin_acc_mm_s2 * T / dx);
-        v = motion_min2(v, 4 * a->blend_tol_mm / (Ts * dx));
+        v = room > 0 ? motion_min2(v, 4 * room / (Ts * dx)) : 0;
     }
     if (da > 1e-12)
         v = motion_min2(v, JUMP_SHARE * c->max_ang_acc_deg_s2 * T / da);

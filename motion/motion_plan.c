@@ -184,8 +184,10 @@ static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
             p->kv[k] = c, p->kt[k] = h;
         }
         apply_chord_caps(p, sg, zcap);
-        double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, prev_end, first) : 0;
         size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
+        double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, prev_end, first,
+                                                   motion_max2(p->iacc[pk], p->iacc[sg->k0]))
+                           : 0;
         /* a joint passed no faster than full acceleration reaches in STOP_EQUIV_PERIODS
          * servo periods (a sharp corner) is a stop in all but name, while the jump would
          * take a share of the moves' acceleration on both sides: stop there instead */

@@ -690,10 +690,11 @@ int motion_chord_zones(struct motion *m);
 double motion_arc_curvature(const struct motion_plan *p, const struct motion_seg *sg,
                             double *kabc);
 /* Speed allowed through the joint between segments a and b (0: stop there); A and B are
- * the samples at the end of a and the start of b. */
+ * the samples at the end of a and the start of b, acc the largest path acceleration next
+ * to the joint. */
 double motion_junction_speed(struct motion *m, const struct motion_seg *a,
                              const struct motion_seg *b, const struct motion_sample *A,
-                             const struct motion_sample *B);
+                             const struct motion_sample *B, double acc);
 /* Share of one period's acceleration (<= JUMP_SHARE) the velocity jump at a joint passed at
  * speed v uses; the moves on either side give it up. */
 double motion_junction_share(const struct motion *m, const struct motion_sample *A,
