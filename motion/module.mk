@@ -7,7 +7,8 @@ LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/m
 TESTS += test_motion test_motion_run test_motion_legs test_motion_override test_motion_hal \
          test_motion_blend \
          test_motion_stop test_motion_manual test_motion_spindle test_motion_stream test_motion_merge \
-         test_motion_small_arcs test_motion_probe test_motion_jerk test_motion_sync
+         test_motion_small_arcs test_motion_probe test_motion_jerk test_motion_sync \
+         test_motion_random
 # The HAL component `motion` (loadrt motion) and the runner's entry points (motion_hal.h).
 LIB_SRCS += hal/components/motion.c
 HAL_COMPS += motion
