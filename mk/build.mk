@@ -42,7 +42,7 @@ SANFLAGS :=
 ifeq ($(SAN),1)
 SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 OPT     := -O1
-# the four-lane functions' baseline build alone (common/clones.h): the ordinary tests run
+# the four-lane functions' baseline build alone (common/simd.h): the ordinary tests run
 # their AVX2 clones on a processor that has AVX2, these the code one without it runs
 BASELINE := -DHEXCNC_BASELINE
 endif
