@@ -301,9 +301,11 @@ END_TEST
  * the other half, and its cut grows while the path slows into the corner and speeds up out
  * of it (motion_junction_speed); the tool stays near P of the programmed path, every limit
  * kept. Found by test_motion_random: the jump took all of P on top of the rounding (under
- * P0.002 the tool strayed 2.26 um here). With P0.002 it now strays 2.11 um: the rounding's
- * first-order estimate uses all of its half of P with nothing in hand for the terms it
- * leaves out (docs/motion.md, "Jerk limiting"), so that case is held to 1.1 P. */
+ * P0.002 the tool strayed 2.26 um here). With P0.002 it now strays 2.11 um, on an arc
+ * speeding up out of the stop at a 50 degree joint: the rounding's estimate takes the speed
+ * as constant under the window and leaves out the path's acceleration a (a cut of
+ * q a^2 T^4 / 1440 more), and under P it has nothing in hand for that (docs/motion.md,
+ * "Jerk limiting"), so that case is held to 1.1 P. */
 START_TEST(test_arc_line_corners)
 {
     static const double tols[] = { 0.002, 0.01 };
@@ -336,7 +338,7 @@ START_TEST(test_arc_line_corners)
                   "path", wj.dev_mm);
     ck_assert_msg(wt.dev_mm <= tols[_i], "without jerk limits %.5f mm", wt.dev_mm);
     printf("arcs kinked into lines, G64 P%.3f: jerk-limited %.3f s (peak leg jerk %.3f of the "
-           "limit, %.4f mm from the path) against trapezoidal %.3f s (%.4f mm): %.3f x the "
+           "limit, %.5f mm from the path) against trapezoidal %.3f s (%.4f mm): %.3f x the "
            "time\n", tols[_i], sj.t_s, r, wj.dev_mm, st.t_s, wt.dev_mm, sj.t_s / st.t_s);
     canon_prog_free(&p);
 }
