@@ -559,11 +559,11 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
      * acc Tj^2 dx / 48 more while the path slows into the corner and speeds up out of it
      * (the mean of the distances from the corner over the window, v Tj / 4 + acc Tj^2 / 24,
      * times dx / 2) */
-    double room = tol - acc * Tj * Tj * dx / 48;
     Ts += Tj / 2;
     for (int i = 0; i < 3; i++)
         dx += (B->dp[i] - A->dp[i]) * (B->dp[i] - A->dp[i]);
     dx = sqrt(dx);
+    double room = tol - acc * Tj * Tj * dx / 48;
     for (int i = 3; i < 6; i++)
         da = motion_max2(da, fabs(B->dp[i] - A->dp[i]));
     if (dx > 1e-12) {

@@ -299,13 +299,9 @@ END_TEST
 /* Arcs joined to lines at a kink (G64 passes such a joint with a velocity jump, no blend
  * arc): the jump's cut takes the blend arcs' half of P, the average's rounding of the arcs
  * the other half, and its cut grows while the path slows into the corner and speeds up out
- * of it (motion_junction_speed); the tool stays near P of the programmed path, every limit
- * kept. Found by test_motion_random: the jump took all of P on top of the rounding (under
- * P0.002 the tool strayed 2.26 um here). With P0.002 it now strays 2.11 um, on an arc
- * speeding up out of the stop at a 50 degree joint: the rounding's estimate takes the speed
- * as constant under the window and leaves out the path's acceleration a (a cut of
- * q a^2 T^4 / 1440 more), and under P it has nothing in hand for that (docs/motion.md,
- * "Jerk limiting"), so that case is held to 1.1 P. */
+ * of it (motion_junction_speed); the tool stays within P of the programmed path, every
+ * limit kept. Found by test_motion_random: the jump took all of P on top of the rounding,
+ * at constant speed, and under P0.002 the tool strayed 2.26 um here. */
 START_TEST(test_arc_line_corners)
 {
     static const double tols[] = { 0.002, 0.01 };
@@ -334,8 +330,7 @@ START_TEST(test_arc_line_corners)
     struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
     ck_assert_int_eq(sj.last.state, MOTION_DONE);
     double r = assert_limits(&sj, "arcs and lines");
-    ck_assert_msg(wj.dev_mm <= (_i ? 1 : 1.1) * tols[_i], "the tool strays %.5f mm from the "
-                  "path", wj.dev_mm);
+    ck_assert_msg(wj.dev_mm <= tols[_i], "the tool strays %.5f mm from the path", wj.dev_mm);
     ck_assert_msg(wt.dev_mm <= tols[_i], "without jerk limits %.5f mm", wt.dev_mm);
     printf("arcs kinked into lines, G64 P%.3f: jerk-limited %.3f s (peak leg jerk %.3f of the "
            "limit, %.5f mm from the path) against trapezoidal %.3f s (%.4f mm): %.3f x the "
