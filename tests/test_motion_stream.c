@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tests/test_motion_dense.h"
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
@@ -327,6 +328,76 @@ START_TEST(stream_sync_on_input_wait)
 }
 END_TEST
 
+/* The streamed run of a random dense program (test_motion_dense.h): where it is and how
+ * far from the programmed moves it strays. */
+struct dense_watch {
+    struct feed f;
+    const struct dense *d;
+    double off_mm;
+};
+
+static int dense_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    (void)m, (void)step;
+    struct dense_watch *w = ctx;
+    feed_some(&w->f);
+    w->off_mm = fmax(w->off_mm, off_path(w->d, o->pose, o->line, 400));
+    return 0;
+}
+
+/* Random dense programs of 5000 to 6000 moves, streamed across windows (merged runs, blends
+ * and the knots' look-ahead meet the windows' ends wherever they fall) and planned whole:
+ * the streamed run ends where the whole one does, in its time within 0.2 %, on its path
+ * (within Q plus P, with jerk limits max(P, P/2 + KINEMATIC_TOLERANCE)), every leg within
+ * its limits as in stream_matches_whole_plan. Loop 0 trapezoidal, 1 with jerk limits. */
+START_TEST(stream_random_dense)
+{
+    unsigned long long seed = 0x7f4a7c159e3779b9ULL * (unsigned long long)(_i + 1);
+    int jerk = _i % 2;
+    struct dense d;
+    dense_prog(&d, &seed, 5000, 6000);
+    struct tm_machine whole, st;
+    ck_assert_int_eq(tm_open(&whole, stream_cfg(jerk), &kins_hexapod_ops), 0);
+    ck_assert_int_eq(tm_open(&st, stream_cfg(jerk), &kins_hexapod_ops), 0);
+    char err[400];
+    ck_assert_msg(motion_load(whole.m, &d.p, err, sizeof err) == MOTION_OK, "%s", err);
+    ck_assert_int_eq(motion_start(whole.m), MOTION_OK);
+    struct tm_stats sw, ss;
+    tm_run(whole.m, DT, 4000000, &sw, NULL, NULL);
+    ck_assert_int_eq(sw.last.state, MOTION_DONE);
+    struct dense_watch w = { .d = &d };
+    struct motion_stream *s = stream_open(&st, &d.p, &w.f, 2);
+    tm_run(st.m, DT, 4000000, &ss, dense_hook, &w);
+    ck_assert_msg(ss.last.state == MOTION_DONE, "state %d: %s", ss.last.state,
+                  motion_last_error(st.m));
+    struct motion_stream_info si;
+    motion_stream_info(s, &si);
+    const struct motion_config *mc = &st.mc;
+    double allowed = d.tol_q + (jerk ? fmax(d.tol_p, 0.5 * d.tol_p + mc->kin_tol_mm)
+                                     : d.tol_p) + 1e-6;
+    printf("random dense, %d moves, %s P%g Q%g%s: %zu windows, run %.3f s (whole %.3f s), "
+           "%.5f mm off the path\n", d.n, d.g61 ? "G61" : "G64", d.tol_p, d.tol_q,
+           jerk ? ", jerk limits" : "", si.windows, ss.t_s, sw.t_s, w.off_mm);
+    ck_assert_uint_gt(si.windows, 1);
+    ck_assert_double_lt(fabs(ss.t_s - sw.t_s), 0.002 * sw.t_s);
+    ck_assert_double_le(w.off_mm, allowed);
+    for (int j = 0; j < 6; j++) {
+        ck_assert_double_le(ss.max_leg_v[j], mc->joint[j].max_vel_mm_s * (1 + 1e-9));
+        ck_assert_double_le(ss.max_leg_a[j],
+                            fmax(mc->joint[j].max_acc_mm_s2, sw.max_leg_a[j]) * 1.01);
+        if (jerk)
+            ck_assert_double_le(ss.max_leg_j[j], LEG_JERK * (1 + 1e-9));
+        ck_assert_double_lt(fabs(ss.last.pose[j] - d.end[j]), 1e-9);
+        ck_assert_double_lt(fabs(sw.last.pose[j] - d.end[j]), 1e-9);
+    }
+    motion_stream_detach(st.m);
+    motion_stream_destroy(s);
+    dense_free(&d);
+    tm_close(&whole);
+    tm_close(&st);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("motion_stream");
@@ -337,6 +408,7 @@ int main(void)
     tcase_add_loop_test(tc, stream_pause_resume_abort, 0, 2);
     tcase_add_loop_test(tc, stream_check_reports_line, 0, 2);
     tcase_add_loop_test(tc, stream_sync_on_input_wait, 0, 2);
+    tcase_add_loop_test(tc, stream_random_dense, 0, 2);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
