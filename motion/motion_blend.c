@@ -93,7 +93,7 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
                  struct blend_rec *rec)
 {
     double at[6], tol = motion_blend_start(cfg, in);
-    double arc_share = motion_jerk_window_s(cfg) > 0 ? 1 - JERK_ROUND_SHARE : 1;
+    double arc_share = motion_blend_share(motion_jerk_window_s(cfg));
     double at_len = in->start_tcp ? in->start_tool_len_mm : 0;
     int at_tcp = in->start_tcp;
     memcpy(at, in->start, sizeof at);

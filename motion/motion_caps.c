@@ -553,7 +553,7 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     const struct motion_sample *A = Ap, *B = Bp;
     double T = c->servo_period_s, Ts = c->setpoint_period_s > 0 ? c->setpoint_period_s : T;
     double dx = 0, da = 0, v = HUGE_VAL, Tj = m->jerk_window_s;
-    double tol = a->blend_tol_mm * (Tj > 0 ? 1 - JERK_ROUND_SHARE : 1);
+    double tol = a->blend_tol_mm * motion_blend_share(Tj);
     /* a jump of the direction by dx at speed v: a set-point chord across it cuts the corner
      * by up to v Ts dx / 4, the moving average of jerk limiting by v Tj dx / 8, and by
      * acc Tj^2 dx / 48 more while the path slows into the corner and speeds up out of it

@@ -634,6 +634,14 @@ int motion_plan_profile(struct motion *m, char *err, size_t errlen);
  * rounding together stay within P of the programmed path). */
 #define JERK_ROUND_SHARE 0.5
 
+/* The share of a G64 P a blend arc may cut a corner by, and a joint passed with a velocity
+ * jump: all of it, with jerk limits (a moving average of jerk_window_s > 0) what the
+ * rounding leaves. */
+static inline double motion_blend_share(double jerk_window_s)
+{
+    return jerk_window_s > 0 ? 1 - JERK_ROUND_SHARE : 1;
+}
+
 /* The part of segment sg's G64 P that jerk limiting's rounding may use, mm (0 without jerk
  * limits or under G61): the one place of that rule. */
 static inline double motion_jerk_round_mm(const struct motion *m, const struct motion_seg *sg)

@@ -160,6 +160,16 @@ static inline void dense_free(struct dense *d)
     free(d->cmd);
 }
 
+/* How far the commanded tool may be from d's programmed moves, mm: under G64 the blends
+ * within P, with jerk limits within half of it and the average's rounding the other half or
+ * its share of KINEMATIC_TOLERANCE (docs/motion.md, "Jerk limiting"); the merge's Q on top. */
+static inline double dense_allowed(const struct dense *d, const struct motion_config *mc,
+                                   int jerk)
+{
+    return d->tol_q + (jerk ? fmax(d->tol_p, 0.5 * d->tol_p + mc->kin_tol_mm) : d->tol_p) +
+           1e-6;
+}
+
 /* Distance of the commanded X Y Z q from the programmed moves within `reach` moves of the
  * one on `line`, and the MOTION_MERGE_MAX before those (a merged run of feeds carries its
  * last feed's line). */

@@ -39,6 +39,7 @@
 #define DT 0.001
 #define CASES 48
 #define SANITIZED_CASES 12
+
 /* The operator of every third case: the feed override moved at random, a pause now and
  * then and a resume later, given to both machines alike. */
 struct operator { unsigned long long seed; long next, resume_at; int on, pauses; };
@@ -120,14 +121,12 @@ static int run_case(int k, struct worst *wr)
     motion_plan_info(a.m, &info);
     const struct motion_config *mc = &a.mc;
     int jerk = mc->max_lin_jerk_mm_s3 > 0;
-    /* G64 P: blends within P; with jerk limits half of it, and the average's rounding the
-     * other half or its share of KINEMATIC_TOLERANCE; the merge's Q on top. Where half of P
-     * is below that share (P 0.001 on the TMU machine) the blend arcs of sharp corners are so
-     * small that the average's window reaches past them and the rounding's bound does not
-     * hold (docs/motion.md, "Jerk limiting"): 400 cases took the tool up to 1.34 times as
-     * far; there the test holds it to 1.5 times, so that it grows no worse unseen. */
-    double allowed = d.tol_q + (jerk ? fmax(d.tol_p, 0.5 * d.tol_p + mc->kin_tol_mm)
-                                     : d.tol_p) + 1e-6;
+    /* Where half of P is below the rounding's share of KINEMATIC_TOLERANCE (P 0.001 on the
+     * TMU machine) the blend arcs of sharp corners are so small that the average's window
+     * reaches past them and the rounding's bound does not hold (docs/motion.md, "Jerk
+     * limiting"): 400 cases took the tool up to 1.34 times as far; there the test holds it
+     * to 1.5 times, so that it grows no worse unseen. */
+    double allowed = dense_allowed(&d, mc, jerk);
     int small_p = jerk && !d.g61 && 0.5 * d.tol_p < KIN_TOL_SHARE * mc->kin_tol_mm;
     double held = small_p ? 1.5 * allowed : allowed;
     double v0[6] = { 0 }, a0[6] = { 0 }, worst_path = 0;

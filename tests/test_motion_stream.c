@@ -348,7 +348,7 @@ static int dense_hook(struct motion *m, const struct motion_out *o, int step, vo
 /* Random dense programs of 5000 to 6000 moves, streamed across windows (merged runs, blends
  * and the knots' look-ahead meet the windows' ends wherever they fall) and planned whole:
  * the streamed run ends where the whole one does, in its time within 0.2 %, on its path
- * (within Q plus P, with jerk limits max(P, P/2 + KINEMATIC_TOLERANCE)), every leg within
+ * (dense_allowed), every leg within
  * its limits as in stream_matches_whole_plan. Loop 0 trapezoidal, 1 with jerk limits. */
 START_TEST(stream_random_dense)
 {
@@ -373,8 +373,7 @@ START_TEST(stream_random_dense)
     struct motion_stream_info si;
     motion_stream_info(s, &si);
     const struct motion_config *mc = &st.mc;
-    double allowed = d.tol_q + (jerk ? fmax(d.tol_p, 0.5 * d.tol_p + mc->kin_tol_mm)
-                                     : d.tol_p) + 1e-6;
+    double allowed = dense_allowed(&d, mc, jerk);
     printf("random dense, %d moves, %s P%g Q%g%s: %zu windows, run %.3f s (whole %.3f s), "
            "%.5f mm off the path\n", d.n, d.g61 ? "G61" : "G64", d.tol_p, d.tol_q,
            jerk ? ", jerk limits" : "", si.windows, ss.t_s, sw.t_s, w.off_mm);
