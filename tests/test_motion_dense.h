@@ -15,13 +15,6 @@
 
 #define FIRST_LINE 3           /* the first move's line (the path mode is on line 2) */
 
-/* A small deterministic generator (the C library's rand differs between systems). */
-static inline double tm_uniform(unsigned long long *s)
-{
-    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(*s >> 11) / 9007199254740992.0;
-}
-
 /* What a case's program is: its path mode and the moves' start points (move i on line
  * FIRST_LINE + i is command cmd[i] of the program). */
 struct dense {

@@ -36,13 +36,6 @@ static struct tk_cfg *machine_cfg(int jerk)
     return c;
 }
 
-/* A small deterministic generator (the C library's rand differs between systems). */
-static double uniform(unsigned long long *s)
-{
-    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(*s >> 11) / 9007199254740992.0;
-}
-
 /* A random program of n moves from the workspace's middle: mostly straight five-axis feeds,
  * some XY arcs. Its end into end. */
 static void random_prog(struct canon_prog *p, unsigned long long *s, double end[6])
@@ -51,16 +44,16 @@ static void random_prog(struct canon_prog *p, unsigned long long *s, double end[
     canon_prog_init(p);
     double at[6] = { 0, 0, 645, 0, 0, 0 };
     memcpy(p->start, at, sizeof at);
-    int mode = (int)(uniform(s) * 4);
+    int mode = (int)(tm_uniform(s) * 4);
     p->start_path_mode = mode == 0 ? 610 : 640;
     p->start_path_tol_mm = mode == 0 ? 0 : tols[mode - 1];
-    int n = 3 + (int)(uniform(s) * 6);
-    double feed = 600 + uniform(s) * 29400;
+    int n = 3 + (int)(tm_uniform(s) * 6);
+    double feed = 600 + tm_uniform(s) * 29400;
     for (int i = 0; i < n; i++) {
         double to[6];
-        if (uniform(s) < 0.25) {                       /* an XY arc, either way */
-            double r = 5 + uniform(s) * 30, a0 = uniform(s) * 2 * M_PI;
-            double sweep = (uniform(s) < 0.5 ? -1 : 1) * (0.3 + uniform(s) * 2.5);
+        if (tm_uniform(s) < 0.25) {                    /* an XY arc, either way */
+            double r = 5 + tm_uniform(s) * 30, a0 = tm_uniform(s) * 2 * M_PI;
+            double sweep = (tm_uniform(s) < 0.5 ? -1 : 1) * (0.3 + tm_uniform(s) * 2.5);
             double c[3] = { at[0] - r * cos(a0), at[1] - r * sin(a0), at[2] };
             memcpy(to, at, sizeof to);
             to[0] = c[0] + r * cos(a0 + sweep), to[1] = c[1] + r * sin(a0 + sweep);
@@ -71,10 +64,10 @@ static void random_prog(struct canon_prog *p, unsigned long long *s, double end[
             static const double up[3] = { 0, 0, 1 };
             tm_arc(p, i + 2, to, c, up, sweep > 0 ? 1 : -1, feed);
         } else {
-            to[0] = -60 + 120 * uniform(s), to[1] = -60 + 120 * uniform(s);
-            to[2] = 630 + 30 * uniform(s);
+            to[0] = -60 + 120 * tm_uniform(s), to[1] = -60 + 120 * tm_uniform(s);
+            to[2] = 630 + 30 * tm_uniform(s);
             for (int k = 3; k < 6; k++)
-                to[k] = -8 + 16 * uniform(s);
+                to[k] = -8 + 16 * tm_uniform(s);
             tm_add(p, CANON_FEED, i + 2, to, feed, 0);
         }
         memcpy(at, to, sizeof at);
@@ -82,33 +75,16 @@ static void random_prog(struct canon_prog *p, unsigned long long *s, double end[
     memcpy(end, at, sizeof at);
 }
 
-/* The operator: the override moved at random, a pause now and then, resumed later. */
-struct walk {
-    unsigned long long seed;
-    int next;                  /* step of the next change */
-    int resume_at;             /* step to resume a pause at (0: none) */
-    int pauses;
-};
-
-static int walk_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+/* The operator (tm_operate), as a run's hook. */
+static int operator_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
 {
-    struct walk *w = ctx;
-    if (w->resume_at && step >= w->resume_at && o->state == MOTION_PAUSED) {
+    struct tm_act act = tm_operate(ctx, step, o->state);
+    if (act.resume)
         ck_assert_int_eq(motion_resume(m), MOTION_OK);
-        w->resume_at = 0;
-    }
-    if (step < w->next)
-        return 0;
-    double u = uniform(&w->seed);
-    if (u < 0.04 && o->state == MOTION_RUNNING && !w->resume_at) {
+    if (act.pause)
         ck_assert_int_eq(motion_pause(m), MOTION_OK);
-        w->resume_at = step + 50 + (int)(uniform(&w->seed) * 500);
-        w->pauses++;
-    } else {
-        double ovr = u < 0.1 ? 0 : u < 0.3 ? 2 : 2 * uniform(&w->seed);
-        ck_assert_int_eq(motion_set_feed_override(m, ovr), MOTION_OK);
-    }
-    w->next = step + 3 + (int)(uniform(&w->seed) * 800);
+    else if (act.ovr >= 0)
+        ck_assert_int_eq(motion_set_feed_override(m, act.ovr), MOTION_OK);
     return 0;
 }
 
@@ -137,9 +113,9 @@ START_TEST(test_random_override)
             continue;
         }
         ck_assert_int_eq(motion_start(mc.m), MOTION_OK);
-        struct walk w = { .seed = seed ^ 0x5bd1e995ULL, .next = 1 };
+        struct tm_operator w = { .seed = seed ^ 0x5bd1e995ULL, .next = 1 };
         struct tm_stats s;
-        tm_run(mc.m, DT, 4000000, &s, walk_hook, &w);
+        tm_run(mc.m, DT, 4000000, &s, operator_hook, &w);
         if (s.last.state == MOTION_PAUSED) {  /* paused at the very end: let it finish */
             ck_assert_int_eq(motion_resume(mc.m), MOTION_OK);
             struct tm_stats s2;

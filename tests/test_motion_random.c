@@ -40,32 +40,18 @@
 #define CASES 48
 #define SANITIZED_CASES 12
 
-/* The operator of every third case: the feed override moved at random, a pause now and
- * then and a resume later, given to both machines alike. */
-struct operator { unsigned long long seed; long next, resume_at; int on, pauses; };
-
-static void operate(struct operator *op, long n, const struct motion_out *o,
+/* The operator (tm_operate) of every third case, given to both machines alike. */
+static void operate(struct tm_operator *op, long n, const struct motion_out *o,
                     struct motion *a, struct motion *b)
 {
-    if (!op->on)
-        return;
-    if (op->resume_at && n >= op->resume_at && o->state == MOTION_PAUSED) {
+    struct tm_act act = tm_operate(op, n, o->state);
+    if (act.resume)
         ck_assert(motion_resume(a) == MOTION_OK && motion_resume(b) == MOTION_OK);
-        op->resume_at = 0;
-    }
-    if (n < op->next)
-        return;
-    double u = tm_uniform(&op->seed);
-    if (u < 0.04 && o->state == MOTION_RUNNING && !op->resume_at) {
+    if (act.pause)
         ck_assert(motion_pause(a) == MOTION_OK && motion_pause(b) == MOTION_OK);
-        op->resume_at = n + 50 + (long)(tm_uniform(&op->seed) * 500);
-        op->pauses++;
-    } else {
-        double ovr = u < 0.1 ? 0 : u < 0.3 ? 2 : 2 * tm_uniform(&op->seed);
-        ck_assert(motion_set_feed_override(a, ovr) == MOTION_OK &&
-                  motion_set_feed_override(b, ovr) == MOTION_OK);
-    }
-    op->next = n + 3 + (long)(tm_uniform(&op->seed) * 800);
+    else if (act.ovr >= 0)
+        ck_assert(motion_set_feed_override(a, act.ovr) == MOTION_OK &&
+                  motion_set_feed_override(b, act.ovr) == MOTION_OK);
 }
 
 /* The machine of case k: the TMU hexapod or the leg-bound one, with jerk limits on odd
@@ -135,12 +121,14 @@ static int run_case(int k, struct worst *wr)
     ck_assert_int_eq(motion_step(a.m, DT, &prev), MOTION_OK);
     ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
     same_brief(&prev, &ob);
-    struct operator op = { .seed = seed ^ 0x5bd1e995ULL, .next = 1, .on = k % 3 == 2 };
-    double acc_slack = op.on ? 1e-3 : 1e-6, feed_bound = op.on ? 2 : 1;
-    long n = 1, bound = (long)((op.on ? 8 : 2) * info.time_s / DT) + 2000;
+    struct tm_operator op = { .seed = seed ^ 0x5bd1e995ULL, .next = 1 };
+    int operated = k % 3 == 2;
+    double acc_slack = operated ? 1e-3 : 1e-6, feed_bound = operated ? 2 : 1;
+    long n = 1, bound = (long)((operated ? 8 : 2) * info.time_s / DT) + 2000;
     int reach = jerk ? 400 : 8;               /* the average's line lags by T/2 */
     do {
-        operate(&op, n, &prev, a.m, b.m);
+        if (operated)
+            operate(&op, n, &prev, a.m, b.m);
         ck_assert_int_eq(motion_step(a.m, DT, &oa), MOTION_OK);
         ck_assert_int_eq(motion_step(b.m, DT, &ob), MOTION_OK);
         same_executor(a.m, b.m);

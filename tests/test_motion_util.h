@@ -163,6 +163,48 @@ static inline void tm_small_arcs(struct canon_prog *p, int n, double r, double s
     }
 }
 
+/* A small deterministic generator for the random tests (the C library's rand differs
+ * between systems): uniform in [0, 1). */
+static inline double tm_uniform(unsigned long long *s)
+{
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) / 9007199254740992.0;
+}
+
+/* An operator at random: moves the feed override (0 to 2, every 3 to 800 periods) and now
+ * and then pauses, to resume 50 to 550 periods later. Start with next = 1. */
+struct tm_operator {
+    unsigned long long seed;
+    long next;                 /* period of the next change */
+    long resume_at;            /* period to resume a pause at (0: none) */
+    int pauses;
+};
+
+/* What the operator does at period n, the machine in state st: resume (first), pause, or
+ * set the override to *ovr (>= 0; -1: leave it). */
+struct tm_act { int resume, pause; double ovr; };
+
+static inline struct tm_act tm_operate(struct tm_operator *op, long n, enum motion_state st)
+{
+    struct tm_act act = { 0, 0, -1 };
+    if (op->resume_at && n >= op->resume_at && st == MOTION_PAUSED) {
+        act.resume = 1;
+        op->resume_at = 0;
+    }
+    if (n < op->next)
+        return act;
+    double u = tm_uniform(&op->seed);
+    if (u < 0.04 && st == MOTION_RUNNING && !op->resume_at) {
+        act.pause = 1;
+        op->resume_at = n + 50 + (long)(tm_uniform(&op->seed) * 500);
+        op->pauses++;
+    } else {
+        act.ovr = u < 0.1 ? 0 : u < 0.3 ? 2 : 2 * tm_uniform(&op->seed);
+    }
+    op->next = n + 3 + (long)(tm_uniform(&op->seed) * 800);
+    return act;
+}
+
 /* What a run measured. */
 struct tm_stats {
     int steps;
