@@ -129,11 +129,34 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
     }
 }
 
+/* With jerk limits, where half of P is below the rounding's share of KINEMATIC_TOLERANCE
+ * (motion_round_tol_mm: the average may round the path by more than the arc cuts the
+ * corner), whether blend arc g (under G64 P tol_mm) is shorter than the moving average's
+ * window T at the fastest the arc may be passed (its chord cap, chord period cp:
+ * motion_chord.c). The average then spans the whole arc and sees a corner: the arc's
+ * curvature holds the speed down around it, and the path's acceleration on either side
+ * spreads the window's samples beyond the rounding's estimate (a constant speed on a
+ * constant curvature). Such a joint is left sharp: passed with a velocity jump whose cut,
+ * the average's with the acceleration's, the junction rule keeps within the arc's share of
+ * P, or stopped at, where the leader rests T (motion_junction_speed). */
+static int shorter_than_window(const struct motion_config *cfg, double T, double cp,
+                               double tol_mm, const struct motion_blend_geom *g)
+{
+    if (!(T > 0) || !(cfg->kin_tol_mm > 0))
+        return 0;
+    double round = fmax(KIN_TOL_SHARE * cfg->kin_tol_mm, JERK_ROUND_SHARE * tol_mm);
+    if (!(round > tol_mm * motion_blend_share(T)))
+        return 0;
+    return g->radius_mm * g->turn_rad < sqrt(8 * round * g->radius_mm) / cp * T;
+}
+
 /* Finds the corners to round: a straight feed move under G64 P followed (past commands that
  * do not stop the path) by another straight feed move. Returns the count. */
-static size_t find_blends(const struct canon_prog *in, struct blend_rec *rec)
+static size_t find_blends(const struct motion_config *cfg, const struct canon_prog *in,
+                          struct blend_rec *rec)
 {
     size_t n = 0;
+    double T = motion_jerk_window_s(cfg), cp = motion_chord_period(cfg);
     for (size_t i = 0; i < in->count; i++) {
         if (in->cmds[i].type == CANON_PROGRAM_END)
             break;
@@ -146,7 +169,8 @@ static size_t find_blends(const struct canon_prog *in, struct blend_rec *rec)
             continue;
         struct motion_blend_geom g;
         if (!motion_blend_corner(rec[i].dir, rec[j].dir, rec[i].len_mm, rec[j].len_mm,
-                                 rec[i].arc_tol_mm, &g))
+                                 rec[i].arc_tol_mm, &g) ||
+            shorter_than_window(cfg, T, cp, rec[i].tol_mm, &g))
             continue;
         rec[i].g = g;
         rec[i].next = j;
@@ -275,7 +299,7 @@ int motion_blend_program_map(const struct motion_config *c, const struct canon_p
     if (!rec)
         return MOTION_ERR_NOMEM;
     scan(c, in, rec);
-    size_t n = find_blends(in, rec);
+    size_t n = find_blends(c, in, rec);
     struct motion_blend_abc *ab = n ? calloc(in->count + n, sizeof *ab) : NULL;
     if (n && ab) {             /* the blended program's size is known: one allocation, not a
                                 * dozen growing copies per streamed window */
