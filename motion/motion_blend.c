@@ -130,7 +130,7 @@ static void scan(const struct motion_config *cfg, const struct canon_prog *in,
 }
 
 /* With jerk limits, where half of P is below the rounding's share of KINEMATIC_TOLERANCE
- * (motion_round_tol_mm: the average may round the path by more than the arc cuts the
+ * (motion_round_budget_mm: the average may round the path by more than the arc cuts the
  * corner), whether blend arc g (under G64 P tol_mm) is shorter than the moving average's
  * window T at the fastest the arc may be passed (its chord cap, chord period cp:
  * motion_chord.c). The average then spans the whole arc and sees a corner: the arc's
@@ -144,7 +144,7 @@ static int shorter_than_window(const struct motion_config *cfg, double T, double
 {
     if (!(T > 0) || !(cfg->kin_tol_mm > 0))
         return 0;
-    double round = fmax(KIN_TOL_SHARE * cfg->kin_tol_mm, JERK_ROUND_SHARE * tol_mm);
+    double round = motion_round_budget_mm(cfg, JERK_ROUND_SHARE * tol_mm);
     if (!(round > tol_mm * motion_blend_share(T)))
         return 0;
     return g->radius_mm * g->turn_rad < sqrt(8 * round * g->radius_mm) / cp * T;

@@ -649,13 +649,20 @@ static inline double motion_jerk_round_mm(const struct motion *m, const struct m
     return m->jerk && sg->blend_tol_mm > 0 ? JERK_ROUND_SHARE * sg->blend_tol_mm : 0;
 }
 
-/* How far the set-point chords (and with jerk limits the moving average) may cut a curve of
- * segment sg, mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE, or motion_jerk_round_mm when that is
- * larger (motion_jerk.c). */
+/* How far the set-point chords (and with jerk limits the moving average) may cut a curve,
+ * mm: KIN_TOL_SHARE of KINEMATIC_TOLERANCE, or the rounding's share of G64 P (jerk_round_mm,
+ * 0 without jerk limits or under G61) when that is larger (motion_jerk.c). */
+static inline double motion_round_budget_mm(const struct motion_config *c,
+                                            double jerk_round_mm)
+{
+    double t = KIN_TOL_SHARE * c->kin_tol_mm;
+    return jerk_round_mm > t ? jerk_round_mm : t;
+}
+
+/* motion_round_budget_mm for a curve of segment sg. */
 static inline double motion_round_tol_mm(const struct motion *m, const struct motion_seg *sg)
 {
-    double t = KIN_TOL_SHARE * m->cfg.kin_tol_mm, j = motion_jerk_round_mm(m, sg);
-    return j > t ? j : t;
+    return motion_round_budget_mm(&m->cfg, motion_jerk_round_mm(m, sg));
 }
 
 /* Share of one period's acceleration a G64 corner's velocity jump may use. */
