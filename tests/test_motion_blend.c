@@ -426,6 +426,37 @@ START_TEST(test_no_blend)
 }
 END_TEST
 
+/* With jerk limits and half of P below the rounding's share of KINEMATIC_TOLERANCE, a
+ * corner whose blend arc would be shorter than the moving average's window is left sharp
+ * (motion_blend.c, shorter_than_window: the junction rule passes it); without jerk limits,
+ * or with P large enough, the same corner is rounded. A 90-degree corner under P0.001 has
+ * an arc of 1.9 um, the window at the arc's fastest (0.26 mm/s, 20 ms) 5 um. */
+START_TEST(test_jerk_leaves_short_arcs)
+{
+    static const double pts[3][6] = {{0, 0, 0, 0, 0, 0}, {10, 0, 0, 0, 0, 0}, {10, 10, 0, 0, 0, 0}};
+    struct motion_config cfg;
+    motion_config_default(&cfg);
+    cfg.kin_tol_mm = 0.001;
+    cfg.max_lin_acc_mm_s2 = 500;
+    struct canon_prog p, out;
+    size_t nb = 9;
+    polyline_prog(&p, pts, 3, 640, 0.001, 600);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
+    ck_assert_int_eq(nb, 1);                      /* no jerk limits: rounded */
+    canon_prog_free(&out);
+    cfg.max_lin_jerk_mm_s3 = 50000;               /* a 20 ms average */
+    ck_assert_double_eq_tol(motion_jerk_window_s(&cfg), 0.02, 1e-12);
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
+    ck_assert_int_eq(nb, 0);                      /* left sharp */
+    canon_prog_free(&p);
+    polyline_prog(&p, pts, 3, 640, 0.01, 600);    /* P0.01: half of it is the rounding's */
+    ck_assert_int_eq(motion_blend_program(&cfg, &p, &out, &nb, NULL), MOTION_OK);
+    ck_assert_int_eq(nb, 1);
+    canon_prog_free(&out);
+    canon_prog_free(&p);
+}
+END_TEST
+
 /* G93: the trimmed lines and the arc keep the speed of the moves they come from (10 mm in
  * 0.01 min: 16.67 mm/s), measured on the run. */
 START_TEST(test_inverse_time)
@@ -710,6 +741,7 @@ static Suite *blend_suite(void)
     tcase_add_test(tc, test_short_segments);
     tcase_add_test(tc, test_orientation);
     tcase_add_test(tc, test_no_blend);
+    tcase_add_test(tc, test_jerk_leaves_short_arcs);
     tcase_add_test(tc, test_inverse_time);
     tcase_add_test(tc, test_hexapod_zigzag);
     tcase_add_test(tc, test_setpoint_chords);
