@@ -175,6 +175,15 @@ static int run_case(int k, struct worst *wr)
     return 0;
 }
 
+/* Runs case k and counts it as run or refused at load. */
+static void tally(int k, struct worst *wr, int *refused)
+{
+    if (run_case(k, wr))
+        (*refused)++;
+    else
+        wr->ran++;
+}
+
 START_TEST(test_random_dense)
 {
     const char *only = getenv("HEXCNC_RANDOM_CASE"), *many = getenv("HEXCNC_RANDOM_CASES");
@@ -186,21 +195,12 @@ START_TEST(test_random_dense)
     struct worst wr;
     memset(&wr, 0, sizeof wr);
     for (int k = 0; k < cases; k++) {
-        if (only && atoi(only) != k)
-            continue;
-        if (run_case(k, &wr))
-            refused++;
-        else
-            wr.ran++;
+        if (!only || atoi(only) == k)
+            tally(k, &wr, &refused);
     }
-    for (size_t h = 0; !only && h < sizeof HARD_CASES / sizeof *HARD_CASES; h++) {
-        if (HARD_CASES[h] < cases)
-            continue;
-        if (run_case(HARD_CASES[h], &wr))
-            refused++;
-        else
-            wr.ran++;
-    }
+    for (size_t h = 0; !only && h < sizeof HARD_CASES / sizeof *HARD_CASES; h++)
+        if (HARD_CASES[h] >= cases)
+            tally(HARD_CASES[h], &wr, &refused);
     printf("random dense programs: %d run (%d refused at load), %.0f s of motion, %d feeds "
            "merged, %d pauses, %.0f %% of the look-ahead machine's periods calm; at most %.4f "
            "of a leg's speed, %.4f of its acceleration, %.4f of its jerk limit, %.4f of the path "
