@@ -24,7 +24,8 @@
  * The seeds are fixed: a failure names its case, which reruns alone with
  * HEXCNC_RANDOM_CASE=N; HEXCNC_RANDOM_CASES=N runs N cases instead of CASES, and the
  * sanitizer's run (HEXCNC_SANITIZED=1, some ten times slower) the first SANITIZED_CASES,
- * every kind of case among them; HARD_CASES run as well. */
+ * every kind of case among them; HARD_CASES run as well. HEXCNC_RANDOM_EACH=1 prints each
+ * case's time and path figure. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -76,6 +77,8 @@ static struct tk_cfg *case_cfg(int k)
 /* The worst of all cases, as shares of the limits. */
 struct worst {
     double leg_v, leg_a, leg_j, path, feed;
+    double case_path;        /* the last case's: its path figure, of its tolerance */
+    int case_jerk;           /* ... whether it ran with jerk limits */
     long periods, calm;
     int ran, merged, pauses;
 };
@@ -165,6 +168,7 @@ static int run_case(int k, struct worst *wr)
         ck_assert_msg(fabs(oa.pose[i] - d.end[i]) <= 1e-9, "case %d: ends %g from its end "
                       "on axis %d", k, oa.pose[i] - d.end[i], i);
     wr->path = fmax(wr->path, worst_path / allowed);
+    wr->case_path = worst_path / allowed, wr->case_jerk = jerk;
     wr->periods += n;
     wr->calm += b.m->ahead.calm;
     wr->merged += (int)info.merged;
@@ -178,10 +182,16 @@ static int run_case(int k, struct worst *wr)
 /* Runs case k and counts it as run or refused at load. */
 static void tally(int k, struct worst *wr, int *refused)
 {
-    if (run_case(k, wr))
+    long periods = wr->periods;
+    if (run_case(k, wr)) {
         (*refused)++;
-    else
-        wr->ran++;
+        return;
+    }
+    wr->ran++;
+    if (getenv("HEXCNC_RANDOM_EACH"))       /* one line a case, to compare planners by */
+        printf("case %d: %s, %.3f s, %.4f of the path tolerance\n", k,
+               wr->case_jerk ? "jerk-limited" : "trapezoidal",
+               (double)(wr->periods - periods) * DT, wr->case_path);
 }
 
 START_TEST(test_random_dense)
