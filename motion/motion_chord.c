@@ -68,25 +68,41 @@ static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double 
     }
 }
 
+/* How fast a chord may run near end `end` of sg, as its squared length's bound: the lowest
+ * of the reaching arcs' linear and angular ones (the lower, the slower). */
+static double end_bound(const struct motion_config *c, const struct motion_seg *sg, int end)
+{
+    double b = HUGE_VAL;
+    if (sg->chord_k[end] > 0)
+        b = sg->chord_tol[end] / sg->chord_k[end];
+    if (sg->chord_kabc[end] > 0 && c->kin_tol_deg > 0)
+        b = motion_min2(b, KIN_TOL_SHARE * c->kin_tol_deg / sg->chord_kabc[end]);
+    return b;
+}
+
 /* The places inside sg (0 < s < len) where a reach ends and no knot lies yet, ascending;
  * returns how many (0 to 2). */
-static int new_knots(const struct motion_plan *p, const struct motion_seg *sg, double s[2])
+static int new_knots(const struct motion_config *c, const struct motion_plan *p,
+                     const struct motion_seg *sg, double s[2])
 {
-    int n = 0;
+    int n = 0, only = -1;
     double cand[2] = {sg->chord_mm[0], sg->len - sg->chord_mm[1]};
     if (sg->kind > SEG_ARC || sg->rotary)
         return 0;
     double eps = 1e-9 * (1 + sg->len), h = sg->len / (double)(sg->nk - 1);
-    /* Reaches from both ends that meet: every knot of sg lies in one and so every interval
-     * has a capped knot at each end, whose lower cap (the sharper arc's) holds over it. A knot
-     * where a reach ends would only let the speed rise towards the gentler arc: short moves
-     * between blends (dense CAM code) keep their two knots. */
+    /* Reaches from both ends that meet: every point of sg lies in one. The speed between
+     * two knots is at most the faster one's (v^2 is linear in s there), so the reach of the
+     * slower end (the sharper arc's) needs a knot where it ends: then every interval lies
+     * either within it, between two of its knots, or within the other reach alone. The other
+     * reach's end lies inside the slower one's and needs none: short moves between blends
+     * (dense CAM code) get one knot more, not two. */
     if (sg->chord_mm[0] > 0 && sg->chord_mm[1] > 0 &&
         sg->chord_mm[0] + sg->chord_mm[1] >= sg->len - eps)
-        return 0;
-    for (int c = 0; c < 2; c++) {
-        double x = cand[c];
-        if (!(x > eps && x < sg->len - eps) || sg->chord_mm[c] <= 0)
+        only = end_bound(c, sg, 0) <= end_bound(c, sg, 1) ? 0 : 1;
+    for (int e = 0; e < 2; e++) {
+        double x = cand[e];
+        if (!(x > eps && x < sg->len - eps) || sg->chord_mm[e] <= 0 ||
+            (only >= 0 && e != only))
             continue;
         double nearest = p->ks[sg->k0] + h * round((x - p->ks[sg->k0]) / h);
         if (fabs(nearest - x) <= eps || (n == 1 && fabs(s[0] - x) <= eps))
@@ -115,12 +131,12 @@ static int resize_knots(struct motion_plan *p, size_t cap)
 }
 
 /* Puts the knots where the reaches end into the (evenly spaced) knots of every segment. */
-static int insert_knots(struct motion_plan *p)
+static int insert_knots(const struct motion_config *c, struct motion_plan *p)
 {
     size_t extra = 0;
     double s[2];
     for (size_t j = 0; j < p->nseg; j++)
-        extra += (size_t)new_knots(p, &p->segs[j], s);
+        extra += (size_t)new_knots(c, p, &p->segs[j], s);
     if (extra == 0)
         return 0;
     size_t n = p->nknot + extra;
@@ -130,7 +146,7 @@ static int insert_knots(struct motion_plan *p)
     size_t w = 0;
     for (size_t j = 0; j < p->nseg; j++) {
         struct motion_seg *sg = &p->segs[j];
-        int m = new_knots(p, sg, s), used = 0;
+        int m = new_knots(c, p, sg, s), used = 0;
         size_t k0 = w;
         for (size_t i = 0; i < sg->nk; i++) {
             double x = p->ks[sg->k0 + i];
@@ -174,11 +190,13 @@ int motion_chord_zones(struct motion *m)
         double d = sqrt(8 * tol / k);
         if (kabc > 1e-30 && c->kin_tol_deg > 0)
             d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / kabc));
+        /* with jerk limits also where the moving average's window may hold a sample on
+         * the arc: within cap T of it, the cap being at most d / chord period */
         d *= CHORD_MARGIN;
         mark(sg, 0, sg->len, k, kabc, tol);
         mark(sg, 1, sg->len, k, kabc, tol);
         reach(p, j, -1, d, k, kabc, tol);
         reach(p, j, +1, d, k, kabc, tol);
     }
-    return insert_knots(p);
+    return insert_knots(c, p);
 }

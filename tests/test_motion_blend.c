@@ -645,6 +645,62 @@ START_TEST(test_arc_chords)
 }
 END_TEST
 
+/* Two arcs close together, all tangent: a 3 mm arc, a line of 0.1 mm, a 0.03 mm arc, at
+ * 500 mm/s with 100 Hz set points. The line lies within reach of both arcs' chords (all of
+ * it of the large one's, its last 0.016 mm of the small one's), and its two knots are capped
+ * by the large arc and by both: the speed must come down to the small arc's cap where that
+ * arc's reach begins, not at the line's end only. (Without a knot there it ran 6.9 mm/s where
+ * the small arc allows 1.47 mm/s, decelerating between the line's two knots.) */
+START_TEST(test_meeting_reaches)
+{
+    const double z = 640, r1 = 3, r2 = 0.03, gap = 0.1, nz[3] = {0, 0, 1}, Ts = 0.01;
+    /* up the y axis to (0,0); left round (-r1,0) to (-r1,r1), heading -x; the gap to
+     * (-r1-gap, r1); left round (-r1-gap, r1-r2) to (-r1-gap-r2, r1-r2), heading -y */
+    double S[6] = {0, -20, z}, A[6] = {0, 0, z}, C1[3] = {-r1, 0, z}, B[6] = {-r1, r1, z},
+           G[6] = {-r1 - gap, r1, z}, C2[3] = {-r1 - gap, r1 - r2, z},
+           H[6] = {-r1 - gap - r2, r1 - r2, z}, E[6] = {-r1 - gap - r2, r1 - r2 - 20, z};
+    struct canon_prog p;
+    canon_prog_init(&p);
+    memcpy(p.start, S, sizeof p.start);
+    tm_add(&p, CANON_FEED, 10, A, 30000, 0);
+    tm_arc(&p, 11, B, C1, nz, 1, 30000);
+    tm_add(&p, CANON_FEED, 12, G, 30000, 0);
+    tm_arc(&p, 13, H, C2, nz, 1, 30000);
+    tm_add(&p, CANON_FEED, 14, E, 30000, 0);
+    struct tk_cfg *c = tm_fast_hexapod_cfg(DT, 0.001);
+    ck_assert_ptr_nonnull(c);
+    tk_setf(c, "TRAJ", "SETPOINT_PERIOD", Ts * 1e9);
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, c, &kins_hexapod_ops), 0);
+    load_start(mc.m, &p);
+    /* the small arc's cap (the longest chord its curvature allows, over one set-point
+     * period) and its reach, motion_chord.c */
+    double chord = sqrt(8 * 0.9 * 0.001 * r2), cap = chord / Ts, reach = 1.1 * chord;
+    struct motion_out o, prev;
+    ck_assert_int_eq(motion_step(mc.m, DT, &prev), MOTION_OK);
+    double fastest = 0;
+    int seen = 0;
+    for (int n = 0; n < 100000 && prev.state != MOTION_DONE; n++) {
+        ck_assert_int_eq(motion_step(mc.m, DT, &o), MOTION_OK);
+        double v = hypot(o.pose[0] - prev.pose[0], o.pose[1] - prev.pose[1]) / DT;
+        int in = fabs(o.pose[1] - r1) < 1e-9 && o.pose[0] <= G[0] + reach &&
+                 o.pose[0] >= G[0];       /* the period's both ends within the reach */
+        if (in && fabs(prev.pose[1] - r1) < 1e-9 && prev.pose[0] <= G[0] + reach)
+            fastest = fmax(fastest, v), seen++;
+        prev = o;
+    }
+    ck_assert_int_eq(prev.state, MOTION_DONE);
+    printf("arcs of 3 and 0.03 mm 0.1 mm apart, 100 Hz set points: %d periods within reach of "
+           "the small arc's chords, at most %.3f mm/s (its cap %.3f mm/s)\n", seen, fastest,
+           cap);
+    ck_assert_int_gt(seen, 0);
+    ck_assert_msg(fastest <= cap * (1 + 1e-6), "%.4f mm/s within reach of the 0.03 mm arc, "
+                  "cap %.4f mm/s", fastest, cap);
+    canon_prog_free(&p);
+    tm_close(&mc);
+}
+END_TEST
+
 /* The TMU hexapod where the legs bind (bench_topp_blend's machine): legs 40 mm/s and
  * 200 mm/s^2, path 500 mm/s and 5000 mm/s^2, no kinematic-error bound. */
 static struct tk_cfg *leg_bound_cfg(void)
@@ -747,6 +803,7 @@ static Suite *blend_suite(void)
     tcase_add_test(tc, test_setpoint_chords);
     tcase_add_test(tc, test_stop_phases);
     tcase_add_test(tc, test_arc_chords);
+    tcase_add_test(tc, test_meeting_reaches);
     tcase_add_test(tc, test_blend_legs_time_optimal);
     suite_add_tcase(s, tc);
     return s;
