@@ -68,8 +68,9 @@ static void reach(struct motion_plan *p, size_t j, int dir, double d_mm, double 
     }
 }
 
-/* How fast a chord may run near end `end` of sg, as its squared length's bound: the lowest
- * of the reaching arcs' linear and angular ones (the lower, the slower). */
+/* How fast a chord may run near end `end` of sg: the bound on its squared length (over 8)
+ * of the arcs reaching sg from there, the lower of the linear and the angular one; the
+ * lower the bound, the slower the cap. */
 static double end_bound(const struct motion_config *c, const struct motion_seg *sg, int end)
 {
     double b = HUGE_VAL;
@@ -190,8 +191,6 @@ int motion_chord_zones(struct motion *m)
         double d = sqrt(8 * tol / k);
         if (kabc > 1e-30 && c->kin_tol_deg > 0)
             d = motion_min2(d, sqrt(8 * KIN_TOL_SHARE * c->kin_tol_deg / kabc));
-        /* with jerk limits also where the moving average's window may hold a sample on
-         * the arc: within cap T of it, the cap being at most d / chord period */
         d *= CHORD_MARGIN;
         mark(sg, 0, sg->len, k, kabc, tol);
         mark(sg, 1, sg->len, k, kabc, tol);
