@@ -659,14 +659,16 @@ START_TEST(test_meeting_reaches)
     double S[6] = {0, -20, z}, A[6] = {0, 0, z}, C1[3] = {-r1, 0, z}, B[6] = {-r1, r1, z},
            G[6] = {-r1 - gap, r1, z}, C2[3] = {-r1 - gap, r1 - r2, z},
            H[6] = {-r1 - gap - r2, r1 - r2, z}, E[6] = {-r1 - gap - r2, r1 - r2 - 20, z};
+    const double *ends[5] = {A, B, G, H, E}, *centres[5] = {NULL, C1, NULL, C2, NULL};
     struct canon_prog p;
     canon_prog_init(&p);
     memcpy(p.start, S, sizeof p.start);
-    tm_add(&p, CANON_FEED, 10, A, 30000, 0);
-    tm_arc(&p, 11, B, C1, nz, 1, 30000);
-    tm_add(&p, CANON_FEED, 12, G, 30000, 0);
-    tm_arc(&p, 13, H, C2, nz, 1, 30000);
-    tm_add(&p, CANON_FEED, 14, E, 30000, 0);
+    for (int i = 0; i < 5; i++) {
+        if (centres[i])
+            tm_arc(&p, 10 + i, ends[i], centres[i], nz, 1, 30000);
+        else
+            tm_add(&p, CANON_FEED, 10 + i, ends[i], 30000, 0);
+    }
     struct tk_cfg *c = tm_fast_hexapod_cfg(DT, 0.001);
     ck_assert_ptr_nonnull(c);
     tk_setf(c, "TRAJ", "SETPOINT_PERIOD", Ts * 1e9);
