@@ -25,15 +25,6 @@ static void open_hexapod(struct tm_machine *mc)
     ck_assert_int_eq(tm_open(mc, c, &kins_hexapod_ops), 0);
 }
 
-/* Loads and starts a program, failing the test with motion's message. */
-static void load_start(struct motion *m, struct canon_prog *p)
-{
-    char err[512] = "";
-    int st = motion_load(m, p, err, sizeof err);
-    ck_assert_msg(st == MOTION_OK, "load: %s", err);
-    ck_assert_int_eq(motion_start(m), MOTION_OK);
-}
-
 /* One 100 mm feed move at 50 mm/s, 1000 mm/s^2 on the trivial machine: a trapezoid with
  * 0.05 s ramps: 2.05 s. The run ends exactly on the end point, in the planned time, and
  * never exceeds the feed or the acceleration. */
@@ -45,7 +36,7 @@ START_TEST(test_trapezoid_trivial)
     canon_prog_init(&p);
     double end[6] = {100, 0, 0, 0, 0, 0};
     tm_add(&p, CANON_FEED, 3, end, 3000, 0);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct motion_plan_info info;
     ck_assert_int_eq(motion_plan_info(mc.m, &info), MOTION_OK);
     ck_assert_msg(fabs(info.time_s - 2.05) < 0.01, "planned %.4f s, ideal 2.05 s", info.time_s);
@@ -78,7 +69,7 @@ START_TEST(test_triangle_and_rapid)
     double a[6] = {0, 2, 0, 0, 0, 0}, b[6] = {0, 2, 300, 0, 0, 0};
     tm_add(&p, CANON_FEED, 1, a, 6000, 0);           /* 2 mm at up to 100 mm/s */
     tm_add(&p, CANON_TRAVERSE, 2, b, 0, 0);          /* 300 mm rapid at 100 mm/s */
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct motion_plan_info info;
     motion_plan_info(mc.m, &info);
     double tri = 2 * sqrt(2 / 1000.0), rapid = 300 / 100.0 + 100 / 1000.0;
@@ -95,7 +86,7 @@ START_TEST(test_triangle_and_rapid)
      * the moves beside it giving up half their acceleration) */
     double g61 = info.time_s;
     p.start_path_mode = 0;
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     motion_plan_info(mc.m, &info);
     ck_assert_msg(info.time_s <= g61 + 1e-9, "G64 %.6f s, G61 %.6f s", info.time_s, g61);
     canon_prog_free(&p);
@@ -114,7 +105,7 @@ START_TEST(test_trapezoid_hexapod)
     double s0[6] = {0, 0, 645, 0, 0, 0}, e[6] = {60, -40, 660, 5, -4, 10};
     memcpy(p.start, s0, sizeof s0);
     tm_add(&p, CANON_FEED, 7, e, 1200, 0);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct motion_plan_info info;
     motion_plan_info(mc.m, &info);
     struct tm_stats s;
@@ -159,8 +150,8 @@ START_TEST(test_brief_record)
     two_machines(&a, &b, &p, s0);
     tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
     tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
-    load_start(a.m, &p);
-    load_start(b.m, &p);
+    tm_load_start(a.m, &p);
+    tm_load_start(b.m, &p);
     motion_set_brief(b.m, true);
     struct motion_out oa, ob;
     memset(&oa, 0, sizeof oa);
@@ -235,8 +226,8 @@ START_TEST(test_ahead_same_bits)
     tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
     tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
     tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
-    load_start(a.m, &p);
-    load_start(b.m, &p);
+    tm_load_start(a.m, &p);
+    tm_load_start(b.m, &p);
     motion_set_rates(a.m, false);
     motion_set_rates(b.m, false);
     motion_set_ahead(b.m, true);
@@ -300,8 +291,8 @@ START_TEST(test_knot_ahead_same_plan)
     tm_add(&p, CANON_DWELL, 401, NULL, 0, 0.1);
     e3[0] += 8, e3[5] += 2;
     tm_add(&p, CANON_FEED, 402, e3, 1500, 0);
-    load_start(a.m, &p);
-    load_start(b.m, &p);
+    tm_load_start(a.m, &p);
+    tm_load_start(b.m, &p);
     const struct motion_plan *pa = &a.m->plan, *pb = &b.m->plan;
     ck_assert_uint_eq(pa->nknot, pb->nknot);
     size_t nk = pa->nknot;
@@ -336,7 +327,7 @@ START_TEST(test_segment_values_per_program)
         canon_prog_init(&p);
         memcpy(p.start, s0, sizeof s0);
         tm_add(&p, CANON_FEED, run ? 7 : 3, run ? e2 : e1, 1500, 0);
-        load_start(a.m, &p);
+        tm_load_start(a.m, &p);
         long n = 0;
         do {
             ck_assert_int_eq(motion_step(a.m, DT, &o), MOTION_OK);
@@ -377,7 +368,7 @@ START_TEST(test_arcs)
     canon_prog_init(&p);
     double e1[6] = {40, 0, 0, 0, 0, 0}, c1[3] = {20, 0, 0}, n1[3] = {0, 0, 1};
     tm_arc(&p, 5, e1, c1, n1, -1, 1200);     /* G2 from (0,0) over the top to (40,0) */
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct arc_check ac = {{20, 0, 0}, {0, 0, 1}, 20, 0, 0};
     struct tm_stats s;
     tm_run(mc.m, DT, 100000, &s, arc_hook, &ac);
@@ -392,7 +383,7 @@ START_TEST(test_arcs)
     canon_prog_init(&p);
     double nt[3] = {0, sin(0.3), cos(0.3)}, ct[3] = {10, 0, 0}, et[6] = {20, 0, 0, 0, 0, 0};
     tm_arc(&p, 6, et, ct, nt, 1, 600);       /* a plane-0 arc with a tilted normal */
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct arc_check at = {{10, 0, 0}, {0, sin(0.3), cos(0.3)}, 10, 0, 0};
     tm_run(mc.m, DT, 100000, &s, arc_hook, &at);
     ck_assert_int_eq(s.last.state, MOTION_DONE);
@@ -423,7 +414,7 @@ START_TEST(test_helix)
     p.start[0] = 5;
     double e[6] = {5, 0, 4, 0, 0, 0}, c[3] = {0, 0, 0}, n[3] = {0, 0, 1};
     tm_arc(&p, 9, e, c, n, 2, 600);           /* G3 with P2: two turns */
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct motion_plan_info info;
     motion_plan_info(mc.m, &info);
     double len = sqrt(pow(4 * M_PI * 5, 2) + 16);
@@ -460,7 +451,7 @@ START_TEST(test_dwell)
     tm_add(&p, CANON_DWELL, 2, NULL, 0, 1.5);
     tm_add(&p, CANON_FEED, 3, b, 600, 0);
     tm_add(&p, CANON_PROGRAM_END, 4, NULL, 0, 0);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct motion_plan_info info;
     motion_plan_info(mc.m, &info);
     double move = 10 / 10.0 + 10 / 1000.0;   /* each: 1 s cruise + one ramp's worth */
@@ -542,7 +533,7 @@ static double joint_speed(double blend, int gcode, const double *second)
     canon_prog_sink(&p, &pm);
     tm_add(&p, CANON_FEED, 2, a, 1200, 0);
     tm_add(&p, CANON_FEED, 3, second, 1200, 0);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct joint_watch w = {2, 1e9, 0};
     struct tm_stats s;
     tm_run(mc.m, DT, 100000, &s, joint_hook, &w);
@@ -580,7 +571,7 @@ START_TEST(test_inverse_time_and_rotary)
     struct canon_cmd c = {.type = CANON_FEED, .line = 1, .file = "t.ngc", .feed_mm_min = 99,
                           .inverse_time_min = 0.01, .end = {10, 0, 0, 0, 0, 0}};
     canon_prog_sink(&p, &c);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     struct tm_stats s;
     tm_run(mc.m, DT, 100000, &s, NULL, NULL);
     ck_assert_double_eq_tol(s.max_v_mm_s, 10 / 0.6, 1e-6);
@@ -589,7 +580,7 @@ START_TEST(test_inverse_time_and_rotary)
     canon_prog_init(&p);
     double r[6] = {0, 0, 0, 30, 0, 0};
     tm_add(&p, CANON_FEED, 2, r, 600, 0);
-    load_start(mc.m, &p);
+    tm_load_start(mc.m, &p);
     tm_run(mc.m, DT, 100000, &s, NULL, NULL);
     ck_assert_double_eq_tol(s.last.pose[3], 30, 1e-9);
     ck_assert_double_eq_tol(s.t_s, 3 + 10 / 900.0, 0.005);

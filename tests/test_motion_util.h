@@ -115,6 +115,32 @@ static inline void tm_add(struct canon_prog *p, enum canon_type type, int line,
         abort();
 }
 
+/* A program: path mode (gcode 640 with P = tol, or 610), then feed moves through pts[1..n-1]
+ * from pts[0], lines 10, 11, ... */
+static inline void tm_polyline_prog(struct canon_prog *p, const double (*pts)[6], int n,
+                                    int gcode, double tol, double feed_mm_min)
+{
+    canon_prog_init(p);
+    memcpy(p->start, pts[0], sizeof p->start);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 1, .file = "test.ngc",
+                           .value = tol, .ivalue = gcode};
+    if (canon_prog_sink(p, &pm))
+        abort();
+    for (int i = 1; i < n; i++)
+        tm_add(p, CANON_FEED, 9 + i, pts[i], feed_mm_min, 0);
+}
+
+/* With Check (the tests, not the bench): */
+#ifdef ck_assert_msg
+/* Loads and starts a program; fails the test with the planner's message. */
+static inline void tm_load_start(struct motion *m, const struct canon_prog *p)
+{
+    char err[512] = "";
+    ck_assert_msg(motion_load(m, p, err, sizeof err) == MOTION_OK, "load: %s", err);
+    ck_assert_int_eq(motion_start(m), MOTION_OK);
+}
+#endif
+
 /* Appends an arc (plane 17/18/19 or 0 with any normal). */
 static inline void tm_arc(struct canon_prog *p, int line, const double *end, const double *center,
                           const double *normal, int rotation, double feed_mm_min)
