@@ -15,11 +15,12 @@
 #define LEG_JERK 50000.0       /* mm/s^3, [JOINT_n] MAX_JERK */
 #define LIN_JERK 50000.0       /* mm/s^3, [TRAJ] MAX_LINEAR_JERK */
 #define ANG_JERK 30000.0       /* deg/s^3, [TRAJ] MAX_ANGULAR_JERK */
+#define JERK_WINDOW 0.020      /* s, [TRAJ] JERK_WINDOW: half the legs' 2 x 1000 / 50000 */
 
 /* One check of prog on ini, trapezoidal (scale 0) or with the jerk limits above times
- * scale. */
-static int check_one(const char *ini, const char *prog, double jerk, struct check_result *r,
-                     double *window_s)
+ * scale, and [TRAJ] JERK_WINDOW window (s; 0: none). */
+static int check_one(const char *ini, const char *prog, double jerk, double window,
+                     struct check_result *r, double *window_s)
 {
     char err[1024];
     struct check_machine *mc;
@@ -32,6 +33,7 @@ static int check_one(const char *ini, const char *prog, double jerk, struct chec
         mc->mcfg.max_ang_jerk_deg_s3 = jerk * ANG_JERK;
         for (int i = 0; i < mc->mcfg.njoints; i++)
             mc->mcfg.joint[i].max_jerk_mm_s3 = jerk * LEG_JERK;
+        mc->mcfg.jerk_window_s = window;
         motion_destroy(mc->motion);
         mc->motion = NULL;
         if (motion_create(&mc->mcfg, mc->kins, &mc->motion, err, sizeof err) != MOTION_OK) {
@@ -62,12 +64,14 @@ static void peaks(const struct check_result *r, double jerk_mm_s3, double out[3]
     }
 }
 
-/* Both checks of one program (the jerk limits times scale), one row. */
-static int row(const char *label, const char *ini, const char *prog, double scale)
+/* Both checks of one program (the jerk limits times scale, [TRAJ] JERK_WINDOW window s or
+ * none), one row. */
+static int row(const char *label, const char *ini, const char *prog, double scale,
+               double window)
 {
     struct check_result t, j;
     double w0, w1, pt[3], pj[3];
-    if (check_one(ini, prog, 0, &t, &w0) || check_one(ini, prog, scale, &j, &w1))
+    if (check_one(ini, prog, 0, 0, &t, &w0) || check_one(ini, prog, scale, window, &j, &w1))
         return -1;
     peaks(&t, scale * LEG_JERK, pt);
     peaks(&j, scale * LEG_JERK, pj);
@@ -110,15 +114,21 @@ int main(int argc, char **argv)
            "ratio", "trap. v a j", "jerk-lim. v a j");
     int fail = 0;
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
-        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1);
+        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, 0);
     char label[64];
     snprintf(label, sizeof label, "dense, %d blocks", blocks);
-    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, 0);
+    printf("\nthe same jerk limits with [TRAJ] JERK_WINDOW = %.3f (a %.0f ms moving average: "
+           "the legs' acceleration lowered to 50000 x %.3f / 2 = %.0f mm/s^2):\n", JERK_WINDOW,
+           JERK_WINDOW * 1e3, JERK_WINDOW, LEG_JERK * JERK_WINDOW / 2);
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
+        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, JERK_WINDOW);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, JERK_WINDOW);
     printf("\nthe same with 4 x the jerk limits (a 10 ms moving average; jerk to 200000 "
            "mm/s^3):\n");
     fail |= row("TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc",
-                4);
-    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4);
+                4, 0);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4, 0);
     unlink(dense);
     return fail ? 1 : 0;
 }

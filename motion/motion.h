@@ -94,6 +94,10 @@ struct motion_config {
                                      * is on when this, max_ang_jerk_deg_s3 and every joint's
                                      * max_jerk_mm_s3 are set, off when none is */
     double max_ang_jerk_deg_s3;     /* [TRAJ] MAX_ANGULAR_JERK, deg/s^3; 0: none */
+    double jerk_window_s;           /* [TRAJ] JERK_WINDOW, s: the jerk limits' moving average,
+                                     * shorter than 2 x acceleration / jerk, every
+                                     * acceleration then lowered to jerk x window / 2
+                                     * (motion_jerk_share); 0: that longest 2 a / j */
     double default_lin_vel_mm_s;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY, mm/s: feed of a move
                                      * programmed before any F word (canon feed 0) */
     double kin_tol_mm;              /* [TRAJ] KINEMATIC_TOLERANCE, mm: largest deviation of the
@@ -132,6 +136,14 @@ int motion_config_read(struct motion_config *c, const struct kins_config *cfg, i
  * differencing the set points period by period, exceeds MAX_JERK wherever the unfiltered
  * motion keeps its acceleration limits. */
 double motion_jerk_window_s(const struct motion_config *c);
+/* The window in which every acceleration may be used in full: the longest 2 x acceleration /
+ * jerk, s (0: jerk limiting off). [TRAJ] JERK_WINDOW may be shorter, not longer. */
+double motion_jerk_full_window_s(const struct motion_config *c);
+/* With [TRAJ] JERK_WINDOW set: lowers each acceleration limit of c (path, A B C, every leg)
+ * to its jerk limit x the window / 2, so that the mean of that window keeps every jerk
+ * limit. motion_create applies it to its own copy; the machine's limits (what a check
+ * reports against) stay as configured. Nothing without the key. */
+void motion_jerk_share(struct motion_config *c);
 
 struct motion;
 

@@ -181,6 +181,29 @@ static int check_jerk(const struct motion_config *c, char *err, size_t errlen)
                  missing ? missing : joint_key);
         return MOTION_ERR_CONFIG;
     }
+    if (c->jerk_window_s != 0) {
+        double full = motion_jerk_full_window_s(c);
+        if (set == 0 || !(c->jerk_window_s > 0)) {
+            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: %s", c->jerk_window_s,
+                     set == 0 ? "only with jerk limits ([TRAJ] MAX_LINEAR_JERK, "
+                                "MAX_ANGULAR_JERK and every [JOINT_n] MAX_JERK); without "
+                                "them motion is trapezoidal, with no moving average"
+                              : "must be positive");
+            return MOTION_ERR_CONFIG;
+        }
+        if (c->jerk_window_s < 2 * c->servo_period_s - 1e-12) {
+            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: shorter than two servo periods "
+                     "(%g s)", c->jerk_window_s, 2 * c->servo_period_s);
+            return MOTION_ERR_CONFIG;
+        }
+        if (c->jerk_window_s > full * (1 + 1e-9)) {
+            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: longer than the %.4f s in which "
+                     "the jerk limits allow every acceleration in full (2 x acceleration / "
+                     "jerk); a longer window only rounds the path more: leave the key out",
+                     c->jerk_window_s, full);
+            return MOTION_ERR_CONFIG;
+        }
+    }
     double w = motion_jerk_window_s(c);
     if (w > MOTION_JERK_MAX_S) {
         snprintf(err, errlen, "jerk limits: motion would need a %.3f s moving average to keep "
@@ -228,6 +251,7 @@ static const struct motion_key {
      offsetof(struct motion_config, max_ang_acc_deg_s2)},
     {"TRAJ", "MAX_LINEAR_JERK", 1, 0, 0, offsetof(struct motion_config, max_lin_jerk_mm_s3)},
     {"TRAJ", "MAX_ANGULAR_JERK", 1, 0, 0, offsetof(struct motion_config, max_ang_jerk_deg_s3)},
+    {"TRAJ", "JERK_WINDOW", 1, 0, 0, offsetof(struct motion_config, jerk_window_s)},
     {"TRAJ", "DEFAULT_LINEAR_VELOCITY", 1, 0, 0,
      offsetof(struct motion_config, default_lin_vel_mm_s)},
     {"TRAJ", "KINEMATIC_TOLERANCE", 1, 1, 0, offsetof(struct motion_config, kin_tol_mm)},

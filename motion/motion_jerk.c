@@ -68,7 +68,9 @@ struct motion_jerk {
     struct motion_jerk_meta last_meta;
 };
 
-double motion_jerk_window_s(const struct motion_config *c)
+/* The longest of 2 x acceleration / jerk over the path, A B C and the legs, s (not yet in
+ * whole periods): the window in which the leader may use every acceleration in full. */
+double motion_jerk_full_window_s(const struct motion_config *c)
 {
     if (!c || c->max_lin_jerk_mm_s3 <= 0)
         return 0;
@@ -78,9 +80,32 @@ double motion_jerk_window_s(const struct motion_config *c)
     for (int i = 0; i < c->njoints; i++)
         if (c->joint[i].max_jerk_mm_s3 > 0)
             t = fmax(t, 2 * c->joint[i].max_acc_mm_s2 / c->joint[i].max_jerk_mm_s3);
+    return t;
+}
+
+double motion_jerk_window_s(const struct motion_config *c)
+{
+    double t = motion_jerk_full_window_s(c);
+    if (t <= 0)
+        return 0;
+    if (c->jerk_window_s > 0)       /* [TRAJ] JERK_WINDOW: shorter, the accelerations lowered */
+        t = c->jerk_window_s;
     /* whole periods: the window is n periods, never shorter than asked */
     double n = ceil(t / c->servo_period_s - 1e-9);
     return fmax(n, 2) * c->servo_period_s;
+}
+
+void motion_jerk_share(struct motion_config *c)
+{
+    double T = motion_jerk_window_s(c);
+    if (T <= 0 || !(c->jerk_window_s > 0))
+        return;
+    /* the mean's jerk is at most 2 a / T: a leader within j T / 2 keeps j */
+    c->max_lin_acc_mm_s2 = fmin(c->max_lin_acc_mm_s2, c->max_lin_jerk_mm_s3 * T / 2);
+    c->max_ang_acc_deg_s2 = fmin(c->max_ang_acc_deg_s2, c->max_ang_jerk_deg_s3 * T / 2);
+    for (int i = 0; i < c->njoints; i++)
+        c->joint[i].max_acc_mm_s2 = fmin(c->joint[i].max_acc_mm_s2,
+                                         c->joint[i].max_jerk_mm_s3 * T / 2);
 }
 
 double motion_chord_period(const struct motion_config *c)

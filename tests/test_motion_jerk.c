@@ -17,7 +17,9 @@
 #define LIN_JERK 50000.0       /* mm/s^3 */
 #define ANG_JERK 30000.0       /* deg/s^3 */
 
-/* The TMU hexapod, with jerk limits or without. */
+#define WINDOW 0.020           /* s, [TRAJ] JERK_WINDOW: the legs to 50000 x 0.02 / 2 = 500 */
+
+/* The TMU hexapod, with jerk limits (1; 2: and [TRAJ] JERK_WINDOW = WINDOW) or without. */
 static struct tk_cfg *jerk_cfg(int jerk)
 {
     struct tk_cfg *c = tm_hexapod_cfg();
@@ -25,6 +27,8 @@ static struct tk_cfg *jerk_cfg(int jerk)
     if (!jerk)
         return c;
     tm_set_jerk(c, LIN_JERK, ANG_JERK, LEG_JERK);
+    if (jerk == 2)
+        tk_setf(c, "TRAJ", "JERK_WINDOW", WINDOW);
     return c;
 }
 
@@ -180,6 +184,52 @@ START_TEST(test_config)
     motion_config_default(&c);
     ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
     ck_assert_double_eq(motion_jerk_window_s(&c), 0);
+    /* a window without jerk limits is refused, not ignored */
+    tk_setf(t, "TRAJ", "JERK_WINDOW", 0.02);
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_msg(strstr(err, "[TRAJ] JERK_WINDOW = 0.02 s: only with jerk limits"), "%s", err);
+    free(t);
+    /* a shorter window: every acceleration lowered to jerk x window / 2 where it is above */
+    t = jerk_cfg(2);
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.040, 1e-12);
+    struct motion_config shared = c;
+    motion_jerk_share(&shared);
+    for (int i = 0; i < 6; i++) {
+        ck_assert_double_eq_tol(shared.joint[i].max_acc_mm_s2, 500, 1e-9);  /* from 1000 */
+        ck_assert_double_eq(shared.joint[i].max_vel_mm_s, c.joint[i].max_vel_mm_s);
+    }
+    ck_assert_double_eq(shared.max_lin_acc_mm_s2, c.max_lin_acc_mm_s2);   /* 500: within */
+    ck_assert_double_eq(shared.max_ang_acc_deg_s2, c.max_ang_acc_deg_s2); /* 300: within */
+    ck_assert_double_eq_tol(motion_jerk_window_s(&shared), WINDOW, 1e-12);
+    struct motion *mo;
+    ck_assert_int_eq(motion_create(&c, k, &mo, err, sizeof err), MOTION_OK);
+    motion_destroy(mo);
+    /* rounded up to whole servo periods, never shorter than asked */
+    tk_setf(t, "TRAJ", "JERK_WINDOW", 0.0205);
+    kc = tk_config(t);
+    motion_config_default(&c);
+    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.021, 1e-12);
+    /* longer than the full acceleration needs, or shorter than two periods: refused */
+    static const struct { const char *v, *msg; } bad[] = {
+        { "0.05", "[TRAJ] JERK_WINDOW = 0.05 s: longer than the 0.0400 s" },
+        { "0.0015", "[TRAJ] JERK_WINDOW = 0.0015 s: shorter than two servo periods" },
+        { "0", "[TRAJ] JERK_WINDOW = 0: " },
+        { "-0.01", "[TRAJ] JERK_WINDOW = -0.01: " },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        tk_set(t, "TRAJ", "JERK_WINDOW", bad[i].v);
+        kc = tk_config(t);
+        motion_config_default(&c);
+        ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+        ck_assert_msg(strstr(err, bad[i].msg), "%s: %s", bad[i].v, err);
+    }
     free(t);
     kins_free(k);
 }
@@ -268,20 +318,26 @@ END_TEST
 /* G64 corners between straight feeds (a zigzag of 10 mm lines turning 60 and 120 degrees):
  * the blend arcs take half of P, the rounding the other half; the tool stays within P of the
  * programmed corners, every limit kept. */
+/* A G64 P tol zigzag of ten 10 mm feeds at F6000 turning 60 and 120 degrees. */
+static void zigzag(struct canon_prog *p, double tol)
+{
+    canon_prog_init(p);
+    double at[6] = { -40, 0, 645, 0, 0, 0 };
+    memcpy(p->start, at, sizeof at);
+    p->start_path_mode = 640;
+    p->start_path_tol_mm = tol;
+    for (int i = 0; i < 10; i++) {
+        double a = (i % 2 ? -1 : 1) * (i % 4 < 2 ? 60 : 30) * M_PI / 180;
+        at[0] += 10 * cos(a), at[1] += 10 * sin(a);
+        tm_add(p, CANON_FEED, i + 1, at, 6000, 0);
+    }
+}
+
 START_TEST(test_blended_corners)
 {
     static const double tols[] = { 0.01, 0.05 };
     struct canon_prog p;
-    canon_prog_init(&p);
-    double at[6] = { -40, 0, 645, 0, 0, 0 };
-    memcpy(p.start, at, sizeof at);
-    p.start_path_mode = 640;
-    p.start_path_tol_mm = tols[_i];
-    for (int i = 0; i < 10; i++) {
-        double a = (i % 2 ? -1 : 1) * (i % 4 < 2 ? 60 : 30) * M_PI / 180;
-        at[0] += 10 * cos(a), at[1] += 10 * sin(a);
-        tm_add(&p, CANON_FEED, i + 1, at, 6000, 0);
-    }
+    zigzag(&p, tols[_i]);
     struct watch wj = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
     struct watch wt = wj;
     struct tm_stats sj = run(1, &p, &wj, 1), st = run(0, &p, &wt, 1);
@@ -293,6 +349,43 @@ START_TEST(test_blended_corners)
            "from the programmed corners) against trapezoidal %.3f s (%.4f mm): %.3f x the "
            "time\n", tols[_i], sj.t_s, r, wj.dev_mm, st.t_s, wt.dev_mm, sj.t_s / st.t_s);
     canon_prog_free(&p);
+}
+END_TEST
+
+/* [TRAJ] JERK_WINDOW half the full window: the legs' acceleration lowered to 500 mm/s^2,
+ * every jerk still kept in every period (differenced), the tool within P of the blended
+ * zigzag and within KINEMATIC_TOLERANCE of the G61 square. The shorter average rounds the
+ * corners less, so the zigzag runs faster than with the full window; the square, where the
+ * legs bind, shows what the lowered acceleration costs. */
+START_TEST(test_jerk_window)
+{
+    struct canon_prog z, q;
+    zigzag(&z, 0.01);
+    square(&q);
+    struct watch w0 = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
+    struct watch wz = w0, wz1 = w0, wq = w0, wq1 = w0;
+    struct tm_stats sz = run(2, &z, &wz, 1), sz1 = run(1, &z, &wz1, 0);
+    struct tm_stats sq = run(2, &q, &wq, 1), sq1 = run(1, &q, &wq1, 0);
+    ck_assert_int_eq(sz.last.state, MOTION_DONE);
+    ck_assert_int_eq(sq.last.state, MOTION_DONE);
+    double rz = assert_limits(&sz, "zigzag, window"), rq = assert_limits(&sq, "square, window");
+    double az = 0, aq = 0;
+    for (int j = 0; j < 6; j++) {
+        az = fmax(az, sz.max_leg_a[j]), aq = fmax(aq, sq.max_leg_a[j]);
+        ck_assert_msg(sz.max_leg_a[j] <= 500 * (1 + 1e-9) && sq.max_leg_a[j] <= 500 * (1 + 1e-9),
+                      "leg %d at %.3f and %.3f mm/s^2 with its acceleration lowered to 500", j,
+                      sz.max_leg_a[j], sq.max_leg_a[j]);
+    }
+    ck_assert_msg(wz.dev_mm <= 0.01, "the tool strays %.5f mm from the zigzag", wz.dev_mm);
+    ck_assert_msg(wq.dev_mm <= 0.001, "the tool strays %.5f mm from the square", wq.dev_mm);
+    ck_assert_msg(sz.t_s < sz1.t_s, "the zigzag took %.3f s with the 20 ms window, %.3f s with "
+                  "the 40 ms one", sz.t_s, sz1.t_s);
+    printf("JERK_WINDOW 0.020: zigzag G64 P0.01 %.3f s against %.3f s with the full 40 ms "
+           "window (peak leg acceleration %.1f mm/s^2, jerk %.3f of the limit, %.4f mm from the "
+           "corners); G61 square %.3f s against %.3f s (%.1f mm/s^2, %.3f, %.5f mm)\n", sz.t_s,
+           sz1.t_s, az, rz, wz.dev_mm, sq.t_s, sq1.t_s, aq, rq, wq.dev_mm);
+    canon_prog_free(&z);
+    canon_prog_free(&q);
 }
 END_TEST
 
@@ -539,6 +632,7 @@ int main(void)
     tcase_add_loop_test(tc, test_blended_corners, 0, 2);
     tcase_add_loop_test(tc, test_arc_line_corners, 0, 2);
     tcase_add_test(tc, test_two_arcs);
+    tcase_add_test(tc, test_jerk_window);
     tcase_add_test(tc, test_synced_outputs);
     tcase_add_test(tc, test_synced_spindle_coolant);
     suite_add_tcase(s, tc);

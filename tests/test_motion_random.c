@@ -61,7 +61,8 @@ static void operate(struct tm_operator *op, long n, const struct motion_out *o,
 }
 
 /* The machine of case k: the TMU hexapod or the leg-bound one, with jerk limits on odd
- * cases (a 20 ms average on the leg-bound machine, 40 ms on the TMU's). */
+ * cases (a 20 ms average on the leg-bound machine, 40 ms on the TMU's; half that with
+ * HEXCNC_RANDOM_WINDOW=1, as [TRAJ] JERK_WINDOW, the accelerations lowered to match). */
 static struct tk_cfg *case_cfg(int k)
 {
     int legs = (k / 2) % 2, jerk = k % 2;
@@ -71,6 +72,8 @@ static struct tk_cfg *case_cfg(int k)
         tm_set_jerk(c, 500000, 200000, 20000);
     else if (jerk)
         tm_set_jerk(c, 50000, 30000, 50000);
+    if (jerk && getenv("HEXCNC_RANDOM_WINDOW"))
+        tk_setf(c, "TRAJ", "JERK_WINDOW", legs ? 0.010 : 0.020);
     return c;
 }
 

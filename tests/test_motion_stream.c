@@ -1,6 +1,7 @@
 /* test_motion_stream.c: a program planned window by window while it runs (motion_stream.c)
  * against the same program planned whole (motion_load), trapezoidal (loop 0) and with jerk
- * limits (loop 1: every leg's jerk within MAX_JERK, streamed as whole). */
+ * limits (loop 1: every leg's jerk within MAX_JERK, streamed as whole; the first test also
+ * loop 2, with [TRAJ] JERK_WINDOW). */
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
@@ -13,13 +14,16 @@
 #define LEG_JERK 200000.0      /* mm/s^3, loop 1: a 10 ms moving average (test_motion_jerk
                                 * has the 40 ms one; this keeps the sanitizer run short) */
 
-/* The TMU hexapod, with jerk limits when jerk (the test's loop index) is 1. */
+/* The TMU hexapod, with jerk limits when jerk (the test's loop index) is 1 or 2; 2 adds
+ * [TRAJ] JERK_WINDOW 0.005 s, half the legs' 10 ms, their acceleration lowered to 500. */
 static struct tk_cfg *stream_cfg(int jerk)
 {
     struct tk_cfg *c = tm_hexapod_cfg();
     if (!c || !jerk)
         return c;
     tm_set_jerk(c, LEG_JERK, 120000, LEG_JERK);
+    if (jerk == 2)
+        tk_setf(c, "TRAJ", "JERK_WINDOW", 0.005);
     return c;
 }
 
@@ -139,6 +143,10 @@ START_TEST(stream_matches_whole_plan)
         ck_assert_double_le(ss.max_leg_a[j], fmax(1000, sw.max_leg_a[j]) * 1.01);
         if (_i)
             ck_assert_double_le(ss.max_leg_j[j], LEG_JERK * (1 + 1e-9));
+        if (_i == 2) {           /* the window's lowered acceleration, streamed and whole */
+            ck_assert_double_le(ss.max_leg_a[j], 500 * (1 + 1e-9));
+            ck_assert_double_le(sw.max_leg_a[j], 500 * (1 + 1e-9));
+        }
     }
     ck_assert_uint_eq(ss.last.settings_done, 6);           /* 9000 / 1500 */
     ck_assert_uint_eq(sw.last.settings_done, 6);
@@ -402,7 +410,7 @@ int main(void)
     Suite *s = suite_create("motion_stream");
     TCase *tc = tcase_create("stream");
     tcase_set_timeout(tc, 300);
-    tcase_add_loop_test(tc, stream_matches_whole_plan, 0, 2);
+    tcase_add_loop_test(tc, stream_matches_whole_plan, 0, 3);
     tcase_add_loop_test(tc, stream_starved_stops_on_path, 0, 2);
     tcase_add_loop_test(tc, stream_pause_resume_abort, 0, 2);
     tcase_add_loop_test(tc, stream_check_reports_line, 0, 2);
