@@ -115,8 +115,14 @@ def tap_run(tmp):
     index = [r[4] for r in rows]
     # the index handshake: set before each synchronised move, cleared by the encoder in the
     # period it met its index, its count then within a period's turn (0.01 rev) of 0 (four
-    # moves: the tap, two G33 passes, the MDI tap; the count may already stand at 0 there)
-    cleared = [i for i in range(1, len(rows)) if index[i - 1] == 1 and index[i] == 0]
+    # moves: the tap, two G33 passes, the MDI tap; the count may already stand at 0 there).
+    # The sampler runs after motion and sim-spindle: where the encoder meets its index in
+    # the very period motion sets the pin, the pin is cleared before it is sampled and only
+    # the count's jump to 0 shows the handshake (one period's turn in a hundred: the MDI
+    # tap's spindle phase depends on when the client sends it)
+    cleared = [i for i in range(1, len(rows)) if index[i - 1] == 1 and index[i] == 0 or
+               index[i - 1] == 0 and index[i] == 0 and abs(revs[i]) <= 0.0101 and
+               abs(revs[i] - revs[i - 1]) > 0.5]
     print("     index-enable cleared at periods %s, the count there %s" % (
         cleared, ["%.4f" % revs[i] for i in cleared]))
     check("spindle.0.index-enable was set before each synchronised move and cleared by the "
