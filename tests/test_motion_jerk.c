@@ -152,6 +152,14 @@ static double assert_limits(const struct tm_stats *st, const char *what)
     return worst;
 }
 
+/* The motion configuration of table t into c: MOTION_OK or the error, said in err. */
+static int read_cfg(struct tk_cfg *t, struct motion_config *c, char *err, size_t errlen)
+{
+    struct kins_config kc = tk_config(t);
+    motion_config_default(c);
+    return motion_config_read(c, &kc, 6, err, errlen);
+}
+
 START_TEST(test_config)
 {
     struct kins *k;
@@ -160,42 +168,31 @@ START_TEST(test_config)
     struct tk_cfg *t = jerk_cfg(1);
     struct kins_config kc = tk_config(t);
     ck_assert_int_eq(kins_create(&kins_hexapod_ops, &kc, &k, err, sizeof err), 0);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
     /* the longest of 2 a / j: the legs' 2 x 1000 / 50000 */
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.040, 1e-12);
     tk_set(t, "JOINT_4", "MAX_JERK", NULL);     /* JOINT_4's MAX_JERK gone */
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "[JOINT_4] MAX_JERK: missing"), "%s", err);
     free(t);
     /* a jerk so low that the average would be longer than a second */
     t = jerk_cfg(1);
     tk_set(t, "JOINT_2", "MAX_JERK", "1000");
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "2.000 s moving average"), "%s", err);
     free(t);
     /* none: trapezoidal, no average */
     t = jerk_cfg(0);
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq(motion_jerk_window_s(&c), 0);
     /* a window without jerk limits is refused, not ignored */
     tk_setf(t, "TRAJ", "JERK_WINDOW", 0.02);
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_ERR_CONFIG);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "[TRAJ] JERK_WINDOW = 0.02 s: only with jerk limits"), "%s", err);
     free(t);
     /* a shorter window: every acceleration lowered to jerk x window / 2 where it is above */
     t = jerk_cfg(2);
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
     ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.040, 1e-12);
     struct motion_config shared = c;
@@ -212,9 +209,7 @@ START_TEST(test_config)
     motion_destroy(mo);
     /* rounded up to whole servo periods, never shorter than asked */
     tk_setf(t, "TRAJ", "JERK_WINDOW", 0.0205);
-    kc = tk_config(t);
-    motion_config_default(&c);
-    ck_assert_int_eq(motion_config_read(&c, &kc, 6, err, sizeof err), MOTION_OK);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.021, 1e-12);
     /* longer than the full acceleration needs, or shorter than two periods: refused */
     static const struct { const char *v, *msg; } bad[] = {
