@@ -72,6 +72,9 @@ struct check_leg {
     double peak_acc_mm_s2;           /* largest |change of rate| per period, mm/s^2 */
     double peak_jerk_mm_s3;          /* largest |change of acceleration| per period, mm/s^3 */
     double limit_jerk_mm_s3;         /* [JOINT_n] MAX_JERK, mm/s^3 (0: none) */
+    double planned_acc_mm_s2;        /* the acceleration motion plans the leg to: its
+                                      * MAX_ACCELERATION, or under [TRAJ] JERK_WINDOW
+                                      * MAX_JERK x window / 2 where lower */
     double limit_min_mm, limit_max_mm, limit_vel_mm_s, limit_acc_mm_s2; /* from the INI */
     const char *vel_key, *acc_key;   /* the INI keys of the rate limits: MAX_VELOCITY, or
                                       * STEPGEN_MAXVEL when the drive's limit is lower */
@@ -130,6 +133,9 @@ struct check_result {
                                       * period from the commanded pose */
     int max_tip_deviation_line;
     double kin_tol_mm;               /* [TRAJ] KINEMATIC_TOLERANCE, for reference */
+    double jerk_window_s;            /* the jerk limits' moving average, s (0: no jerk
+                                      * limits); jerk_window_set: from [TRAJ] JERK_WINDOW */
+    int jerk_window_set;
     long deviation_evals;            /* forward solves spent on the deviation */
     double max_condition;            /* largest condition number seen */
     int max_condition_line;

@@ -54,6 +54,7 @@ static void json_legs(const struct check_result *r, FILE *f)
         json_field(f, "limit_max_mm", l->limit_max_mm, 0);
         json_field(f, "limit_vel_mm_s", l->limit_vel_mm_s, 0);
         json_field(f, "limit_acc_mm_s2", l->limit_acc_mm_s2, 0);
+        json_field(f, "planned_acc_mm_s2", l->planned_acc_mm_s2, 0);
         fputs(",\"limit_vel_key\":", f);
         json_str(f, l->vel_key ? l->vel_key : "");
         fputs(",\"limit_acc_key\":", f);
@@ -96,6 +97,7 @@ void check_print_json(const struct check_result *r, FILE *f)
     json_field(f, "machining_time_s", r->machining_time_s, 0);
     json_field(f, "planned_time_s", r->planned_time_s, 0);
     json_field(f, "length_mm", r->length_mm, 0);
+    json_field(f, "jerk_window_s", r->jerk_window_s, 0);
     if (r->tip_measured) {
         json_field(f, "tip_deviation_mm", r->max_tip_deviation_mm, 0);
         fprintf(f, ",\"tip_deviation_line\":%d", r->max_tip_deviation_line);
@@ -138,6 +140,30 @@ static void print_duration(FILE *f, double s)
         fprintf(f, "%.3f s", s);
 }
 
+/* With jerk limits, the moving average's length and where it comes from; under [TRAJ]
+ * JERK_WINDOW, the legs' accelerations it lowers (the range over the legs). */
+static void print_jerk(const struct check_result *r, FILE *f)
+{
+    if (!(r->jerk_window_s > 0))
+        return;
+    fprintf(f, "jerk            a %g ms moving average of the set points (%s)", r->jerk_window_s
+            * 1e3, r->jerk_window_set ? "[TRAJ] JERK_WINDOW" : "2 x acceleration / jerk");
+    double lo = HUGE_VAL, hi = 0;
+    int lowered = 0;
+    for (int i = 0; i < r->njoints; i++) {
+        const struct check_leg *l = &r->leg[i];
+        lo = fmin(lo, l->planned_acc_mm_s2), hi = fmax(hi, l->planned_acc_mm_s2);
+        lowered |= l->planned_acc_mm_s2 < l->limit_acc_mm_s2;
+    }
+    if (r->jerk_window_set && lowered && lo == hi)
+        fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
+                "%g mm/s^2", lo);
+    else if (r->jerk_window_set && lowered)
+        fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
+                "%g..%g mm/s^2", lo, hi);
+    fputc('\n', f);
+}
+
 /* The short table for people. */
 void check_print_table(const struct check_result *r, FILE *f)
 {
@@ -159,8 +185,10 @@ void check_print_table(const struct check_result *r, FILE *f)
         snprintf(moved, sizeof moved, " %g mm or %g deg on from the last", CHECK_COND_STEP_MM,
                  CHECK_COND_STEP_DEG);
         schedule(when, sizeof when, r->condition_every_s, moved);
-        fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n\n",
+        fprintf(f, "condition       %.3f max (line %d), limit %.1f; measured %s\n",
                 r->max_condition, r->max_condition_line, r->condition_limit, when);
+        print_jerk(r, f);
+        fputc('\n', f);
         int jerk = r->njoints > 0 && r->leg[0].limit_jerk_mm_s3 > 0;
         fprintf(f, "leg   min mm     max mm     range mm         peak mm/s  limit   "
                 "peak mm/s^2  limit%s\n", jerk ? "    peak mm/s^3     limit" : "");

@@ -624,11 +624,14 @@ static void measures(struct sim *s, const struct motion_out *out)
 static void leg_limits(struct sim *s)
 {
     const struct kins *k = s->mc->kins;
+    struct motion_config planned = s->mc->mcfg;
+    motion_jerk_share(&planned);     /* what motion plans to (lower under JERK_WINDOW) */
     for (int i = 0; i < s->nj; i++) {
         struct check_leg *lg = &s->r->leg[i];
         lg->limit_min_mm = k->joint_min[i], lg->limit_max_mm = k->joint_max[i];
         lg->limit_vel_mm_s = s->mc->mcfg.joint[i].max_vel_mm_s;
         lg->limit_acc_mm_s2 = s->mc->mcfg.joint[i].max_acc_mm_s2;
+        lg->planned_acc_mm_s2 = planned.joint[i].max_acc_mm_s2;
         lg->vel_key = "MAX_VELOCITY", lg->acc_key = "MAX_ACCELERATION";
         /* a step generator slower than the planner's limit cannot follow: check against it */
         if (s->mc->drive_vel[i] > 0 && s->mc->drive_vel[i] < lg->limit_vel_mm_s)
