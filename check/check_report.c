@@ -141,7 +141,7 @@ static void print_duration(FILE *f, double s)
 }
 
 /* With jerk limits, the moving average's length and where it comes from; under [TRAJ]
- * JERK_WINDOW, the legs' accelerations it lowers (the range over the legs). */
+ * JERK_WINDOW, the accelerations motion plans the legs to (the range over the legs). */
 static void print_jerk(const struct check_result *r, FILE *f)
 {
     if (!(r->jerk_window_s > 0))
@@ -149,16 +149,14 @@ static void print_jerk(const struct check_result *r, FILE *f)
     fprintf(f, "jerk            a %g ms moving average of the set points (%s)", r->jerk_window_s
             * 1e3, r->jerk_window_set ? "[TRAJ] JERK_WINDOW" : "2 x acceleration / jerk");
     double lo = HUGE_VAL, hi = 0;
-    int lowered = 0;
     for (int i = 0; i < r->njoints; i++) {
         const struct check_leg *l = &r->leg[i];
         lo = fmin(lo, l->planned_acc_mm_s2), hi = fmax(hi, l->planned_acc_mm_s2);
-        lowered |= l->planned_acc_mm_s2 < l->limit_acc_mm_s2;
     }
-    if (r->jerk_window_set && lowered && lo == hi)
+    if (r->jerk_window_set && lo == hi)
         fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
                 "%g mm/s^2", lo);
-    else if (r->jerk_window_set && lowered)
+    else if (r->jerk_window_set)
         fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
                 "%g..%g mm/s^2", lo, hi);
     fputc('\n', f);
