@@ -2,6 +2,7 @@
 # A misspelt key in a machine's INI stops `hexcnc run`, `check`, `kins`, `interp -i` and
 # `halcmd -i` before anything starts, naming file, line and the closest known key; a missing
 # leg limit is named too. Before, MAX_VELOCTY = 20 silently left the leg at 100 mm/s.
+# `hexcnc ini check` finds the same, and what only keys together say (the jerk limits).
 root=${HEXCNC_ROOT:-.}
 bin=${HEXCNC_BIN:-$root/bin/hexcnc}
 tmp=$(mktemp -d) || exit 1
@@ -39,5 +40,31 @@ else bad "missing MAX_VELOCITY:"; cat "$tmp/out"; fi
 # The good file still runs.
 if "$bin" check "$tmp/good.ini" "$prog" > "$tmp/out" 2>&1; then ok "the good copy checks"
 else bad "the good copy:"; cat "$tmp/out"; fi
+# `hexcnc ini check`: quiet and 0 on the good copy; the misspelt key named with its line;
+# and what only keys together say, found by building the machine as `hexcnc check` does:
+# jerk limits on the path but not on the legs, and a JERK_WINDOW longer than they need.
+if "$bin" ini check "$tmp/good.ini" > "$tmp/out" 2>&1 && [ ! -s "$tmp/out" ]; then
+    ok "ini check passes the good copy, quietly"
+else bad "ini check on the good copy:"; cat "$tmp/out"; fi
+"$bin" ini check "$tmp/typo.ini" > "$tmp/out" 2>&1 && bad "ini check passed the typo"
+if grep -qF "$want" "$tmp/out"; then ok "ini check names file, line and MAX_VELOCITY"
+else bad "ini check on the typo:"; cat "$tmp/out"; fi
+sed 's/^MAX_ANGULAR_ACCELERATION.*/&\nMAX_LINEAR_JERK = 50000\nMAX_ANGULAR_JERK = 30000/' \
+    "$tmp/good.ini" > "$tmp/jerk_path.ini"
+"$bin" ini check "$tmp/jerk_path.ini" > "$tmp/out" 2>&1 && bad "ini check passed half the jerk limits"
+if grep -qF "$tmp/jerk_path.ini: [JOINT_0] MAX_JERK: missing; jerk limits are all set" "$tmp/out"
+then ok "ini check: jerk limits on the path only, the legs' missing one named"
+else bad "ini check on half the jerk limits:"; cat "$tmp/out"; fi
+sed 's/^MAX_ACCELERATION.*/&\nMAX_JERK = 50000/; s/^MAX_LINEAR_JERK.*/&\nJERK_WINDOW = 0.05/' \
+    "$tmp/jerk_path.ini" > "$tmp/window.ini"
+line=$(grep -n '^JERK_WINDOW' "$tmp/window.ini" | cut -d: -f1)
+"$bin" ini check "$tmp/window.ini" > "$tmp/out" 2>&1 && bad "ini check passed a long window"
+if grep -qF "$tmp/window.ini:$line: [TRAJ] JERK_WINDOW = 0.05 s: longer than the 0.0400 s" \
+   "$tmp/out"; then ok "ini check: JERK_WINDOW longer than the jerk limits need, with its line"
+else bad "ini check on a long window:"; cat "$tmp/out"; fi
+sed 's/^JERK_WINDOW = 0.05$/JERK_WINDOW = 0.02/' "$tmp/window.ini" > "$tmp/window2.ini"
+if "$bin" ini check "$tmp/window2.ini" > "$tmp/out" 2>&1 && [ ! -s "$tmp/out" ]; then
+    ok "ini check passes a 20 ms window"
+else bad "ini check on a 20 ms window:"; cat "$tmp/out"; fi
 [ $fail -eq 0 ] && echo "ini_check_cli: $pass passed" && exit 0
 echo "ini_check_cli: $fail failed"; exit 1
