@@ -225,10 +225,13 @@ const char *inifile_config_get(void *ctx, const char *section, const char *key)
 /* Prefixes a message with the file and, when it starts with a key of the file, its line. */
 char *inifile_locate_msg(const struct inifile *ini, const char *msg, char *out, size_t len)
 {
-    char section[64], key[64];
+    char section[64], key[64] = "";
     int line = 0;
     if (sscanf(msg, "[%63[^]]] %63[^ :=]", section, key) == 2)
         line = inifile_line(ini, section, key);
+    for (size_t i = 0; line == 0 && key[0] && i < ini->n; i++)
+        if (!strcmp(ini->items[i].section, section))    /* a missing key: its section's */
+            line = ini->items[i].line;                   /* first line, as config_check */
     if (!ini->path)
         snprintf(out, len, "%s", msg);
     else if (line > 0)

@@ -63,8 +63,9 @@ int inifile_api_socket(const char *value, const char *dir, char *out, size_t len
 const char *inifile_config_get(void *ctx, const char *section, const char *key);
 
 /* Points a message about a key at its line: a msg that starts "[SECTION] KEY" (followed by
- * ':', ' ' or '=') naming a key of the file becomes "PATH:LINE: msg"; any other becomes
- * "PATH: msg" ("msg" alone when nothing is loaded). Returns out. */
+ * ':', ' ' or '=') naming a key of the file becomes "PATH:LINE: msg"; naming a key the file
+ * lacks in a section it has, the section's first line (where config_check puts a missing
+ * key); any other becomes "PATH: msg" ("msg" alone when nothing is loaded). Returns out. */
 char *inifile_locate_msg(const struct inifile *ini, const char *msg, char *out, size_t len);
 
 #endif

@@ -101,8 +101,12 @@ START_TEST(messages_point_at_the_key)
     snprintf(want, sizeof want, "%s:5: [RS274NGC] FEED_UNITS = furlongs: use mm/min", path);
     ck_assert_str_eq(inifile_locate_msg(&ini, "[RS274NGC] FEED_UNITS = furlongs: use mm/min",
                                         out, sizeof out), want);
-    snprintf(want, sizeof want, "%s: [KINS] BASE_RADIUS: missing", path);
+    snprintf(want, sizeof want, "%s: [KINS] BASE_RADIUS: missing", path);   /* no [KINS] */
     ck_assert_str_eq(inifile_locate_msg(&ini, "[KINS] BASE_RADIUS: missing", out, sizeof out),
+                     want);
+    /* a key missing from a section the file has: the section's first line */
+    snprintf(want, sizeof want, "%s:2: [JOINT_3] MAX_JERK: missing", path);
+    ck_assert_str_eq(inifile_locate_msg(&ini, "[JOINT_3] MAX_JERK: missing", out, sizeof out),
                      want);
     snprintf(want, sizeof want, "%s: no kinematics", path);
     ck_assert_str_eq(inifile_locate_msg(&ini, "no kinematics", out, sizeof out), want);
