@@ -14,21 +14,10 @@
 #include "interp/interp.h"
 #include "motion/motion_hal.h"
 #include "sim/modbus_sim.h"
+#include "tests/test_net_util.h"
 
 #define PERIOD_NS 1000000L
 #define NLEGS 6
-
-/* A free loopback port: bound to port 0, read, released. */
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in sa = { .sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK) };
-    ck_assert_int_eq(bind(fd, (struct sockaddr *)&sa, sizeof(sa)), 0);
-    socklen_t sl = sizeof(sa);
-    getsockname(fd, (struct sockaddr *)&sa, &sl);
-    close(fd);
-    return ntohs(sa.sin_port);
-}
 
 /* The configuration's INI with a free port per drive appended ([MODBUS_DRIVE_n] PORT wins
  * over [MODBUS] BASE_PORT), so parallel test runs never share the example's ports. */
@@ -43,8 +32,10 @@ static void ini_with_free_ports(const char *ini, char *out, size_t len)
     while (fgets(line, sizeof line, src))
         fputs(line, dst);
     fclose(src);
+    int ports[NLEGS];
+    ck_assert_int_eq(tn_free_ports(ports, NLEGS), 0);
     for (int i = 0; i < NLEGS; i++)
-        fprintf(dst, "\n[MODBUS_DRIVE_%d]\nPORT = %d\n", i, free_port());
+        fprintf(dst, "\n[MODBUS_DRIVE_%d]\nPORT = %d\n", i, ports[i]);
     fclose(dst);
 }
 

@@ -11,6 +11,7 @@
 #include "hal/hal.h"
 #include "tests/test_hal_util.h"
 #include "sim/modbus_sim.h"
+#include "tests/test_net_util.h"
 
 #define NDRIVES 6
 #define PERIOD_NS 1000000L          /* servo period */
@@ -39,20 +40,10 @@ static void write_ini(char *buf, size_t len, const int *ports, const char *extra
     fclose(f);
 }
 
-/* Six free loopback ports: bound once to port 0, read, released. */
+/* Six free loopback ports (test_net_util.h). */
 static void free_ports(int *ports)
 {
-    int fds[NDRIVES];
-    for (int i = 0; i < NDRIVES; i++) {
-        fds[i] = socket(AF_INET, SOCK_STREAM, 0);
-        struct sockaddr_in sa = { .sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK) };
-        ck_assert_int_eq(bind(fds[i], (struct sockaddr *)&sa, sizeof(sa)), 0);
-        socklen_t sl = sizeof(sa);
-        getsockname(fds[i], (struct sockaddr *)&sa, &sl);
-        ports[i] = ntohs(sa.sin_port);
-    }
-    for (int i = 0; i < NDRIVES; i++)
-        close(fds[i]);
+    ck_assert_int_eq(tn_free_ports(ports, NDRIVES), 0);
 }
 
 /* The leg command of drive i at servo period k: a 2 Hz sine of 5 mm around 600 + 10 i. */

@@ -11,6 +11,7 @@
 
 #include "hal/hal.h"
 #include "sim/modbus_sim.h"
+#include "tests/test_net_util.h"
 #include "task/runner.h"
 
 #define NLEGS 6
@@ -160,18 +161,6 @@ START_TEST(can_ready_but_estop)
 }
 END_TEST
 
-/* A free loopback port: bound to port 0, read, released. */
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in sa = { .sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK) };
-    ck_assert_int_eq(bind(fd, (struct sockaddr *)&sa, sizeof(sa)), 0);
-    socklen_t sl = sizeof(sa);
-    getsockname(fd, (struct sockaddr *)&sa, &sl);
-    close(fd);
-    return ntohs(sa.sin_port);
-}
-
 /* A Modbus drive that does not answer at start: six simulated drives in this process (the
  * HAL file's own simulator left out), drive 2 reads requests and never answers. The run
  * stops before motion with the drive, its address, unit and the cause. */
@@ -183,8 +172,10 @@ START_TEST(modbus_no_answer_at_start)
     struct modbus_sim *sim;
     ck_assert_int_eq(modbus_sim_create(&sim, NLEGS, &so), MODBUS_SIM_OK);
     char tail[512] = "", item[64], ini[1024], hal_copy[1100], hal_src[1024], line[1024];
+    int ports[NLEGS];
+    ck_assert_int_eq(tn_free_ports(ports, NLEGS), 0);
     for (int i = 0; i < NLEGS; i++) {
-        int port = free_port();
+        int port = ports[i];
         ck_assert_int_eq(modbus_sim_start_tcp_port(sim, i, "127.0.0.1", port), MODBUS_SIM_OK);
         snprintf(item, sizeof item, "\n[MODBUS_DRIVE_%d]\nPORT = %d\n", i, port);
         strcat(tail, item);

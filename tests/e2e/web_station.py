@@ -52,11 +52,29 @@ def wait_until(fn, timeout=30.0, step=0.05):
 
 
 def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    p = s.getsockname()[1]
-    s.close()
-    return p
+    """A free loopback port below the kernel's ephemeral range: a port from bind(0) is an
+    ephemeral one, which an outgoing connection (the browser's, anything's) may be given
+    before the station binds it (tests/test_net_util.h does the same for the C tests)."""
+    low = 32768
+    try:
+        with open("/proc/sys/net/ipv4/ip_local_port_range") as f:
+            low = int(f.read().split()[0])
+    except (OSError, ValueError, IndexError):
+        pass
+    first = 10000
+    span = low - first
+    start = first + (os.getpid() * 7919 + int(time.time())) % span
+    for i in range(span):
+        p = first + (start - first + i) % span
+        s = socket.socket()
+        try:
+            s.bind(("127.0.0.1", p))
+            return p
+        except OSError:
+            continue
+        finally:
+            s.close()
+    raise RuntimeError("no free port below %d" % low)
 
 
 def session_call(sock, method, **params):
