@@ -3,7 +3,7 @@
 
 # free_base_port N: prints a port P such that no TCP socket of this machine (ss, iproute2)
 # uses P..P+N-1, taken from 20000..32000, below the kernel's ephemeral ports (32768 and up)
-# that clients and the C tests' port-0 binds use. The first guess comes from the shell's pid
+# that clients use, and above the 10000..19999 of the C and Python tests (test_net_util.h). The first guess comes from the shell's pid
 # so parallel runs do not start from the same one. (fb_ prefix: shell functions share the
 # caller's variables.)
 free_base_port()

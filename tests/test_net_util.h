@@ -15,9 +15,11 @@
  * connection of any program takes one between this test choosing it and its server binding
  * it: a port from bind(0) is an ephemeral one, and a client connecting in the meantime
  * (the test's own drives, or anything else on the machine) could be given the same number,
- * and the server then cannot listen there. Each candidate is bound (without SO_REUSEADDR, so
- * one still in TIME_WAIT is passed over too) and all are held until n are found, so they
- * differ; the start is spread by process and time so that parallel runs seldom meet.
+ * and the server then cannot listen there. They are taken from 10000 .. 19999 (the Modbus
+ * shell tests take theirs from 20000 .. 32000, modbus_test_lib.sh). Each candidate is bound
+ * (without SO_REUSEADDR, so one still in TIME_WAIT is passed over too) and all are held
+ * until n are found, so they differ; the start is spread by process and time so that
+ * parallel runs seldom meet.
  */
 static inline int tn_free_ports(int *ports, int n)
 {
@@ -28,12 +30,13 @@ static inline int tn_free_ports(int *ports, int n)
             low = 32768;
         fclose(f);
     }
-    const int first = 10000;                     /* above the well-known and registered few */
-    if (low - first < 1000 || n < 1 || n > 64)
+    const int first = 10000, end = low < 20000 ? low : 20000;
+    (void)high;
+    if (end - first < 1000 || n < 1 || n > 64)
         return -1;
-    int span = low - first, fds[64], found = 0;
+    int span = end - first, fds[64], found = 0;
     int p = first + (int)(((unsigned)getpid() * 7919u + (unsigned)time(NULL)) % (unsigned)span);
-    for (int tried = 0; tried < span && found < n; tried++, p = p + 1 < low ? p + 1 : first) {
+    for (int tried = 0; tried < span && found < n; tried++, p = p + 1 < end ? p + 1 : first) {
         int fd = socket(AF_INET, SOCK_STREAM, 0);
         struct sockaddr_in sa = { .sin_family = AF_INET, .sin_port = htons((uint16_t)p),
                                   .sin_addr.s_addr = htonl(INADDR_LOOPBACK) };
