@@ -23,15 +23,14 @@
  */
 static inline int tn_free_ports(int *ports, int n)
 {
-    int low = 32768, high = 60999;
+    int low = 32768;             /* the ephemeral range's first port */
     FILE *f = fopen("/proc/sys/net/ipv4/ip_local_port_range", "r");
     if (f) {
-        if (fscanf(f, "%d %d", &low, &high) != 2)
+        if (fscanf(f, "%d", &low) != 1)
             low = 32768;
         fclose(f);
     }
     const int first = 10000, end = low < 20000 ? low : 20000;
-    (void)high;
     if (end - first < 1000 || n < 1 || n > 64)
         return -1;
     int span = end - first, fds[64], found = 0;
