@@ -153,12 +153,11 @@ static void print_jerk(const struct check_result *r, FILE *f)
         const struct check_leg *l = &r->leg[i];
         lo = fmin(lo, l->planned_acc_mm_s2), hi = fmax(hi, l->planned_acc_mm_s2);
     }
-    if (r->jerk_window_set && lo == hi)
+    char legs[64];
+    snprintf(legs, sizeof legs, lo == hi ? "%g" : "%g..%g", lo, hi);
+    if (r->jerk_window_set)
         fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
-                "%g mm/s^2", lo);
-    else if (r->jerk_window_set)
-        fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
-                "%g..%g mm/s^2", lo, hi);
+                "%s mm/s^2", legs);
     fputc('\n', f);
 }
 

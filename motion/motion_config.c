@@ -183,12 +183,15 @@ static int check_jerk(const struct motion_config *c, char *err, size_t errlen)
     }
     if (c->jerk_window_s != 0) {
         double full = motion_jerk_full_window_s(c);
-        if (set == 0 || !(c->jerk_window_s > 0)) {
-            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: %s", c->jerk_window_s,
-                     set == 0 ? "only with jerk limits ([TRAJ] MAX_LINEAR_JERK, "
-                                "MAX_ANGULAR_JERK and every [JOINT_n] MAX_JERK); without "
-                                "them motion is trapezoidal, with no moving average"
-                              : "must be positive");
+        if (set == 0) {
+            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: only with jerk limits ([TRAJ] "
+                     "MAX_LINEAR_JERK, MAX_ANGULAR_JERK and every [JOINT_n] MAX_JERK); without "
+                     "them motion is trapezoidal, with no moving average", c->jerk_window_s);
+            return MOTION_ERR_CONFIG;
+        }
+        if (!(c->jerk_window_s > 0)) {      /* (the INI's is refused at reading already) */
+            snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: must be positive",
+                     c->jerk_window_s);
             return MOTION_ERR_CONFIG;
         }
         if (c->jerk_window_s < 2 * c->servo_period_s - 1e-12) {

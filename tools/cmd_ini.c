@@ -23,16 +23,12 @@ static int ini_check_files(int argc, char **argv)
     for (int i = 0; i < argc; i++) {
         struct inifile ini = { 0 };
         char err[8192];
-        int machine = 0;
-        if (config_load(&ini, argv[i], err, sizeof err) != CONFIG_OK) {
-            fprintf(stderr, "%s\n", err);
-            bad = 1;
-        } else {
-            machine = inifile_get(&ini, "KINS", "KINEMATICS") != NULL;
-        }
+        int loaded = config_load(&ini, argv[i], err, sizeof err) == CONFIG_OK;
+        int machine = loaded && inifile_get(&ini, "KINS", "KINEMATICS") != NULL;
         inifile_free(&ini);
         struct check_machine *mc;
-        if (machine && check_machine_open(argv[i], &mc, err, sizeof err) != CHECK_OK) {
+        if (!loaded || (machine && check_machine_open(argv[i], &mc, err, sizeof err) !=
+                        CHECK_OK)) {
             fprintf(stderr, "%s\n", err);
             bad = 1;
         } else if (machine) {
