@@ -15,10 +15,11 @@
 #define LEG_JERK 50000.0       /* mm/s^3, [JOINT_n] MAX_JERK */
 #define LIN_JERK 50000.0       /* mm/s^3, [TRAJ] MAX_LINEAR_JERK */
 #define ANG_JERK 30000.0       /* deg/s^3, [TRAJ] MAX_ANGULAR_JERK */
-#define JERK_WINDOW 0.020      /* s, [TRAJ] JERK_WINDOW: half the legs' 2 x 1000 / 50000 */
+#define FULL_WINDOW (-1.0)     /* (check_one's window: the full one, every acceleration) */
 
 /* One check of prog on ini, trapezoidal (scale 0) or with the jerk limits above times
- * scale, and [TRAJ] JERK_WINDOW window (s; 0: none). */
+ * scale, and [TRAJ] JERK_WINDOW window (s; 0: none, the default window; FULL_WINDOW: the
+ * full one); the window motion used into *window_s. */
 static int check_one(const char *ini, const char *prog, double jerk, double window,
                      struct check_result *r, double *window_s)
 {
@@ -33,7 +34,8 @@ static int check_one(const char *ini, const char *prog, double jerk, double wind
         mc->mcfg.max_ang_jerk_deg_s3 = jerk * ANG_JERK;
         for (int i = 0; i < mc->mcfg.njoints; i++)
             mc->mcfg.joint[i].max_jerk_mm_s3 = jerk * LEG_JERK;
-        mc->mcfg.jerk_window_s = window;
+        mc->mcfg.jerk_window_s = window == FULL_WINDOW ? motion_jerk_full_window_s(&mc->mcfg)
+                                                       : window;
         motion_destroy(mc->motion);
         mc->motion = NULL;
         if (motion_create(&mc->mcfg, mc->kins, &mc->motion, err, sizeof err) != MOTION_OK) {
@@ -64,8 +66,8 @@ static void peaks(const struct check_result *r, double jerk_mm_s3, double out[3]
     }
 }
 
-/* Both checks of one program (the jerk limits times scale, [TRAJ] JERK_WINDOW window s or
- * none), one row. */
+/* Both checks of one program (the jerk limits times scale, [TRAJ] JERK_WINDOW window as
+ * check_one takes it), one row. */
 static int row(const char *label, const char *ini, const char *prog, double scale,
                double window)
 {
@@ -75,9 +77,10 @@ static int row(const char *label, const char *ini, const char *prog, double scal
         return -1;
     peaks(&t, scale * LEG_JERK, pt);
     peaks(&j, scale * LEG_JERK, pj);
-    printf("%-22s %9.3f s %9.3f s %6.3fx   %4.2f %4.2f %7.2f   %4.2f %4.2f %5.2f\n", label,
-           t.machining_time_s, j.machining_time_s, j.machining_time_s / t.machining_time_s,
-           pt[0], pt[1], pt[2], pj[0], pj[1], pj[2]);
+    printf("%-22s %9.3f s %9.3f s %6.3fx %4.0f ms   %4.2f %4.2f %7.2f   %4.2f %4.2f %5.2f\n",
+           label, t.machining_time_s, j.machining_time_s,
+           j.machining_time_s / t.machining_time_s, w1 * 1e3, pt[0], pt[1], pt[2], pj[0], pj[1],
+           pj[2]);
     check_result_free(&t);
     check_result_free(&j);
     return 0;
@@ -106,29 +109,35 @@ int main(int argc, char **argv)
         return 1;
     }
     printf("jerk limiting: [JOINT_n] MAX_JERK %.0f mm/s^3, [TRAJ] MAX_LINEAR_JERK %.0f mm/s^3, "
-           "MAX_ANGULAR_JERK %.0f deg/s^3 on the TMU's limits (a 40 ms moving average);\n"
+           "MAX_ANGULAR_JERK %.0f deg/s^3 on the TMU's limits, the default window (the "
+           "path's 2 x 500 / 50000 = 20 ms on the TMU, its legs' acceleration lowered to 500 "
+           "mm/s^2, their own 2 x 1000 / 50000 being 40 ms);\n"
            "peaks: the largest over the legs, differenced every servo period, as a ratio to "
            "the leg's limit (jerk: to %.0f mm/s^3 in both columns)\n\n", LEG_JERK, LIN_JERK,
            ANG_JERK, LEG_JERK);
-    printf("%-22s %11s %11s %7s   %-16s   %-16s\n", "program", "trapezoidal", "jerk-limited",
-           "ratio", "trap. v a j", "jerk-lim. v a j");
+    printf("%-22s %11s %11s %7s %7s   %-16s   %-16s\n", "program", "trapezoidal",
+           "jerk-limited", "ratio", "window", "trap. v a j", "jerk-lim. v a j");
     int fail = 0;
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
         fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, 0);
     char label[64];
     snprintf(label, sizeof label, "dense, %d blocks", blocks);
     fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, 0);
-    printf("\nthe same jerk limits with [TRAJ] JERK_WINDOW = %.3f (a %.0f ms moving average: "
-           "the legs' acceleration lowered to 50000 x %.3f / 2 = %.0f mm/s^2):\n", JERK_WINDOW,
-           JERK_WINDOW * 1e3, JERK_WINDOW, LEG_JERK * JERK_WINDOW / 2);
+    printf("\nthe same jerk limits with [TRAJ] JERK_WINDOW the full window (every acceleration "
+           "in full: on the TMU the legs' 40 ms):\n");
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
-        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, JERK_WINDOW);
-    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, JERK_WINDOW);
-    printf("\nthe same with 4 x the jerk limits (a 10 ms moving average; jerk to 200000 "
-           "mm/s^3):\n");
+        fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, FULL_WINDOW);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, FULL_WINDOW);
+    printf("\nthe same with 4 x the jerk limits (the default window, here the full 10 ms; "
+           "jerk to 200000 mm/s^3):\n");
     fail |= row("TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc",
                 4, 0);
     fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4, 0);
+    printf("\nthe same with 4 x the jerk limits and [TRAJ] JERK_WINDOW = 0.005 (the path's "
+           "own window, half the full one: the default shortens no window below 20 ms):\n");
+    fail |= row("TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc",
+                4, 0.005);
+    fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4, 0.005);
     unlink(dense);
     return fail ? 1 : 0;
 }

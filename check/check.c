@@ -171,6 +171,7 @@ void check_result_header(struct check_machine *mc, const struct check_opts *o,
     r->kin_tol_mm = mc->mcfg.kin_tol_mm;
     r->jerk_window_s = motion_jerk_window_s(&mc->mcfg);
     r->jerk_window_set = r->jerk_window_s > 0 && mc->mcfg.jerk_window_s > 0;
+    r->jerk_full_window_s = motion_jerk_full_window_s(&mc->mcfg);
     r->condition_limit = mc->cond_limit;
     r->deviation_every_s = o->deviation_every_s;
     r->condition_every_s = o->condition_every_s;

@@ -136,6 +136,7 @@ struct check_result {
     double jerk_window_s;            /* the jerk limits' moving average, s (0: no jerk
                                       * limits); jerk_window_set: from [TRAJ] JERK_WINDOW */
     int jerk_window_set;
+    double jerk_full_window_s;       /* the window with every acceleration in full, s */
     long deviation_evals;            /* forward solves spent on the deviation */
     double max_condition;            /* largest condition number seen */
     int max_condition_line;

@@ -98,6 +98,7 @@ void check_print_json(const struct check_result *r, FILE *f)
     json_field(f, "planned_time_s", r->planned_time_s, 0);
     json_field(f, "length_mm", r->length_mm, 0);
     json_field(f, "jerk_window_s", r->jerk_window_s, 0);
+    json_field(f, "jerk_full_window_s", r->jerk_full_window_s, 0);
     if (r->tip_measured) {
         json_field(f, "tip_deviation_mm", r->max_tip_deviation_mm, 0);
         fprintf(f, ",\"tip_deviation_line\":%d", r->max_tip_deviation_line);
@@ -140,14 +141,19 @@ static void print_duration(FILE *f, double s)
         fprintf(f, "%.3f s", s);
 }
 
-/* With jerk limits, the moving average's length and where it comes from; under [TRAJ]
- * JERK_WINDOW, the accelerations motion plans the legs to (the range over the legs). */
+/* With jerk limits, the moving average's length and where it comes from; where it is shorter
+ * than the full window, that one and the accelerations motion plans the legs to (the range
+ * over the legs). */
 static void print_jerk(const struct check_result *r, FILE *f)
 {
     if (!(r->jerk_window_s > 0))
         return;
-    fprintf(f, "jerk            a %g ms moving average of the set points (%s)", r->jerk_window_s
-            * 1e3, r->jerk_window_set ? "[TRAJ] JERK_WINDOW" : "2 x acceleration / jerk");
+    fprintf(f, "jerk            a %g ms moving average of the set points (%s", r->jerk_window_s
+            * 1e3, r->jerk_window_set ? "[TRAJ] JERK_WINDOW" : "the default");
+    if (r->jerk_window_s >= r->jerk_full_window_s) {
+        fputs("; every acceleration in full)\n", f);
+        return;
+    }
     double lo = HUGE_VAL, hi = 0;
     for (int i = 0; i < r->njoints; i++) {
         const struct check_leg *l = &r->leg[i];
@@ -155,10 +161,8 @@ static void print_jerk(const struct check_result *r, FILE *f)
     }
     char legs[64];
     snprintf(legs, sizeof legs, lo == hi ? "%g" : "%g..%g", lo, hi);
-    if (r->jerk_window_set)
-        fprintf(f, ": accelerations planned to MAX_JERK x window / 2 at most, the legs' to "
-                "%s mm/s^2", legs);
-    fputc('\n', f);
+    fprintf(f, "; %g ms with every acceleration in full): accelerations planned to MAX_JERK x "
+            "window / 2 at most, the legs' to %s mm/s^2\n", r->jerk_full_window_s * 1e3, legs);
 }
 
 /* The short table for people. */

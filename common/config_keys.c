@@ -154,10 +154,12 @@ const struct config_key config_keys[] = {
       "jerk-limited (docs/motion.md); all or none" },
     { "TRAJ", "MAX_ANGULAR_JERK", NUM, "deg/s^3", "> 0", 0, 0, "none (trapezoidal)", "jerk "
       "limit of each of A B C; all or none, with MAX_LINEAR_JERK" },
-    { "TRAJ", "JERK_WINDOW", NUM, "s", "> 0", 0, 0, "2 x acceleration / jerk", "the jerk "
-      "limits' moving average, shorter than the longest 2 x acceleration / jerk: every "
-      "acceleration is then lowered to jerk x window / 2; dense blended code runs faster, "
-      "ramps slower (docs/motion.md)" },
+    { "TRAJ", "JERK_WINDOW", NUM, "s", "> 0", 0, 0, "the path's 2 x acceleration / jerk",
+      "the jerk limits' moving average, up to the longest 2 x acceleration / jerk (every "
+      "acceleration in full); where shorter, each acceleration is lowered to jerk x window / "
+      "2: dense blended code runs faster, ramps slower. The default is the path's and A B C's "
+      "2 x acceleration / jerk, and a leg's with its acceleration taken no higher than "
+      "MAX_LINEAR_ACCELERATION (docs/motion.md)" },
     { "TRAJ", "NO_FORCE_HOMING", BOOL, "", "", 0, 0, "0", "1: programs and MDI may run "
       "before the legs are homed (the session, docs/machine.md)" },
     { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },

@@ -56,7 +56,8 @@ int motion_create(const struct motion_config *cfg, struct kins *k, struct motion
     m->have_tf = kins_get_tool_frame(k, &m->tf) == KINS_OK;
     m->nj = k->njoints;
     m->cfg.njoints = m->nj;
-    motion_jerk_share(&m->cfg);     /* [TRAJ] JERK_WINDOW: the leader's accelerations */
+    motion_jerk_share(&m->cfg);     /* (a window shorter than the full one: the leader's
+                                     * accelerations lowered, the window kept in the copy) */
     m->jerk_window_s = motion_jerk_window_s(&m->cfg);
     m->chord_period_s = motion_chord_period(&m->cfg);
     m->override_cmd = 1;

@@ -95,9 +95,10 @@ struct motion_config {
                                      * max_jerk_mm_s3 are set, off when none is */
     double max_ang_jerk_deg_s3;     /* [TRAJ] MAX_ANGULAR_JERK, deg/s^3; 0: none */
     double jerk_window_s;           /* [TRAJ] JERK_WINDOW, s: the jerk limits' moving average,
-                                     * shorter than 2 x acceleration / jerk, every
-                                     * acceleration then lowered to jerk x window / 2
-                                     * (motion_jerk_share); 0: that longest 2 a / j */
+                                     * up to the longest 2 x acceleration / jerk, every
+                                     * acceleration lowered to jerk x window / 2 where above
+                                     * (motion_jerk_share); 0: the default window
+                                     * (motion_jerk_default_window_s) */
     double default_lin_vel_mm_s;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY, mm/s: feed of a move
                                      * programmed before any F word (canon feed 0) */
     double kin_tol_mm;              /* [TRAJ] KINEMATIC_TOLERANCE, mm: largest deviation of the
@@ -139,10 +140,16 @@ double motion_jerk_window_s(const struct motion_config *c);
 /* The window in which every acceleration may be used in full: the longest 2 x acceleration /
  * jerk, s (0: jerk limiting off). [TRAJ] JERK_WINDOW may be shorter, not longer. */
 double motion_jerk_full_window_s(const struct motion_config *c);
-/* With [TRAJ] JERK_WINDOW set: lowers each acceleration limit of c (path, A B C, every leg)
- * to its jerk limit x the window / 2, so that the mean of that window keeps every jerk
- * limit. motion_create applies it to its own copy; the machine's limits (what a check
- * reports against) stay as configured. Nothing without the key. */
+/* The window without [TRAJ] JERK_WINDOW (not yet in whole periods), s: the path's and A B C's
+ * 2 x acceleration / jerk, and each leg's with its acceleration no higher than
+ * MAX_LINEAR_ACCELERATION, but no shorter than 20 ms or the full window, whichever is shorter
+ * (0: jerk limiting off). */
+double motion_jerk_default_window_s(const struct motion_config *c);
+/* Where the window (motion_jerk_window_s) is shorter than the full one: lowers each
+ * acceleration limit of c (path, A B C, every leg) to its jerk limit x the window / 2, so that
+ * the mean of that window keeps every jerk limit, and sets c's JERK_WINDOW to it.
+ * motion_create applies it to its own copy; the machine's limits (what a check reports
+ * against) stay as configured. Nothing where the window is the full one. */
 void motion_jerk_share(struct motion_config *c);
 
 struct motion;

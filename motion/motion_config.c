@@ -202,7 +202,7 @@ static int check_jerk(const struct motion_config *c, char *err, size_t errlen)
         if (c->jerk_window_s > full * (1 + 1e-9)) {
             snprintf(err, errlen, "[TRAJ] JERK_WINDOW = %g s: longer than the %.4f s in which "
                      "the jerk limits allow every acceleration in full (2 x acceleration / "
-                     "jerk); a longer window only rounds the path more: leave the key out",
+                     "jerk); a longer window only rounds the path more",
                      c->jerk_window_s, full);
             return MOTION_ERR_CONFIG;
         }

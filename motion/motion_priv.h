@@ -503,6 +503,10 @@ static inline bool motion_at_plan_pace(const struct motion *m)
 
 /* Jerk limiting (motion_jerk.c). The longest moving average allowed, s. */
 #define MOTION_JERK_MAX_S 1.0
+/* The shortest the default window shortens the full one to, s: below it the full window's
+ * rounding is small already, and the lowered accelerations cost more than a shorter window
+ * wins (motion_jerk_default_window_s). */
+#define MOTION_JERK_DEFAULT_MIN_S 0.020
 /* Allocates the moving average when the configuration limits jerk (m->jerk stays NULL when
  * it does not); MOTION_ERR_NOMEM with a message. */
 int motion_jerk_init(struct motion *m, char *err, size_t errlen);

@@ -521,7 +521,8 @@ START_TEST(test_strip_compensation)
 END_TEST
 
 /* The simulated TMU's INI with jerk limits (50,000 mm/s^3 on the path and the legs, 30,000
- * deg/s^3 on A B C: a 40 ms average) and, when window is given, [TRAJ] JERK_WINDOW window, in
+ * deg/s^3 on A B C: a 20 ms average by default, 40 ms for every acceleration in full) and,
+ * when window is given, [TRAJ] JERK_WINDOW window, in
  * dir (made here) beside a copy of its tool table; the INI's path into ini. */
 static void jerk_ini(char *dir, const char *window, char *ini, size_t len)
 {
@@ -560,23 +561,25 @@ static void jerk_ini_remove(const char *dir, const char *ini)
     ck_assert(unlink(ini) == 0 && unlink(path) == 0 && rmdir(dir) == 0);
 }
 
-/* The check under [TRAJ] JERK_WINDOW: the demo's legs, which reach their full 1000 mm/s^2 with
- * the 40 ms average, keep to the 500 the 20 ms one plans them to; the report names the
- * window and the lowered accelerations, and compares the legs with the machine's own
+/* The check with the default window and with [TRAJ] JERK_WINDOW the full one: the demo's
+ * legs, which reach their full 1000 mm/s^2 with the 40 ms average, keep to the 500 the
+ * default 20 ms one plans them to; the report names the window, where it comes from, the
+ * full one and the lowered accelerations, and compares the legs with the machine's own
  * limits. */
 START_TEST(test_jerk_window_reported)
 {
     char d20[] = "/tmp/hexcnc_check_jerk20XXXXXX", d40[] = "/tmp/hexcnc_check_jerk40XXXXXX";
     char i20[1100], i40[1100];
-    jerk_ini(d20, "0.020", i20, sizeof i20);
-    jerk_ini(d40, NULL, i40, sizeof i40);
+    jerk_ini(d20, NULL, i20, sizeof i20);
+    jerk_ini(d40, "0.040", i40, sizeof i40);
     struct check_result w, full;
     ck_assert_int_eq(run(i20, "configs/sim/tmu-hexapod-demo.ngc", NULL, &w), CHECK_OK);
     ck_assert_int_eq(run(i40, "configs/sim/tmu-hexapod-demo.ngc", NULL, &full), CHECK_OK);
     ck_assert_uint_eq(w.nproblems, 0);
     ck_assert_double_eq_tol(w.jerk_window_s, 0.020, 1e-12);
     ck_assert_double_eq_tol(full.jerk_window_s, 0.040, 1e-12);
-    ck_assert(w.jerk_window_set && !full.jerk_window_set);
+    ck_assert(!w.jerk_window_set && full.jerk_window_set);
+    ck_assert_double_eq_tol(w.jerk_full_window_s, 0.040, 1e-12);
     double pw = 0, pf = 0;
     for (int i = 0; i < 6; i++) {
         ck_assert_double_eq(w.leg[i].limit_acc_mm_s2, 1000);       /* the machine's */
@@ -586,7 +589,7 @@ START_TEST(test_jerk_window_reported)
         pw = fmax(pw, w.leg[i].peak_acc_mm_s2), pf = fmax(pf, full.leg[i].peak_acc_mm_s2);
     }
     ck_assert_msg(pw <= 500 * (1 + 1e-6) && pf > 900, "peak leg acceleration %.3f with the "
-                  "window, %.3f without", pw, pf);
+                  "default window, %.3f with the full one", pw, pf);
     ck_assert_msg(w.machining_time_s < full.machining_time_s, "%.3f s against %.3f s",
                   w.machining_time_s, full.machining_time_s);
     char *txt = NULL;
@@ -597,14 +600,15 @@ START_TEST(test_jerk_window_reported)
     check_print_table(&full, f);
     check_print_json(&w, f);
     ck_assert(fclose(f) == 0);
-    ck_assert_msg(strstr(txt, "\"jerk_window_s\":0.02,") &&
+    ck_assert_msg(strstr(txt, "\"jerk_window_s\":0.02,\"jerk_full_window_s\":0.04,") &&
                   strstr(txt, "\"limit_acc_mm_s2\":1000,\"planned_acc_mm_s2\":500,"), "%s",
                   txt);
-    ck_assert_msg(strstr(txt, "jerk            a 20 ms moving average of the set points ([TRAJ] "
-                              "JERK_WINDOW): accelerations planned to MAX_JERK x window / 2 at "
-                              "most, the legs' to 500 mm/s^2\n") &&
-                  strstr(txt, "jerk            a 40 ms moving average of the set points (2 x "
-                              "acceleration / jerk)\n"), "%s", txt);
+    ck_assert_msg(strstr(txt, "jerk            a 20 ms moving average of the set points (the "
+                              "default; 40 ms with every acceleration in full): accelerations "
+                              "planned to MAX_JERK x window / 2 at most, the legs' to 500 "
+                              "mm/s^2\n") &&
+                  strstr(txt, "jerk            a 40 ms moving average of the set points ([TRAJ] "
+                              "JERK_WINDOW; every acceleration in full)\n"), "%s", txt);
     free(txt);
     check_result_free(&w);
     check_result_free(&full);

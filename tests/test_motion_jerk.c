@@ -13,13 +13,15 @@
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
-#define LEG_JERK 50000.0       /* mm/s^3: 2 x 1000 / 50000 = a 40 ms average */
-#define LIN_JERK 50000.0       /* mm/s^3 */
-#define ANG_JERK 30000.0       /* deg/s^3 */
+#define LEG_JERK 50000.0       /* mm/s^3: 2 x 1000 / 50000 = 40 ms for the legs in full */
+#define LIN_JERK 50000.0       /* mm/s^3: 2 x 500 / 50000 = 20 ms, the default window */
+#define ANG_JERK 30000.0       /* deg/s^3: 2 x 300 / 30000 = 20 ms */
 
-#define WINDOW 0.020           /* s, [TRAJ] JERK_WINDOW: the legs to 50000 x 0.02 / 2 = 500 */
+#define WINDOW 0.020           /* s, the default window: the legs to 50000 x 0.02 / 2 = 500 */
+#define FULL_WINDOW 0.040      /* s, every acceleration in full ([TRAJ] JERK_WINDOW) */
 
-/* The TMU hexapod, with jerk limits (1; 2: and [TRAJ] JERK_WINDOW = WINDOW) or without. */
+/* The TMU hexapod, with jerk limits (1: the default window; 2: [TRAJ] JERK_WINDOW =
+ * FULL_WINDOW) or without. */
 static struct tk_cfg *jerk_cfg(int jerk)
 {
     struct tk_cfg *c = tm_hexapod_cfg();
@@ -28,7 +30,7 @@ static struct tk_cfg *jerk_cfg(int jerk)
         return c;
     tm_set_jerk(c, LIN_JERK, ANG_JERK, LEG_JERK);
     if (jerk == 2)
-        tk_setf(c, "TRAJ", "JERK_WINDOW", WINDOW);
+        tk_setf(c, "TRAJ", "JERK_WINDOW", FULL_WINDOW);
     return c;
 }
 
@@ -169,15 +171,19 @@ START_TEST(test_config)
     struct kins_config kc = tk_config(t);
     ck_assert_int_eq(kins_create(&kins_hexapod_ops, &kc, &k, err, sizeof err), 0);
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
-    /* the longest of 2 a / j: the legs' 2 x 1000 / 50000 */
-    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.040, 1e-12);
+    /* the default: the path's 2 x 500 / 50000 and A B C's 2 x 300 / 30000, the legs' with
+     * their acceleration taken as the path's 500; the full window is the legs' 2 x 1000 /
+     * 50000 */
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_default_window_s(&c), WINDOW, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), FULL_WINDOW, 1e-12);
     tk_set(t, "JOINT_4", "MAX_JERK", NULL);     /* JOINT_4's MAX_JERK gone */
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "[JOINT_4] MAX_JERK: missing"), "%s", err);
     free(t);
     /* a jerk so low that the average would be longer than a second */
     t = jerk_cfg(1);
-    tk_set(t, "JOINT_2", "MAX_JERK", "1000");
+    tk_set(t, "JOINT_2", "MAX_JERK", "500");        /* 2 x min(1000, 500) / 500 = 2 s */
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "2.000 s moving average"), "%s", err);
     free(t);
@@ -190,11 +196,10 @@ START_TEST(test_config)
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_ERR_CONFIG);
     ck_assert_msg(strstr(err, "[TRAJ] JERK_WINDOW = 0.02 s: only with jerk limits"), "%s", err);
     free(t);
-    /* a shorter window: every acceleration lowered to jerk x window / 2 where it is above */
-    t = jerk_cfg(2);
+    /* the default window, shorter than the full one: every acceleration lowered to jerk x
+     * window / 2 where it is above, the window kept in the lowered copy */
+    t = jerk_cfg(1);
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
-    ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
-    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.040, 1e-12);
     struct motion_config shared = c;
     motion_jerk_share(&shared);
     for (int i = 0; i < 6; i++) {
@@ -203,10 +208,57 @@ START_TEST(test_config)
     }
     ck_assert_double_eq(shared.max_lin_acc_mm_s2, c.max_lin_acc_mm_s2);   /* 500: within */
     ck_assert_double_eq(shared.max_ang_acc_deg_s2, c.max_ang_acc_deg_s2); /* 300: within */
+    ck_assert_double_eq_tol(shared.jerk_window_s, WINDOW, 1e-12);
     ck_assert_double_eq_tol(motion_jerk_window_s(&shared), WINDOW, 1e-12);
     struct motion *mo;
     ck_assert_int_eq(motion_create(&c, k, &mo, err, sizeof err), MOTION_OK);
     motion_destroy(mo);
+    free(t);
+    /* [TRAJ] JERK_WINDOW the full window: nothing lowered */
+    t = jerk_cfg(2);
+    ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), FULL_WINDOW, 1e-12);
+    shared = c;
+    motion_jerk_share(&shared);
+    ck_assert(!memcmp(&shared, &c, sizeof c));
+    /* legs slower than the path (their 2 x 400 / 50000 = 16 ms within the path's 20): the
+     * default is the full window, nothing lowered */
+    struct tk_cfg *slow = jerk_cfg(1);
+    tk_setf_joints(slow, "MAX_ACCELERATION", 400);
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), WINDOW, 1e-12);
+    /* ... and the path's acceleration above the legs' 1000: the legs' own 40 ms */
+    free(slow);
+    slow = jerk_cfg(1);
+    tk_setf(slow, "TRAJ", "MAX_LINEAR_ACCELERATION", 2000);
+    tk_setf(slow, "TRAJ", "MAX_LINEAR_JERK", 200000);       /* (its own 20 ms) */
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), FULL_WINDOW, 1e-12);
+    /* ... and between (the path's 700): the legs lowered to the path's acceleration, 28 ms */
+    tk_setf(slow, "TRAJ", "MAX_LINEAR_ACCELERATION", 700);
+    tk_setf(slow, "TRAJ", "MAX_LINEAR_JERK", 70000);        /* (its own 20 ms) */
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.028, 1e-12);
+    free(slow);
+    /* four times the jerk: the path's 5 ms, the full window 10 ms, which the default keeps
+     * (it shortens to no less than 20 ms) */
+    slow = jerk_cfg(0);
+    tm_set_jerk(slow, 4 * LIN_JERK, 4 * ANG_JERK, 4 * LEG_JERK);
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.010, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.010, 1e-12);
+    /* ... and legs of 2000 mm/s^2 with it: the full window 20 ms, the path's 5 ms; the
+     * default 20 ms */
+    tk_setf_joints(slow, "MAX_ACCELERATION", 2000);
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.020, 1e-12);
+    /* ... of 4000: the full window 40 ms; the default 20 ms, the legs lowered to 2000 */
+    tk_setf_joints(slow, "MAX_ACCELERATION", 4000);
+    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.020, 1e-12);
+    ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.040, 1e-12);
+    free(slow);
     /* rounded up to whole servo periods, never shorter than asked */
     tk_setf(t, "TRAJ", "JERK_WINDOW", 0.0205);
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
@@ -345,12 +397,12 @@ START_TEST(test_blended_corners)
 }
 END_TEST
 
-/* [TRAJ] JERK_WINDOW half the full window: the legs' acceleration lowered to 500 mm/s^2,
- * every jerk still kept in every period (differenced), the tool within P of the blended
- * zigzag and within KINEMATIC_TOLERANCE of the G61 square. The shorter average rounds the
- * corners less, so the zigzag runs faster than with the full window (asserted); the square,
- * where the legs now bind at 500, is printed beside it (it ends sooner too on this machine:
- * each of its stops rests 20 ms less). */
+/* The default window, half the full one on this machine: the legs' acceleration lowered to
+ * 500 mm/s^2, every jerk still kept in every period (differenced), the tool within P of the
+ * blended zigzag and within KINEMATIC_TOLERANCE of the G61 square. The shorter average rounds
+ * the corners less, so the zigzag runs faster than with the full window ([TRAJ] JERK_WINDOW
+ * = 0.040, asserted); the square, where the legs now bind at 500, is printed beside it (it
+ * ends sooner too on this machine: each of its stops rests 20 ms less). */
 START_TEST(test_jerk_window)
 {
     struct canon_prog z, q;
@@ -358,26 +410,31 @@ START_TEST(test_jerk_window)
     square(&q);
     struct watch w0 = { .pause_at = -1, .resume_at = -1, .abort_at = -1, .ovr_at = { -1, -1 } };
     struct watch wz = w0, wz1 = w0, wq = w0, wq1 = w0;
-    struct tm_stats sz = run(2, &z, &wz, 1), sz1 = run(1, &z, &wz1, 0);
-    struct tm_stats sq = run(2, &q, &wq, 1), sq1 = run(1, &q, &wq1, 0);
+    struct tm_stats sz = run(1, &z, &wz, 1), sz1 = run(2, &z, &wz1, 0);
+    struct tm_stats sq = run(1, &q, &wq, 1), sq1 = run(2, &q, &wq1, 0);
     ck_assert_int_eq(sz.last.state, MOTION_DONE);
     ck_assert_int_eq(sq.last.state, MOTION_DONE);
     double rz = assert_limits(&sz, "zigzag, window"), rq = assert_limits(&sq, "square, window");
-    double az = 0, aq = 0;
+    double az = 0, aq = 0, af = 0;
     for (int j = 0; j < 6; j++) {
         az = fmax(az, sz.max_leg_a[j]), aq = fmax(aq, sq.max_leg_a[j]);
+        af = fmax(af, sq1.max_leg_a[j]);
         ck_assert_msg(sz.max_leg_a[j] <= 500 * (1 + 1e-9) && sq.max_leg_a[j] <= 500 * (1 + 1e-9),
                       "leg %d at %.3f and %.3f mm/s^2 with its acceleration lowered to 500", j + 1,
                       sz.max_leg_a[j], sq.max_leg_a[j]);
     }
+    assert_limits(&sq1, "square, full window");
+    ck_assert_msg(af > 550, "the square's legs reach only %.3f mm/s^2 with every acceleration "
+                  "in full", af);      /* (what the default gives up there) */
     ck_assert_msg(wz.dev_mm <= 0.01, "the tool strays %.5f mm from the zigzag", wz.dev_mm);
     ck_assert_msg(wq.dev_mm <= 0.001, "the tool strays %.5f mm from the square", wq.dev_mm);
     ck_assert_msg(sz.t_s < sz1.t_s, "the zigzag took %.3f s with the 20 ms window, %.3f s with "
                   "the 40 ms one", sz.t_s, sz1.t_s);
-    printf("JERK_WINDOW 0.020: zigzag G64 P0.01 %.3f s against %.3f s with the full 40 ms "
+    printf("the default 20 ms window: zigzag G64 P0.01 %.3f s against %.3f s with the full 40 ms "
            "window (peak leg acceleration %.1f mm/s^2, jerk %.3f of the limit, %.4f mm from the "
-           "corners); G61 square %.3f s against %.3f s (%.1f mm/s^2, %.3f, %.5f mm)\n", sz.t_s,
-           sz1.t_s, az, rz, wz.dev_mm, sq.t_s, sq1.t_s, aq, rq, wq.dev_mm);
+           "corners); G61 square %.3f s against %.3f s (%.1f mm/s^2, %.3f, %.5f mm; %.1f mm/s^2 "
+           "with the full window)\n", sz.t_s, sz1.t_s, az, rz, wz.dev_mm, sq.t_s, sq1.t_s, aq,
+           rq, wq.dev_mm, af);
     canon_prog_free(&z);
     canon_prog_free(&q);
 }

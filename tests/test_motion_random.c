@@ -61,8 +61,9 @@ static void operate(struct tm_operator *op, long n, const struct motion_out *o,
 }
 
 /* The machine of case k: the TMU hexapod or the leg-bound one, with jerk limits on odd
- * cases (a 20 ms average on the leg-bound machine, 40 ms on the TMU's; half that with
- * HEXCNC_RANDOM_WINDOW=1, as [TRAJ] JERK_WINDOW, the accelerations lowered to match). */
+ * cases (the default 20 ms average on both, the TMU's legs lowered to 500 mm/s^2 by it; with
+ * HEXCNC_RANDOM_WINDOW=1 each machine's full window as [TRAJ] JERK_WINDOW, 40 ms on the TMU,
+ * 20 ms on the other, every acceleration in full). */
 static struct tk_cfg *case_cfg(int k)
 {
     int legs = (k / 2) % 2, jerk = k % 2;
@@ -73,7 +74,7 @@ static struct tk_cfg *case_cfg(int k)
     else if (jerk)
         tm_set_jerk(c, 50000, 30000, 50000);
     if (jerk && getenv("HEXCNC_RANDOM_WINDOW"))
-        tk_setf(c, "TRAJ", "JERK_WINDOW", legs ? 0.010 : 0.020);
+        tk_setf(c, "TRAJ", "JERK_WINDOW", legs ? 0.020 : 0.040);
     return c;
 }
 

@@ -11,8 +11,10 @@
 #include "tests/test_motion_util.h"
 
 #define DT 0.001
-#define LEG_JERK 200000.0      /* mm/s^3, loop 1: a 10 ms moving average (test_motion_jerk
-                                * has the 40 ms one; this keeps the sanitizer run short) */
+#define LEG_JERK 200000.0      /* mm/s^3, loop 1: a 10 ms moving average, the full window,
+                                * which the default keeps as it is under 20 ms
+                                * (test_motion_jerk has 20 ms; this keeps the sanitizer run
+                                * short) */
 
 /* The TMU hexapod, with jerk limits when jerk (the test's loop index) is 1 or 2; 2 adds
  * [TRAJ] JERK_WINDOW 0.005 s, half the legs' 10 ms, their acceleration lowered to 500. */

@@ -26,8 +26,10 @@ M2
 
 
 def jerk_window_s(ini):
-    """The jerk limiter's moving average (docs/motion.md): 2 a / j, longest over the path's
-    and the legs' limits, in whole servo periods; 0 when the INI sets no jerk limits."""
+    """The jerk limiter's moving average (docs/motion.md): [TRAJ] JERK_WINDOW, else the
+    longest 2 a / j of the path and A B C, and of the legs with a leg's acceleration no higher
+    than the path's, but no shorter than 20 ms or the full window (the longest 2 a / j); in
+    whole servo periods; 0 when the INI sets no jerk limits."""
     sec, vals = None, {}
     for line in open(ini):
         line = line.split("#")[0].strip()
@@ -38,10 +40,18 @@ def jerk_window_s(ini):
             vals[(sec, k)] = v
     if ("TRAJ", "MAX_LINEAR_JERK") not in vals:
         return 0.0
-    pairs = [("TRAJ", "MAX_LINEAR_ACCELERATION", "MAX_LINEAR_JERK"),
-             ("TRAJ", "MAX_ANGULAR_ACCELERATION", "MAX_ANGULAR_JERK")]
-    pairs += [(s, "MAX_ACCELERATION", "MAX_JERK") for s, k in vals if k == "MAX_JERK"]
-    t = max(2 * float(vals[(s, a)]) / float(vals[(s, j)]) for s, a, j in pairs)
+    lin = float(vals[("TRAJ", "MAX_LINEAR_ACCELERATION")])
+    t = max(2 * lin / float(vals[("TRAJ", "MAX_LINEAR_JERK")]),
+            2 * float(vals[("TRAJ", "MAX_ANGULAR_ACCELERATION")]) /
+            float(vals[("TRAJ", "MAX_ANGULAR_JERK")]))
+    full = t
+    for s, k in list(vals):
+        if k == "MAX_JERK":
+            acc, jerk = float(vals[(s, "MAX_ACCELERATION")]), float(vals[(s, "MAX_JERK")])
+            t, full = max(t, 2 * min(acc, lin) / jerk), max(full, 2 * acc / jerk)
+    t = max(t, min(full, 0.020))
+    if ("TRAJ", "JERK_WINDOW") in vals:
+        t = float(vals[("TRAJ", "JERK_WINDOW")])
     period = float(vals.get(("EMCMOT", "SERVO_PERIOD"), "1000000")) * 1e-9
     return max(2, -(-round(t / period, 9) // 1)) * period
 
