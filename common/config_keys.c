@@ -159,7 +159,8 @@ const struct config_key config_keys[] = {
       "acceleration in full); where shorter, each acceleration is lowered to jerk x window / "
       "2: dense blended code runs faster, ramps slower. The default is the path's and A B C's "
       "2 x acceleration / jerk, and a leg's with its acceleration taken no higher than "
-      "MAX_LINEAR_ACCELERATION (docs/motion.md)" },
+      "MAX_LINEAR_ACCELERATION; no shorter than 20 ms, or the full window where that is "
+      "shorter (docs/motion.md)" },
     { "TRAJ", "NO_FORCE_HOMING", BOOL, "", "", 0, 0, "0", "1: programs and MDI may run "
       "before the legs are homed (the session, docs/machine.md)" },
     { "TRAJ", "OPTIONAL_STOP", BOOL, "", "", 0, 0, "1", "M1 stops the program" },
