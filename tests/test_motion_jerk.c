@@ -223,42 +223,45 @@ START_TEST(test_config)
     ck_assert(!memcmp(&shared, &c, sizeof c));
     /* legs slower than the path (their 2 x 400 / 50000 = 16 ms within the path's 20): the
      * default is the full window, nothing lowered */
-    struct tk_cfg *slow = jerk_cfg(1);
-    tk_setf_joints(slow, "MAX_ACCELERATION", 400);
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    struct tk_cfg *alt = jerk_cfg(1);
+    tk_setf_joints(alt, "MAX_ACCELERATION", 400);
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), WINDOW, 1e-12);
     ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), WINDOW, 1e-12);
+    free(alt);
     /* ... and the path's acceleration above the legs' 1000: the legs' own 40 ms */
-    free(slow);
-    slow = jerk_cfg(1);
-    tk_setf(slow, "TRAJ", "MAX_LINEAR_ACCELERATION", 2000);
-    tk_setf(slow, "TRAJ", "MAX_LINEAR_JERK", 200000);       /* (its own 20 ms) */
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    alt = jerk_cfg(1);
+    tk_setf(alt, "TRAJ", "MAX_LINEAR_ACCELERATION", 2000);
+    tk_setf(alt, "TRAJ", "MAX_LINEAR_JERK", 200000);       /* (its own 20 ms) */
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), FULL_WINDOW, 1e-12);
     /* ... and between (the path's 700): the legs lowered to the path's acceleration, 28 ms */
-    tk_setf(slow, "TRAJ", "MAX_LINEAR_ACCELERATION", 700);
-    tk_setf(slow, "TRAJ", "MAX_LINEAR_JERK", 70000);        /* (its own 20 ms) */
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    tk_setf(alt, "TRAJ", "MAX_LINEAR_ACCELERATION", 700);
+    tk_setf(alt, "TRAJ", "MAX_LINEAR_JERK", 70000);        /* (its own 20 ms) */
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.028, 1e-12);
-    free(slow);
+    free(alt);
     /* four times the jerk: the path's 5 ms, the full window 10 ms, which the default keeps
      * (it shortens to no less than 20 ms) */
-    slow = jerk_cfg(0);
-    tm_set_jerk(slow, 4 * LIN_JERK, 4 * ANG_JERK, 4 * LEG_JERK);
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    alt = jerk_cfg(0);
+    tm_set_jerk(alt, 4 * LIN_JERK, 4 * ANG_JERK, 4 * LEG_JERK);
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.010, 1e-12);
     ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.010, 1e-12);
     /* ... and legs of 2000 mm/s^2 with it: the full window 20 ms, the path's 5 ms; the
      * default 20 ms */
-    tk_setf_joints(slow, "MAX_ACCELERATION", 2000);
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    tk_setf_joints(alt, "MAX_ACCELERATION", 2000);
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.020, 1e-12);
     /* ... of 4000: the full window 40 ms; the default 20 ms, the legs lowered to 2000 */
-    tk_setf_joints(slow, "MAX_ACCELERATION", 4000);
-    ck_assert_int_eq(read_cfg(slow, &c, err, sizeof err), MOTION_OK);
+    tk_setf_joints(alt, "MAX_ACCELERATION", 4000);
+    ck_assert_int_eq(read_cfg(alt, &c, err, sizeof err), MOTION_OK);
     ck_assert_double_eq_tol(motion_jerk_window_s(&c), 0.020, 1e-12);
     ck_assert_double_eq_tol(motion_jerk_full_window_s(&c), 0.040, 1e-12);
-    free(slow);
+    shared = c;
+    motion_jerk_share(&shared);
+    ck_assert_double_eq_tol(shared.joint[0].max_acc_mm_s2, 2000, 1e-9);
+    free(alt);
     /* rounded up to whole servo periods, never shorter than asked */
     tk_setf(t, "TRAJ", "JERK_WINDOW", 0.0205);
     ck_assert_int_eq(read_cfg(t, &c, err, sizeof err), MOTION_OK);
