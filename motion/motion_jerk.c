@@ -94,7 +94,8 @@ double motion_jerk_full_window_s(const struct motion_config *c)
  * leg's length changes by at most the tool's distance), and the legs keep their share for
  * the bends. On the TMU (legs 1000 mm/s^2 against the path's 500, jerk 50,000 on both) the
  * default is 20 ms where the full window is 40 ms: the dense hour in 7,421 s against 13,682,
- * each of 100 random dense programs in 0.50 - 0.84 of its time, none longer (docs/motion.md).
+ * each of 300 random dense programs on it and two variants of it in 0.50 - 0.88 of its time,
+ * none longer (docs/motion.md).
  * With four times those jerk limits the path's ratio is 5 ms and the full window 10 ms: there
  * the 5 ms one took longer (a random program under G64 P0.001 1.16 times, its corners passed
  * with a velocity jump that the lowered accelerations halve), hence the least. */

@@ -25,7 +25,11 @@
  * HEXCNC_RANDOM_CASE=N; HEXCNC_RANDOM_CASES=N runs N cases instead of CASES, and the
  * sanitizer's run (HEXCNC_SANITIZED=1, some ten times slower) the first SANITIZED_CASES,
  * every kind of case among them; HARD_CASES run as well. HEXCNC_RANDOM_EACH=1 prints each
- * case's time and path figure. */
+ * case's time and path figure; HEXCNC_RANDOM_KIND=N runs only the cases k with k % 4 == N (0
+ * and 1 the TMU's, 2 and 3 the leg-bound machine's, the odd ones with jerk limits);
+ * HEXCNC_RANDOM_TMU=abc-fast or slow-path changes the TMU's limits (A B C at 1500 deg/s^2 and
+ * 150,000 deg/s^3; the path at 200 mm/s^2), to compare jerk windows on more than one machine
+ * (docs/motion.md). */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -73,6 +77,16 @@ static struct tk_cfg *case_cfg(int k)
         tm_set_jerk(c, 500000, 200000, 20000);
     else if (jerk)
         tm_set_jerk(c, 50000, 30000, 50000);
+    const char *tmu = getenv("HEXCNC_RANDOM_TMU");
+    if (!legs && tmu && !strcmp(tmu, "abc-fast")) {
+        tk_setf(c, "TRAJ", "MAX_ANGULAR_ACCELERATION", 1500);
+        if (jerk)
+            tk_setf(c, "TRAJ", "MAX_ANGULAR_JERK", 150000);
+    } else if (!legs && tmu && !strcmp(tmu, "slow-path")) {
+        tk_setf(c, "TRAJ", "MAX_LINEAR_ACCELERATION", 200);
+    } else if (!legs && tmu) {
+        ck_abort_msg("HEXCNC_RANDOM_TMU=%s: abc-fast or slow-path", tmu);
+    }
     if (jerk && getenv("HEXCNC_RANDOM_WINDOW"))
         tk_setf(c, "TRAJ", "JERK_WINDOW", legs ? 0.020 : 0.040);
     return c;
@@ -201,7 +215,7 @@ static void tally(int k, struct worst *wr, int *refused)
 START_TEST(test_random_dense)
 {
     const char *only = getenv("HEXCNC_RANDOM_CASE"), *many = getenv("HEXCNC_RANDOM_CASES");
-    const char *san = getenv("HEXCNC_SANITIZED");
+    const char *san = getenv("HEXCNC_SANITIZED"), *kind = getenv("HEXCNC_RANDOM_KIND");
     int cases = many && atoi(many) > 0 ? atoi(many)
               : san && !strcmp(san, "1") ? SANITIZED_CASES : CASES, refused = 0;
     if (only && atoi(only) >= cases)
@@ -209,11 +223,11 @@ START_TEST(test_random_dense)
     struct worst wr;
     memset(&wr, 0, sizeof wr);
     for (int k = 0; k < cases; k++) {
-        if (!only || atoi(only) == k)
+        if ((!only || atoi(only) == k) && (!kind || k % 4 == atoi(kind)))
             tally(k, &wr, &refused);
     }
     for (size_t h = 0; !only && h < sizeof HARD_CASES / sizeof *HARD_CASES; h++)
-        if (HARD_CASES[h] >= cases)
+        if (HARD_CASES[h] >= cases && (!kind || HARD_CASES[h] % 4 == atoi(kind)))
             tally(HARD_CASES[h], &wr, &refused);
     printf("random dense programs: %d run (%d refused at load), %.0f s of motion, %d feeds "
            "merged, %d pauses, %.0f %% of the look-ahead machine's periods calm; at most %.4f "
@@ -222,7 +236,7 @@ START_TEST(test_random_dense)
            refused, (double)wr.periods * DT, wr.merged, wr.pauses,
            wr.periods ? 100.0 * (double)wr.calm / (double)wr.periods : 0, wr.leg_v, wr.leg_a,
            wr.leg_j, wr.path, wr.feed);
-    ck_assert_int_gt(wr.ran, (only ? 0 : cases * 3 / 4));
+    ck_assert_int_gt(wr.ran, (only ? 0 : kind ? cases / 4 * 3 / 4 : cases * 3 / 4));
     ck_assert(wr.feed <= 1 + 1e-9);
 }
 END_TEST
