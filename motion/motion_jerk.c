@@ -70,9 +70,9 @@ struct motion_jerk {
     struct motion_jerk_meta last_meta;
 };
 
-/* The longest of 2 x acceleration / jerk over the path, A B C and the legs, s (not yet in
- * whole periods): the window in which the leader may use every acceleration in full. */
-double motion_jerk_full_window_s(const struct motion_config *c)
+/* The longest of 2 x acceleration / jerk over the path, A B C and the legs, a leg's
+ * acceleration taken no higher than leg_acc_cap, s (0: no jerk limits). */
+static double longest_window(const struct motion_config *c, double leg_acc_cap)
 {
     if (!c || c->max_lin_jerk_mm_s3 <= 0)
         return 0;
@@ -81,8 +81,16 @@ double motion_jerk_full_window_s(const struct motion_config *c)
         t = fmax(t, 2 * c->max_ang_acc_deg_s2 / c->max_ang_jerk_deg_s3);
     for (int i = 0; i < c->njoints; i++)
         if (c->joint[i].max_jerk_mm_s3 > 0)
-            t = fmax(t, 2 * c->joint[i].max_acc_mm_s2 / c->joint[i].max_jerk_mm_s3);
+            t = fmax(t, 2 * fmin(c->joint[i].max_acc_mm_s2, leg_acc_cap) /
+                            c->joint[i].max_jerk_mm_s3);
     return t;
+}
+
+/* The longest of 2 x acceleration / jerk over the path, A B C and the legs, s (not yet in
+ * whole periods): the window in which the leader may use every acceleration in full. */
+double motion_jerk_full_window_s(const struct motion_config *c)
+{
+    return longest_window(c, HUGE_VAL);
 }
 
 /* The window without [TRAJ] JERK_WINDOW, s (not yet in whole periods): the path's and A B C's
@@ -103,14 +111,8 @@ double motion_jerk_default_window_s(const struct motion_config *c)
 {
     if (!c || c->max_lin_jerk_mm_s3 <= 0)
         return 0;
-    double t = 2 * c->max_lin_acc_mm_s2 / c->max_lin_jerk_mm_s3;
-    if (c->max_ang_jerk_deg_s3 > 0)
-        t = fmax(t, 2 * c->max_ang_acc_deg_s2 / c->max_ang_jerk_deg_s3);
-    for (int i = 0; i < c->njoints; i++)
-        if (c->joint[i].max_jerk_mm_s3 > 0)
-            t = fmax(t, 2 * fmin(c->joint[i].max_acc_mm_s2, c->max_lin_acc_mm_s2) /
-                            c->joint[i].max_jerk_mm_s3);
-    return fmax(t, fmin(motion_jerk_full_window_s(c), MOTION_JERK_DEFAULT_MIN_S));
+    return fmax(longest_window(c, c->max_lin_acc_mm_s2),
+                fmin(motion_jerk_full_window_s(c), MOTION_JERK_DEFAULT_MIN_S));
 }
 
 double motion_jerk_window_s(const struct motion_config *c)
