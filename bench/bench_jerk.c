@@ -1,6 +1,6 @@
 /* bench_jerk.c: what jerk limiting costs in machining time, and the peak leg speed,
  * acceleration and jerk against their limits, trapezoidal beside jerk-limited, on the paper's
- * programs, the TMU demo and the dense five-axis hour, through `hexcnc check`'s servo pass
+ * programs, the TMU demo, long exact-stop moves and the dense five-axis hour, through `hexcnc check`'s servo pass
  * (the legs differenced every servo period). */
 #include <math.h>
 #include <stdio.h>
@@ -86,6 +86,28 @@ static int row(const char *label, const char *ini, const char *prog, double scal
     return 0;
 }
 
+/* Long exact-stop moves on the TMU, where the legs' acceleration counts most: rapids and
+ * feeds of 80 to 160 mm in X Y, Z ramps of 100 mm, turns of A B C in place. */
+static const char LONG_MOVES[] =
+    "G21 G90 G61\nG0 X0 Y0 Z645\nG0 X80\nG0 Y80\nG0 X-80\nG0 Y-80 Z660\nG1 X80 F6000\n"
+    "G1 Y0 Z640\nG0 X0 Y0 Z645\nG1 X60 A5 F3000\nG0 X0 A0\nG0 Z700\nG0 Z600\n"
+    "G1 Z700 F6000\nG1 Z600\nG0 Z645\nG0 A10\nG0 A-10\nG0 B10\nG0 C20\nG0 A0 B0 C0\nM2\n";
+
+/* Writes text into a new file named from tmpl (its XXXXXX.ngc replaced); 0 or -1. */
+static int write_temp(char *tmpl, const char *text)
+{
+    int fd = mkstemps(tmpl, 4);
+    if (fd < 0)
+        return -1;
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        close(fd);
+        return -1;
+    }
+    int ok = fputs(text, f) >= 0;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 int main(int argc, char **argv)
 {
     int blocks = argc > 1 ? atoi(argv[1]) : 240000;
@@ -103,9 +125,15 @@ int main(int argc, char **argv)
         { "TMU demo", "configs/sim/tmu-hexapod.ini", "configs/sim/tmu-hexapod-demo.ngc" },
     };
     char dense[] = "/tmp/hexcnc-bench-jerk-XXXXXX.ngc";
+    char longm[] = "/tmp/hexcnc-bench-long-XXXXXX.ngc";
+    if (write_temp(longm, LONG_MOVES) != 0) {
+        fprintf(stderr, "bench_jerk: cannot write %s\n", longm);
+        return 1;
+    }
     int fd = mkstemps(dense, 4);
     if (fd < 0 || close(fd) != 0 || bench_dense_write(dense, blocks) != 0) {
         fprintf(stderr, "bench_jerk: cannot write %s\n", dense);
+        unlink(longm);
         return 1;
     }
     printf("jerk limiting: [JOINT_n] MAX_JERK %.0f mm/s^3, [TRAJ] MAX_LINEAR_JERK %.0f mm/s^3, "
@@ -120,6 +148,7 @@ int main(int argc, char **argv)
     int fail = 0;
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
         fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, 0);
+    fail |= row("long G61 moves", "configs/sim/tmu-hexapod.ini", longm, 1, 0);
     char label[64];
     snprintf(label, sizeof label, "dense, %d blocks", blocks);
     fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, 0);
@@ -127,6 +156,7 @@ int main(int argc, char **argv)
            "in full: on the TMU the legs' 40 ms):\n");
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++)
         fail |= row(progs[i].label, progs[i].ini, progs[i].prog, 1, FULL_WINDOW);
+    fail |= row("long G61 moves", "configs/sim/tmu-hexapod.ini", longm, 1, FULL_WINDOW);
     fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 1, FULL_WINDOW);
     printf("\nthe same with 4 x the jerk limits (the default window, here the full 10 ms; "
            "jerk to 200000 mm/s^3):\n");
@@ -139,5 +169,6 @@ int main(int argc, char **argv)
                 4, 0.005);
     fail |= row(label, "configs/sim/tmu-hexapod.ini", dense, 4, 0.005);
     unlink(dense);
+    unlink(longm);
     return fail ? 1 : 0;
 }
