@@ -3,8 +3,10 @@ simulated clock): sim-probe drives motion.probe-input from the block of configs/
 a G38.2 stops where the probe touches it, the program reads the result in #5061..#5070 and
 goes on from where the machine stopped; a probe stuck on is refused with an error naming the
 line, before anything moves. Standard library only; run by machine_probe.sh."""
+import json
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -25,35 +27,14 @@ M2
 """
 
 
-def jerk_window_s(ini):
-    """The jerk limiter's moving average (docs/motion.md): [TRAJ] JERK_WINDOW, else the
-    longest 2 a / j of the path and A B C, and of the legs with a leg's acceleration no higher
-    than the path's, but no shorter than 20 ms or the full window (the longest 2 a / j); in
-    whole servo periods; 0 when the INI sets no jerk limits."""
-    sec, vals = None, {}
-    for line in open(ini):
-        line = line.split("#")[0].strip()
-        if line.startswith("["):
-            sec = line.strip("[]")
-        elif "=" in line:
-            k, v = (x.strip() for x in line.split("=", 1))
-            vals[(sec, k)] = v
-    if ("TRAJ", "MAX_LINEAR_JERK") not in vals:
-        return 0.0
-    lin = float(vals[("TRAJ", "MAX_LINEAR_ACCELERATION")])
-    t = max(2 * lin / float(vals[("TRAJ", "MAX_LINEAR_JERK")]),
-            2 * float(vals[("TRAJ", "MAX_ANGULAR_ACCELERATION")]) /
-            float(vals[("TRAJ", "MAX_ANGULAR_JERK")]))
-    full = t
-    for s, k in list(vals):
-        if k == "MAX_JERK":
-            acc, jerk = float(vals[(s, "MAX_ACCELERATION")]), float(vals[(s, "MAX_JERK")])
-            t, full = max(t, 2 * min(acc, lin) / jerk), max(full, 2 * acc / jerk)
-    t = max(t, min(full, 0.020))
-    if ("TRAJ", "JERK_WINDOW") in vals:
-        t = float(vals[("TRAJ", "JERK_WINDOW")])
-    period = float(vals.get(("EMCMOT", "SERVO_PERIOD"), "1000000")) * 1e-9
-    return max(2, -(-round(t / period, 9) // 1)) * period
+def jerk_window_s(ini, tmp):
+    """The jerk limiter's moving average, s, as `hexcnc check` reports it for the INI (0: no
+    jerk limits; docs/motion.md)."""
+    prog = os.path.join(tmp, "window.ngc")
+    open(prog, "w").write("G0 Z646\nM2\n")
+    out = subprocess.run([ms.BIN, "check", "--json", ini, prog], capture_output=True,
+                         text=True, timeout=60)
+    return json.loads(out.stdout)["jerk_window_s"]
 
 
 def program(c, tmp, name, text):
@@ -104,7 +85,7 @@ def main():
               634.95 < trip_z < 635.005, trip_z)
         # 5 mm/s braking at 500 mm/s^2: 0.025 mm further; with jerk limits the moving
         # average adds its lag, 5 mm/s x half its window
-        over = 0.05 + 5 * jerk_window_s(os.path.join(ms.SIM, "tmu-hexapod.ini")) / 2
+        over = 0.05 + 5 * jerk_window_s(os.path.join(ms.SIM, "tmu-hexapod.ini"), tmp) / 2
         check("came to rest just past the trip, braking within the path's limit",
               trip_z - over < stop_z < trip_z, (trip_z, stop_z))
         check("#5070 = 1: X10", abs(pp[0] - 10) < 1e-6, pp)
