@@ -25,6 +25,11 @@ struct sim {
     double T;                          /* servo period, s */
     double inv_T;                      /* 1 / T, 1/s */
     double L0[KINS_MAX_JOINTS];        /* set point of the previous period, mm */
+    const double *prev_L, *prev_p;     /* the previous period's legs and pose: L0 and p0, or
+                                        * the entry before in a calm run */
+    const double *pose, *joints;       /* the period being measured: its pose and legs, its */
+    double time_s, dist_mm;            /* clock and distance done (the record's, or a calm
+                                        * run's entry: motion_step_calm) */
     double v0[KINS_MAX_JOINTS];        /* leg rate over the last period tested, mm/s (the
                                         * machine starts at rest: 0) */
     double a0[KINS_MAX_JOINTS];        /* leg acceleration of the last period tested */
@@ -237,8 +242,8 @@ static void legs_hold(struct sim *s, const struct motion_out *out)
     if (k == 0)
         s->bfirst = s->r->periods;
     for (int i = 0; i < KINS_MAX_JOINTS; i++)    /* (all: a fixed count is unrolled; the */
-        s->Lb[i][k] = out->joint_pos[i];         /* legs past nj are never tested) */
-    s->bline[k] = out->line, s->bfile[k] = out->file, s->btime[k] = out->time_elapsed_s;
+        s->Lb[i][k] = s->joints[i];              /* legs past nj are never tested) */
+    s->bline[k] = out->line, s->bfile[k] = out->file, s->btime[k] = s->time_s;
     if (++s->bn == s->bcap)
         legs_batch(s);
 }
@@ -401,13 +406,16 @@ static void tips_held(struct sim *s)
 /* Every period of a straight feed that turns A B C without G43.4 (tip_of's tool, the
  * kinematics' own: no G43.4 length), held for tips_held. Measured here, in place: a
  * rotation and a distance cost less than a slot of the ring every period. */
-static void tip_period(struct sim *s, const struct motion_out *out)
+static void tip_period(struct sim *s, const struct motion_out *out, bool same_seg)
 {
-    tip_move(s, out);
+    if (!same_seg)
+        tip_move(s, out);
+    else if (out->seg_kind == 1)       /* (tip_move on the move it has: not fresh) */
+        s->tip_fresh = 0;
     if (!s->tip_line || !s->tip_swing)
         return;
     int k = s->tip_n;
-    memcpy(s->tip_pose[k], out->pose, sizeof s->tip_pose[k]);
+    memcpy(s->tip_pose[k], s->pose, sizeof s->tip_pose[k]);
     s->tip_pline[k] = out->line, s->tip_pperiod[k] = s->r->periods;
     if (++s->tip_n == 4)
         tips_held(s);
@@ -431,9 +439,9 @@ static void tip_figure(const struct sim *s)
 static void deviation(struct sim *s, const struct motion_out *out)
 {
     struct check_defer_slot *q = slot_for(s, CHECK_DEFER_DEVIATION, out);
-    memcpy(q->p0, s->p0, sizeof q->p0);
-    memcpy(q->L0, s->L0, sizeof q->L0);
-    memcpy(q->L1, out->joint_pos, sizeof q->L1);
+    memcpy(q->p0, s->prev_p, sizeof q->p0);
+    memcpy(q->L0, s->prev_L, sizeof q->L0);
+    memcpy(q->L1, s->joints, sizeof q->L1);
     q->tool_len_mm = out->tcp ? out->tool_len_mm : s->tf.length_mm;
     q->tip_mode = CHECK_TIP_NONE;
     if (s->have_tf && s->tip_line && !s->tip_fresh) {
@@ -557,8 +565,8 @@ static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind ki
         apply(s, check_defer_next(s->dq, 1));
     }
     q->line = out->line, q->file = out->file, q->period = s->r->periods;
-    q->time_s = out->time_elapsed_s, q->dist_mm = out->distance_done_mm;
-    memcpy(q->pose, out->pose, sizeof q->pose);
+    q->time_s = s->time_s, q->dist_mm = s->dist_mm;
+    memcpy(q->pose, s->pose, sizeof q->pose);
     return q;
 }
 
@@ -597,12 +605,12 @@ static int cond_moved(const struct sim *s, const double pose[KINS_POSE_DIM])
  * planner's, when it waits for this pass), applied in order. */
 static void measures(struct sim *s, const struct motion_out *out)
 {
-    double t = out->time_elapsed_s;
+    double t = s->time_s;
     int changed = out->line != s->line || out->file != s->file;
-    if ((changed && cond_moved(s, out->pose)) || t >= s->next_cond_s) {
+    if ((changed && cond_moved(s, s->pose)) || t >= s->next_cond_s) {
         slot_for(s, CHECK_DEFER_CONDITION, out);
         check_defer_commit(s->dq);
-        memcpy(s->cond_pose, out->pose, sizeof s->cond_pose);
+        memcpy(s->cond_pose, s->pose, sizeof s->cond_pose);
         s->next_cond_s = t + s->o->condition_every_s;
     }
     if (changed || t >= s->next_dev_s) {
@@ -658,6 +666,35 @@ static long period_bound(const struct sim *s, double planned_s)
     return planned_s >= 0 ? (long)(MAX_PERIODS_FACTOR * planned_s / s->T) + 1000 : LONG_MAX;
 }
 
+/* One period measured: legs, tip, the scheduled measures. Its pose, legs, clock and
+ * distance are s's (sim_at), the rest the record's; same_seg: the period before was on the
+ * same segment, and measured with this record (a calm run's). */
+static inline void sim_period(struct sim *s, const struct motion_out *out, bool same_seg)
+{
+    s->r->periods++;
+    legs_hold(s, out);
+    if (s->have_tf)
+        tip_period(s, out, same_seg);
+    measures(s, out);
+    s->line = out->line, s->file = out->file;
+}
+
+/* The period to measure next: pose, legs, clock and distance done. */
+static inline void sim_at(struct sim *s, const double *pose, const double *joints,
+                          double time_s, double dist_mm)
+{
+    s->pose = pose, s->joints = joints, s->time_s = time_s, s->dist_mm = dist_mm;
+}
+
+/* The period measured becomes the one before the next (kept: the record and the calm
+ * run's entries are written over by the next step). */
+static inline void sim_keep(struct sim *s)
+{
+    memcpy(s->L0, s->joints, sizeof s->L0);
+    memcpy(s->p0, s->pose, sizeof s->p0);
+    s->prev_L = s->L0, s->prev_p = s->p0;
+}
+
 /* Steps motion at the servo period to the program's end, measuring as it goes. */
 int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
                    const struct check_opts *o, const struct check_feed *feed,
@@ -686,6 +723,7 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
         return CHECK_ERR_KINS;
     }
     memcpy(s.p0, start, sizeof s.p0);
+    s.prev_L = s.L0, s.prev_p = s.p0;
     memcpy(s.bL0, s.L0, sizeof s.bL0);
     s.bcap = (o->trace && !feed) || o->legs_every_period ? 1 : LEG_BATCH;  /* (the trace
                                                         * samples the legs' rates) */
@@ -699,31 +737,45 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     motion_set_rates(mc->motion, false);   /* rates come from differences of set points */
     motion_set_brief(mc->motion, true);    /* (and the record holds what the pass reads) */
     motion_set_ahead(mc->motion, true);    /* (four periods' legs at once where it can) */
-    for (long n = 0; n < max_periods; n++) {
+    /* (calm periods several at a time, motion_step_calm; not where a trace samples them) */
+    int calm_on = !(o->trace && !feed);
+    struct motion_calm calm;
+    for (long n = 0; n < max_periods;) {
         if (feed && motion_stream_starving(mc->motion)) {
             if (!feed->wait(feed->ctx))
                 break;                  /* the planner stopped: nothing more to follow */
             if (max_periods == LONG_MAX)
                 max_periods = period_bound(&s, feed->planned_s(feed->ctx));
         }
+        int nc = calm_on && max_periods - n >= MOTION_CALM_MAX
+                 ? motion_step_calm(mc->motion, s.T, &calm, &out) : 0;
+        if (nc > 0) {
+            /* (the record is the last period's: each period's own pose, legs, clock and
+             * distance with the rest of it, which is the same in all) */
+            for (int k = 0; k < nc; k++) {
+                sim_at(&s, calm.pose[k], calm.joints[k], calm.time_s[k], calm.dist_mm[k]);
+                sim_period(&s, &out, k > 0);
+                s.prev_p = calm.pose[k], s.prev_L = calm.joints[k];
+            }
+            sim_keep(&s);
+            n += nc;
+            continue;
+        }
         st = motion_step(mc->motion, s.T, &out);
-        r->periods++;
-        legs_hold(&s, &out);
-        if (s.have_tf)
-            tip_period(&s, &out);
-        measures(&s, &out);
+        n++;
+        sim_at(&s, out.pose, out.joint_pos, out.time_elapsed_s, out.distance_done_mm);
+        sim_period(&s, &out, false);
+        sim_keep(&s);
         if (o->trace && !feed && ++s.trace_count >= s.trace_every) {
             check_trace_add(o->trace, out.time_elapsed_s, s.nj, out.joint_pos, s.v0, out.pose);
             s.trace_count = 0;
         }
-        memcpy(s.L0, out.joint_pos, sizeof s.L0);
-        memcpy(s.p0, out.pose, sizeof s.p0);
-        s.line = out.line, s.file = out.file;
         if (out.state == MOTION_DONE || out.state == MOTION_FAULT || st != MOTION_OK)
             break;
         if (out.state == MOTION_PAUSED)   /* M0/M1: the operator would press resume */
             motion_resume(mc->motion);
     }
+    sim_at(&s, out.pose, out.joint_pos, out.time_elapsed_s, out.distance_done_mm);
     motion_set_rates(mc->motion, true);
     motion_set_brief(mc->motion, false);
     motion_set_ahead(mc->motion, false);

@@ -436,6 +436,23 @@ void motion_set_brief(struct motion *m, bool on);
  * time where the plan's pace lets it see them coming, the same bits as period by period
  * (motion_ahead.c): a check's pass, not a machine's servo thread. Off by default. */
 void motion_set_ahead(struct motion *m, bool on);
+/* A check's calm periods, several in one call (ahead and brief on, rates off): where the
+ * next periods run at the plan's own pace inside one interval of the plan, on a line or an
+ * arc, no probe, pause, jerk limiting, stepped block, override or chunk hand-over among them,
+ * takes up to MOTION_CALM_MAX of them exactly as that many motion_step calls would (the same
+ * bits: test_calm_same_bits), and returns how many: 0 when the next period is not one of
+ * them (nothing done; motion_step takes it). out: the last period's record; c: each period's
+ * pose, legs, clock and distance done (pose and legs valid until the next call into m). */
+#define MOTION_CALM_MAX 4
+struct motion_calm {
+    int n;                                      /* periods taken */
+    const double (*pose)[KINS_POSE_DIM];        /* period k's pose, pose[k] */
+    const double (*joints)[KINS_MAX_JOINTS];    /* its legs (joint_pos) */
+    double time_s[MOTION_CALM_MAX];             /* time_elapsed_s at its end */
+    double dist_mm[MOTION_CALM_MAX];            /* distance_done_mm */
+};
+int motion_step_calm(struct motion *m, double period_s, struct motion_calm *c,
+                     struct motion_out *out);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);
 /* Tool changes: whether programs planned from now on stop at M6 until the changer is done,
  * and the changer's answer to request seq (the tool is then in the spindle). */

@@ -90,14 +90,13 @@ static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, 
         s[l] = sv[l], v[l] = vv[l];
 }
 
-/* Fills the entries from the present state on: returns the first's index (0), or -1 when
- * the present segment is one it leaves to evaluate() (synchronised, under G43.4). */
-static int fill(struct motion *m, double dt)
+/* Fills the entries from plan time tau in interval ci of segment cs on: returns the first's
+ * index (0), or -1 when that segment is one it leaves to evaluate() (synchronised, under
+ * G43.4). */
+static int fill(struct motion *m, double dt, size_t ci, size_t cs, double tau)
 {
     struct motion_ahead *a = &m->ahead;
     const struct motion_plan *p = m->run;
-    size_t ci = m->ci, cs = m->cs;
-    double tau = m->tau_s;
     int n = 0;
     for (;;) {
         const struct motion_seg *sg = &p->segs[cs];
@@ -162,7 +161,27 @@ int motion_ahead(struct motion *m, double dt)
         a->n = a->next = 0;
         return -1;
     }
-    return fill(m, dt);
+    return fill(m, dt, m->ci, m->cs, m->tau_s);
+}
+
+int motion_ahead_next(struct motion *m, double dt)
+{
+    struct motion_ahead *a = &m->ahead;
+    const struct motion_plan *p = m->run;
+    size_t ci = m->ci, cs = m->cs;
+    double tau = m->tau_s + dt;        /* advance() at the plan's pace */
+    a->n = a->next = 0;
+    if (!(tau < p->total_time_s))
+        return 0;
+    while (ci + 2 < p->nknot && tau >= p->kt[ci + 1]) {   /* follow_knots */
+        ci++;
+        while (ci >= p->segs[cs].k0 + p->segs[cs].nk)
+            cs++;
+    }
+    if (fill(m, dt, ci, cs, tau) < 0)
+        return 0;
+    a->next = 0;                       /* (fill counts its first entry taken) */
+    return a->n;
 }
 
 void motion_set_ahead(struct motion *m, bool on)

@@ -491,6 +491,9 @@ static inline void motion_probe_settle(struct motion *m)
  * period and the next ones where it has none; -1 where it leaves the period to evaluate()
  * (a synchronised move, G43.4, off the plan's own pace). */
 int motion_ahead(struct motion *m, double dt);
+/* Fills the look-ahead with the periods after the present one, as the plan's own pace
+ * reaches them (motion_step_calm, where no entry is left); how many, 0 where it has none. */
+int motion_ahead_next(struct motion *m, double dt);
 /* Whether the executor runs at the plan's own pace, where the look-ahead foresees the next
  * periods (anywhere else the clock follows the override's ramp): running, at rate 1 with
  * both overrides at 1, no wait for the spindle, no probe's trip bringing it to rest. */

@@ -690,6 +690,56 @@ static inline bool calm_period(struct motion *m, double dt, struct motion_out *o
     return true;
 }
 
+/* See motion.h. The periods calm_period would take one by one, their entries filled here
+ * where none is left (at the plan's pace the next periods' key is known before the clock
+ * moves: motion_ahead_next): the per-period work is the clock, the passed commands and the
+ * place, and the record, the status watch and the executor's pose are written once, for
+ * the last. */
+int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct motion_out *out)
+{
+    if (!m || !c || !out || !(dt > 0) || !m->ahead_on || !m->brief || !m->no_rates ||
+        !m->loaded || m->jerk || m->probe_wired || m->probe_seg || m->step_until_seg ||
+        (m->streaming && !m->chunk) || !motion_at_plan_pace(m))
+        return 0;
+    struct motion_ahead *a = &m->ahead;
+    const struct motion_plan *p = m->run;
+    const struct motion_seg *sg = &p->segs[m->cs];
+    if (sg != m->seg_at || sg->kind > SEG_ARC)
+        return 0;
+    if ((a->next >= a->n || a->run != p) && !motion_ahead_next(m, dt))
+        return 0;
+    int first = a->next, n = 0;
+    while (a->next < a->n) {
+        const struct motion_ahead_at *e = &a->at[a->next];
+        double tau = m->tau_s + dt;          /* advance() at the plan's pace */
+        /* (the entry was filled at this clock in this interval: follow_knots stays in it) */
+        if (e->ci != m->ci || e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
+            a->status[a->next] != KINS_OK)
+            break;
+        m->io_age++;
+        pass_ios(m);
+        m->elapsed_s += dt;
+        motion_sync_advance(m, dt);          /* (the ideal spindle turns; no synchronised
+                                              * move) */
+        m->tau_s = tau;
+        pass_marks(m);
+        pass_ios(m);
+        c->time_s[n] = m->elapsed_s;
+        c->dist_mm[n] = sg->dist0_mm + (sg->len > 0 ? e->s * sg->xyz_len_mm / sg->len : 0);
+        a->taken++, a->calm++;
+        a->next++, n++;
+    }
+    if (!n)
+        return 0;
+    entry_values(m, sg, a->next - 1);
+    stream_watch(m);
+    report(m, out);
+    c->n = n;
+    c->pose = (const double(*)[KINS_POSE_DIM])a->pose[first];
+    c->joints = (const double(*)[KINS_MAX_JOINTS])a->joints[first];
+    return n;
+}
+
 /* One servo period (see motion.h). */
 int motion_step(struct motion *m, double period_s, struct motion_out *out)
 {

@@ -266,6 +266,82 @@ START_TEST(test_ahead_same_bits)
 }
 END_TEST
 
+/* A check's calm periods taken several at a time (motion_step_calm) are the periods
+ * motion_step gives one by one: the program of test_ahead_same_bits on two machines, one
+ * stepping period by period, the other taking runs of calm periods wherever it can; every
+ * period's record equals the other's bit for bit (its brief part), and at the end of every
+ * run the executors stand at the same place with the same values. The feed override is
+ * raised and lowered and a pause and a resume given where the second machine stands at a
+ * period (between runs); most periods were taken in runs. */
+START_TEST(test_calm_same_bits)
+{
+    struct tm_machine a, b;
+    struct canon_prog p;
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
+           e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
+           c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, e4[6] = {5, 5, 645, 0, 0, 0};
+    two_machines(&a, &b, &p, s0);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
+                           .value = 0.01, .ivalue = 640};
+    ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
+    tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
+    tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
+    tm_arc(&p, 5, e3, c3, n3, 1, 1800);
+    double at[6];
+    add_curve(&p, e3, 120, 0.05, 5, at);
+    tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
+    tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
+    tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
+    tm_load_start(a.m, &p);
+    tm_load_start(b.m, &p);
+    motion_set_rates(a.m, false);
+    motion_set_rates(b.m, false);
+    motion_set_brief(a.m, true);
+    motion_set_ahead(b.m, true);
+    motion_set_brief(b.m, true);
+    struct calm_feed f = { .on = 1 };
+    struct motion_out oa, ob;
+    memset(&oa, 0, sizeof oa);
+    long n = 0, paused = 0;
+    int step = 0, in_step = 1;
+    do {
+        /* (the operator's commands where the second machine stands at the period) */
+        if (in_step && step < 3 && n >= (long[]){ 700, 1100, 1500 }[step]) {
+            if (step < 2)
+                ck_assert(motion_set_feed_override(a.m, step == 0 ? 1.5 : 1.0) == MOTION_OK &&
+                          motion_set_feed_override(b.m, step == 0 ? 1.5 : 1.0) == MOTION_OK);
+            else
+                ck_assert(motion_pause(a.m) == MOTION_OK && motion_pause(b.m) == MOTION_OK);
+            step++;
+        }
+        if (oa.state == MOTION_PAUSED && step == 3) {      /* the pause, and then the M0 */
+            ck_assert(in_step);
+            paused++;
+            ck_assert(motion_resume(a.m) == MOTION_OK && motion_resume(b.m) == MOTION_OK);
+        }
+        ck_assert_int_eq(motion_step(a.m, DT, &oa), MOTION_OK);
+        ck_assert_int_eq(calm_next(b.m, DT, &f, &ob, &in_step), MOTION_OK);
+        same_brief(&oa, &ob);
+        if (in_step)
+            same_executor(a.m, b.m);
+    } while ((oa.state == MOTION_RUNNING || oa.state == MOTION_PAUSING ||
+              oa.state == MOTION_PAUSED) && ++n < 200000);
+    ck_assert_int_eq(oa.state, MOTION_DONE);
+    ck_assert(in_step);
+    ck_assert_int_eq(step, 3);
+    ck_assert_int_ge(paused, 2);
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(ob.pose[i], e4[i], 1e-9);
+    /* most periods in runs, of more than two periods on average */
+    ck_assert_msg(f.periods > n / 2 && f.periods > 2 * f.runs, "%ld periods in %ld runs of "
+                  "%ld", f.periods, f.runs, n);
+    ck_assert_int_eq(b.m->ahead.calm, f.periods);
+    canon_prog_free(&p);
+    tm_close(&a);
+    tm_close(&b);
+}
+END_TEST
+
 /* The planner's look-ahead over knots (four knots' kinematics at once) changes no plan: two
  * machines plan the same program, dense blended five-axis feeds, an arc, a dwell and exact
  * stops, the look-ahead off in one; every knot's place, speeds, caps and every interval's
@@ -661,6 +737,7 @@ static Suite *motion_suite(void)
     tcase_add_test(tc, test_brief_record);
     tcase_add_test(tc, test_segment_values_per_program);
     tcase_add_test(tc, test_ahead_same_bits);
+    tcase_add_test(tc, test_calm_same_bits);
     tcase_add_test(tc, test_knot_ahead_same_plan);
     tcase_add_test(tc, test_arcs);
     tcase_add_test(tc, test_helix);

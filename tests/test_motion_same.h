@@ -45,4 +45,40 @@ static inline void same_executor(const struct motion *a, const struct motion *b)
     ck_assert(a->waiting == b->waiting && a->state == b->state);
 }
 
+/* One machine's periods one by one, taken several at a time by motion_step_calm where it
+ * takes them (on), else by motion_step: each period's record is the run's last record with
+ * that period's pose, legs, clock and distance done, which is what motion_step would have
+ * given for it (its brief part). */
+struct calm_feed {
+    int on;
+    struct motion_calm c;
+    struct motion_out last;              /* the run's last period's record */
+    int k;                               /* the run's periods handed out */
+    long runs, periods;                  /* runs taken, and periods in them */
+};
+
+/* The next period into out (its brief part where the machine's record is brief); the
+ * return of motion_step, or MOTION_OK for a period of a run. *in_step: whether the
+ * executor stands at this period (1), or at the end of a run still being handed out (0). */
+static inline int calm_next(struct motion *m, double dt, struct calm_feed *f,
+                            struct motion_out *out, int *in_step)
+{
+    if (f->k >= f->c.n) {
+        f->k = f->c.n = 0;
+        if (!f->on || motion_step_calm(m, dt, &f->c, &f->last) == 0) {
+            *in_step = 1;
+            return motion_step(m, dt, out);
+        }
+        f->runs++, f->periods += f->c.n;
+    }
+    int k = f->k++;
+    *out = f->last;
+    memcpy(out->pose, f->c.pose[k], sizeof out->pose);
+    memcpy(out->joint_pos, f->c.joints[k], (size_t)m->nj * sizeof *out->joint_pos);
+    out->time_elapsed_s = f->c.time_s[k];
+    out->distance_done_mm = f->c.dist_mm[k];
+    *in_step = f->k == f->c.n;
+    return MOTION_OK;
+}
+
 #endif
