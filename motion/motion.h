@@ -432,18 +432,18 @@ void motion_set_rates(struct motion *m, bool on);
  * time_elapsed_s, distance_done_mm, distance_total_mm) and leaves the rest of the record as
  * it was: on dense code the record was a tenth of a check's period. Off by default. */
 void motion_set_brief(struct motion *m, bool on);
-/* On (with rates off): the executor computes the path's pose and legs four periods at a
- * time where the plan's pace lets it see them coming, the same bits as period by period
- * (motion_ahead.c): a check's pass, not a machine's servo thread. Off by default. */
+/* On (with rates off): the executor computes the path's pose and legs eight periods ahead,
+ * four at a time, where the plan's pace lets it see them coming, the same bits as period by
+ * period (motion_ahead.c): a check's pass, not a machine's servo thread. Off by default. */
 void motion_set_ahead(struct motion *m, bool on);
 /* A check's calm periods, several in one call (ahead and brief on, rates off): where the
- * next periods run at the plan's own pace inside one interval of the plan, on a line or an
- * arc, no probe, pause, jerk limiting, stepped block, override or chunk hand-over among them,
- * takes up to MOTION_CALM_MAX of them exactly as that many motion_step calls would (the same
- * bits: test_calm_same_bits), and returns how many: 0 when the next period is not one of
- * them (nothing done; motion_step takes it). out: the last period's record; c: each period's
+ * next periods run at the plan's own pace on one segment, a line or an arc, with no probe,
+ * pause, jerk limiting, stepped block, override or chunk hand-over among them, takes up to
+ * MOTION_CALM_MAX of them exactly as that many motion_step calls would (the same bits:
+ * test_calm_same_bits), and returns how many: 0 when the next period is not one of them
+ * (nothing done; motion_step takes it). out: the last period's record; c: each period's
  * pose, legs, clock and distance done (pose and legs valid until the next call into m). */
-#define MOTION_CALM_MAX 4
+#define MOTION_CALM_MAX 8
 struct motion_calm {
     int n;                                      /* periods taken */
     const double (*pose)[KINS_POSE_DIM];        /* period k's pose, pose[k] */

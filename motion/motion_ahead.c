@@ -1,4 +1,4 @@
-/* motion_ahead.c: a check's executor evaluates the path four periods at a time. */
+/* motion_ahead.c: a check's executor evaluates the path eight periods ahead, four at a time. */
 #include <stdbool.h>
 #include <string.h>
 
@@ -9,19 +9,21 @@
 /*
  * motion_set_ahead(m, true) (the check's servo-rate pass, with rates off): where evaluate()
  * has no entry for the period, it computes the path's position, pose and legs of this period
- * and of the next three as the plan's own pace would reach them (the clock one period on
- * each, the knots followed as follow_knots does), the legs of all four in one
- * kins_inverse4 call: the inverse kinematics of four poses at once take under half the time
- * of four single ones (bench_kins). Four periods in one interval of the plan take their
- * positions as vectors (plan_at4), four on one segment their poses (seg_pose4), lane by lane
- * the scalar functions' operations, where the processor has AVX2 (common/simd.h; else the
- * scalar functions, the same bits). Each entry is keyed by what it is a function of, the
- * plan run, its interval and segment, and the plan clock; a period whose state has that key
- * takes the entry, any other (an override, a pause, a chunk switched, a stop) computes its
- * own and four more. Position, pose and legs are pure functions of the key, so an entry is
- * the very bits the period would compute (test_ahead_same_bits): the look-ahead changes
- * how much is computed at once, never what. The machine's own servo thread does not use it
- * (a period there must not take four periods' work).
+ * and of the next seven (MOTION_AHEAD) as the plan's own pace would reach them (the clock
+ * one period on each, the knots followed as follow_knots does), four at a time
+ * (MOTION_LANES): the legs of four in one kins_inverse4 call, as the inverse kinematics of
+ * four poses at once take under half the time of four single ones (bench_kins). Four periods
+ * in one interval of the plan take their positions as vectors (plan_at4), four on one
+ * segment their poses (seg_pose4), lane by lane the scalar functions' operations, where the
+ * processor has AVX2 (common/simd.h; else the scalar functions, the same bits). Each entry
+ * is keyed by what it is a function of, the plan run, its interval and segment, and the plan
+ * clock; a period whose state has that key takes the entry, any other (an override, a
+ * pause, a chunk switched, a stop) computes its own and seven more. Position, pose and legs
+ * are pure functions of the key, so an entry is the very bits the period would compute
+ * (test_ahead_same_bits): the look-ahead changes how much is computed at once, never what.
+ * motion_step_calm (motion_step.c) fills it from the next period's key, before the clock
+ * gets there (motion_ahead_next), and takes its entries as a run of periods. The machine's
+ * own servo thread does not use it (a period there must not take eight periods' work).
  */
 
 /* motion_seg_pose at the four places s[] of segment sg, on vectors: its operations in its
@@ -90,6 +92,47 @@ static void plan_at4(const struct motion_plan *p, size_t ci, const double *tau, 
         s[l] = sv[l], v[l] = vv[l];
 }
 
+/* Entries g to g + n - 1 (n up to MOTION_LANES) of the look-ahead, their keys set: the
+ * path's position, pose and legs. */
+static void fill_lanes(struct motion *m, int g, int n, bool vec)
+{
+    struct motion_ahead *a = &m->ahead;
+    const struct motion_plan *p = m->run;
+    struct motion_ahead_at *at = &a->at[g];
+    double (*pose)[KINS_POSE_DIM] = &a->pose[g];
+    double sv[MOTION_LANES], vv[MOTION_LANES], tv[MOTION_LANES];
+    if (vec && n == MOTION_LANES && at[0].ci == at[n - 1].ci) {    /* one interval */
+        for (int j = 0; j < n; j++)
+            tv[j] = at[j].tau_s;
+        plan_at4(p, at[0].ci, tv, sv, vv, &m->phases);
+        for (int j = 0; j < n; j++)
+            at[j].s = sv[j], at[j].vp = vv[j];
+    } else {
+        for (int j = 0; j < n; j++) {
+            struct motion_ahead_at *e = &at[j];
+            double ap;
+            motion_plan_at(p, e->ci, e->tau_s, &e->s, &e->vp, &ap, &m->phases);
+            sv[j] = e->s;
+        }
+    }
+    if (!vec || n < MOTION_LANES || at[0].cs != at[n - 1].cs ||
+        !seg_pose4(p, &p->segs[at[0].cs], sv, pose))
+        for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
+            motion_seg_pose(p, &p->segs[at[j].cs], at[j].s, pose[j]);
+    if (n == MOTION_LANES) {
+        kins_inverse4(m->kins, (const double(*)[KINS_POSE_DIM])pose, &a->joints[g],
+                      &a->status[g]);
+        return;
+    }
+    double lanes[MOTION_LANES][KINS_POSE_DIM], joints[MOTION_LANES][KINS_MAX_JOINTS];
+    int status[MOTION_LANES];
+    for (int j = 0; j < MOTION_LANES; j++)    /* (lanes without a period: a pose the */
+        memcpy(lanes[j], pose[j < n ? j : 0], sizeof lanes[j]);   /* kinematics can take) */
+    kins_inverse4(m->kins, (const double(*)[KINS_POSE_DIM])lanes, joints, status);
+    memcpy(&a->joints[g], joints, (size_t)n * sizeof joints[0]);
+    memcpy(&a->status[g], status, (size_t)n * sizeof status[0]);
+}
+
 /* Fills the entries from plan time tau in interval ci of segment cs on: returns the first's
  * index (0), or -1 when that segment is one it leaves to evaluate() (synchronised, under
  * G43.4). */
@@ -119,31 +162,11 @@ static int fill(struct motion *m, double dt, size_t ci, size_t cs, double tau)
     a->next = 0;
     if (n == 0)
         return -1;
-    double sv[MOTION_AHEAD], vv[MOTION_AHEAD], tv[MOTION_AHEAD];
     bool vec = hexcnc_avx2();          /* (else the scalar functions: common/simd.h) */
-    if (vec && n == MOTION_AHEAD && a->at[0].ci == a->at[n - 1].ci) {    /* one interval */
-        for (int j = 0; j < n; j++)
-            tv[j] = a->at[j].tau_s;
-        plan_at4(p, a->at[0].ci, tv, sv, vv, &m->phases);
-        for (int j = 0; j < n; j++)
-            a->at[j].s = sv[j], a->at[j].vp = vv[j];
-    } else {
-        for (int j = 0; j < n; j++) {
-            struct motion_ahead_at *e = &a->at[j];
-            double ap;
-            motion_plan_at(p, e->ci, e->tau_s, &e->s, &e->vp, &ap, &m->phases);
-            sv[j] = e->s;
-        }
-    }
-    if (!vec || n < MOTION_AHEAD || a->at[0].cs != a->at[n - 1].cs ||
-        !seg_pose4(p, &p->segs[a->at[0].cs], sv, a->pose))
-        for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
-            motion_seg_pose(p, &p->segs[a->at[j].cs], a->at[j].s, a->pose[j]);
-    for (int j = n; j < MOTION_AHEAD; j++)      /* (lanes without a period: a pose the */
-        memcpy(a->pose[j], a->pose[0], sizeof a->pose[j]);   /* kinematics can take) */
+    for (int g = 0; g < n; g += MOTION_LANES)
+        fill_lanes(m, g, n - g < MOTION_LANES ? n - g : MOTION_LANES, vec);
     a->run = p;
     a->fills++;
-    kins_inverse4(m->kins, (const double(*)[KINS_POSE_DIM])a->pose, a->joints, a->status);
     return a->next++;
 }
 

@@ -73,7 +73,7 @@ static bool knot_fill(struct motion *m, const struct motion_seg *sg, double s)
     double (*pose)[KINS_POSE_DIM] = a->pose, (*dp)[KINS_POSE_DIM] = a->dp;
     double (*d2p)[KINS_POSE_DIM] = a->d2p;
     int n = 0;
-    while (n < MOTION_AHEAD) {
+    while (n < MOTION_LANES) {
         const struct motion_seg *g = &p->segs[j];
         a->sg[n] = g, a->s[n] = p->ks[k];
         motion_seg_derivs(p, g, p->ks[k], pose[n], dp[n], d2p[n]);
@@ -86,7 +86,7 @@ static bool knot_fill(struct motion *m, const struct motion_seg *sg, double s)
             k = p->segs[j].k0;
         }
     }
-    for (int l = n; l < MOTION_AHEAD; l++) {    /* (lanes without a knot: one it can take) */
+    for (int l = n; l < MOTION_LANES; l++) {    /* (lanes without a knot: one it can take) */
         memcpy(pose[l], pose[0], sizeof pose[l]);
         memcpy(dp[l], dp[0], sizeof dp[l]);
         memcpy(d2p[l], d2p[0], sizeof d2p[l]);

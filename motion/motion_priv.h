@@ -224,9 +224,12 @@ struct motion_manual {
 enum motion_home_phase { HOME_IDLE, HOME_WAIT, HOME_OFF_SWITCH, HOME_SEARCH, HOME_BACKOFF,
                          HOME_LATCH, HOME_SETTLE, HOME_FINAL, HOME_DONE };
 
+/* The lanes of the kinematics' four-at-once calls (kins_inverse4, kins_inverse_path4). */
+#define MOTION_LANES 4
 /* The look-ahead of a check's executor (motion_ahead.c): the next periods' path position,
- * pose and legs, each keyed by the state it is a function of. */
-#define MOTION_AHEAD 4
+ * pose and legs, each keyed by the state it is a function of; filled MOTION_LANES at a
+ * time. */
+#define MOTION_AHEAD 8
 struct motion_ahead_at {
     size_t ci, cs;           /* the key: interval, segment and plan clock (of run) */
     double tau_s;
@@ -251,13 +254,13 @@ struct motion_knot_ahead {
     int on;                  /* all_caps is sampling the plan's knots in order */
     int off;                 /* never (a test compares plans made with and without) */
     int n, next;             /* entries filled, the next one to take */
-    const struct motion_seg *sg[MOTION_AHEAD];
-    double s[MOTION_AHEAD];
-    int status[MOTION_AHEAD];
-    double pose[MOTION_AHEAD][KINS_POSE_DIM], dp[MOTION_AHEAD][KINS_POSE_DIM];
-    double d2p[MOTION_AHEAD][KINS_POSE_DIM];             /* motion_seg_derivs' */
-    double L[MOTION_AHEAD][KINS_MAX_JOINTS], dL[MOTION_AHEAD][KINS_MAX_JOINTS];
-    double d2L[MOTION_AHEAD][KINS_MAX_JOINTS];           /* kins_inverse_path4's */
+    const struct motion_seg *sg[MOTION_LANES];
+    double s[MOTION_LANES];
+    int status[MOTION_LANES];
+    double pose[MOTION_LANES][KINS_POSE_DIM], dp[MOTION_LANES][KINS_POSE_DIM];
+    double d2p[MOTION_LANES][KINS_POSE_DIM];             /* motion_seg_derivs' */
+    double L[MOTION_LANES][KINS_MAX_JOINTS], dL[MOTION_LANES][KINS_MAX_JOINTS];
+    double d2L[MOTION_LANES][KINS_MAX_JOINTS];           /* kins_inverse_path4's */
     long fills, taken;       /* fills, and entries taken after the first of a fill */
 };
 struct motion_ahead {
@@ -268,8 +271,9 @@ struct motion_ahead {
     int status[MOTION_AHEAD];
     int n, next;             /* entries filled, the next one to take */
     long fills, taken;       /* fills, and entries taken after the first of a fill */
-    long calm;               /* periods motion_step took the short way (calm_period) */
+    long calm;               /* periods taken the short way (calm_period, motion_step_calm) */
 };
+_Static_assert(MOTION_AHEAD == MOTION_CALM_MAX, "a calm run is the look-ahead's entries");
 
 /* The motion instance. */
 struct motion {

@@ -690,11 +690,13 @@ static inline bool calm_period(struct motion *m, double dt, struct motion_out *o
     return true;
 }
 
-/* See motion.h. The periods calm_period would take one by one, their entries filled here
+/* See motion.h. The periods calm_period would take one by one, and past the knots inside
+ * the segment as well (follow_knots does nothing else there: no pause or wait lies on a
+ * line or an arc, and the chunk's hand-over knot ends the run), their entries filled here
  * where none is left (at the plan's pace the next periods' key is known before the clock
- * moves: motion_ahead_next): the per-period work is the clock, the passed commands and the
- * place, and the record, the status watch and the executor's pose are written once, for
- * the last. */
+ * moves: motion_ahead_next). The per-period work is the clock, the interval, the passed
+ * commands and the place; the record, the status watch and the executor's pose are
+ * written once, for the last. */
 int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct motion_out *out)
 {
     if (!m || !c || !out || !(dt > 0) || !m->ahead_on || !m->brief || !m->no_rates ||
@@ -708,14 +710,20 @@ int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct 
         return 0;
     if ((a->next >= a->n || a->run != p) && !motion_ahead_next(m, dt))
         return 0;
+    /* (a chunk's hand-over knot, where follow_knots switches to the successor: no run
+     * passes it) */
+    size_t k_leave = m->chunk && !m->chunk->last && !m->tail_taken ? m->chunk->k_leave
+                                                                    : SIZE_MAX;
     int first = a->next, n = 0;
     while (a->next < a->n) {
         const struct motion_ahead_at *e = &a->at[a->next];
         double tau = m->tau_s + dt;          /* advance() at the plan's pace */
-        /* (the entry was filled at this clock in this interval: follow_knots stays in it) */
-        if (e->ci != m->ci || e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
-            a->status[a->next] != KINS_OK)
+        /* (the entry was filled at this clock, its knots followed as follow_knots follows
+         * them: on this segment, a line or an arc, whose knots hold no pause or wait) */
+        if (e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
+            a->status[a->next] != KINS_OK || (e->ci != m->ci && e->ci >= k_leave))
             break;
+        m->ci = e->ci;
         m->io_age++;
         pass_ios(m);
         m->elapsed_s += dt;
