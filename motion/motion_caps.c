@@ -375,9 +375,11 @@ static struct leg_share leg_share(const struct motion *m, const struct motion_se
 
 /* Leg caps at a knot: path speed into *vl, path acceleration into *am (lowered). The leg's
  * rate is L' v and its acceleration L'' v^2 + L' a; L' may grow by L'' hs before the next
- * knot. The shares of the leg's acceleration are sh's. */
+ * knot. The shares of the leg's acceleration are sh's. rest (not NULL): lowered to the
+ * path acceleration at rest, leg_acc_at_speed(m, S, hs, 0, sh), which the same loop has
+ * at hand (at rest the curvature terms take nothing: each leg's whole aL / L'). */
 static void leg_caps(const struct motion *m, const struct motion_sample *S, double hs,
-                     struct leg_share sh, double *vl, double *am)
+                     struct leg_share sh, double *vl, double *am, double *rest)
 {
     const struct motion_config *c = &m->cfg;
     double v2 = HUGE_VAL;      /* the curvature terms' speed, squared: one square root for
@@ -388,6 +390,8 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
         if (d1 > 1e-12) {
             *vl = motion_min2(*vl, c->joint[i].max_vel_mm_s / d1);
             *am = motion_min2(*am, (1 - sh.curv) * c->joint[i].max_acc_mm_s2 / d1);
+            if (rest)
+                *rest = motion_min2(*rest, c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
             v2 = motion_min2(v2, sh.curv * c->joint[i].max_acc_mm_s2 / (sh.hand * d2));
@@ -467,7 +471,7 @@ static int between_knots(struct motion *m, const struct motion_seg *sg, double s
         int st = reach_check(m, sg, &T, h, sample_at(m, sg, s + j * h, &T), err, errlen);
         if (st)
             return st;
-        leg_caps(m, &T, h, sh, &v, am);
+        leg_caps(m, &T, h, sh, &v, am, NULL);
         *vl = motion_min2(*vl, v);
     }
     return MOTION_OK;
@@ -506,7 +510,8 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     }
     double am_machine = am;
     struct leg_share sh = leg_share(m, sg);
-    leg_caps(m, S, h, sh, &vl, &am);
+    double rest = HUGE_VAL;    /* the legs' path acceleration at rest */
+    leg_caps(m, S, h, sh, &vl, &am, &rest);
     if (h < hs && (st = between_knots(m, sg, s, hs, sh, &vl, &am, err, errlen)))
         return st;
     double vk = kin_tol_cap(m, sg, S);
@@ -527,7 +532,7 @@ int motion_knot_caps(struct motion *m, const struct motion_seg *sg, double s, do
     *cap = motion_min2(*hard, feed);
     double am0 = am;
     if (h >= hs) {             /* the legs' share for the path, now the speed is known */
-        am0 = motion_min2(am_machine, leg_acc_at_speed(m, S, h, 0, sh));
+        am0 = motion_min2(am_machine, rest);
         am = motion_min2(am_machine, leg_acc_at_speed(m, S, h, *hard, sh));
     }
     *acc = am;
