@@ -30,6 +30,9 @@ struct sim {
     const double *pose, *joints;       /* the period being measured: its pose and legs, its */
     double time_s, dist_mm;            /* clock and distance done (the record's, or a calm
                                         * run's entry: motion_step_calm) */
+    const struct motion_calm *calm;    /* the calm run the period is of, or NULL (its */
+    int calm_k;                        /* distance done is the run's calm_k-th, taken where
+                                        * read) */
     double v0[KINS_MAX_JOINTS];        /* leg rate over the last period tested, mm/s (the
                                         * machine starts at rest: 0) */
     double a0[KINS_MAX_JOINTS];        /* leg acceleration of the last period tested */
@@ -565,7 +568,8 @@ static struct check_defer_slot *slot_for(struct sim *s, enum check_defer_kind ki
         apply(s, check_defer_next(s->dq, 1));
     }
     q->line = out->line, q->file = out->file, q->period = s->r->periods;
-    q->time_s = s->time_s, q->dist_mm = s->dist_mm;
+    q->time_s = s->time_s;
+    q->dist_mm = s->calm ? motion_calm_dist(s->calm, s->calm_k) : s->dist_mm;
     memcpy(q->pose, s->pose, sizeof q->pose);
     return q;
 }
@@ -753,11 +757,13 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
             /* (the record is the last period's: each period's own pose, legs, clock and
              * distance with the rest of it, which is the same in all) */
             for (int k = 0; k < nc; k++) {
-                sim_at(&s, calm.pose[k], calm.joints[k], calm.time_s[k], calm.dist_mm[k]);
+                sim_at(&s, calm.pose[k], calm.joints[k], calm.time_s[k], 0);
+                s.calm = &calm, s.calm_k = k;
                 sim_period(&s, &out, k > 0);
                 s.prev_p = calm.pose[k], s.prev_L = calm.joints[k];
             }
             sim_keep(&s);
+            s.calm = NULL;
             n += nc;
             continue;
         }

@@ -442,15 +442,23 @@ void motion_set_ahead(struct motion *m, bool on);
  * MOTION_CALM_MAX of them exactly as that many motion_step calls would (the same bits:
  * test_calm_same_bits), and returns how many: 0 when the next period is not one of them
  * (nothing done; motion_step takes it). out: the last period's record; c: each period's
- * pose, legs, clock and distance done (pose and legs valid until the next call into m). */
+ * pose, legs, clock and place on the segment, its distance done by motion_calm_dist (pose
+ * and legs valid until the next call into m). */
 #define MOTION_CALM_MAX 8
 struct motion_calm {
     int n;                                      /* periods taken */
     const double (*pose)[KINS_POSE_DIM];        /* period k's pose, pose[k] */
     const double (*joints)[KINS_MAX_JOINTS];    /* its legs (joint_pos) */
     double time_s[MOTION_CALM_MAX];             /* time_elapsed_s at its end */
-    double dist_mm[MOTION_CALM_MAX];            /* distance_done_mm */
+    double s[MOTION_CALM_MAX];                  /* its place on the segment */
+    double dist0_mm, xyz_len_mm, len;           /* the segment's: distance done at its
+                                                 * start, X Y Z length, length */
 };
+/* Period k's distance_done_mm (a division: taken where it is read). */
+static inline double motion_calm_dist(const struct motion_calm *c, int k)
+{
+    return c->dist0_mm + (c->len > 0 ? c->s[k] * c->xyz_len_mm / c->len : 0);
+}
 int motion_step_calm(struct motion *m, double period_s, struct motion_calm *c,
                      struct motion_out *out);
 void motion_set_spindle_at_speed(struct motion *m, bool at_speed);

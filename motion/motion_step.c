@@ -733,7 +733,7 @@ int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct 
         pass_marks(m);
         pass_ios(m);
         c->time_s[n] = m->elapsed_s;
-        c->dist_mm[n] = sg->dist0_mm + (sg->len > 0 ? e->s * sg->xyz_len_mm / sg->len : 0);
+        c->s[n] = e->s;            /* (entry_values' distance from it: motion_calm_dist) */
         a->taken++, a->calm++;
         a->next++, n++;
     }
@@ -743,6 +743,7 @@ int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct 
     stream_watch(m);
     report(m, out);
     c->n = n;
+    c->dist0_mm = sg->dist0_mm, c->xyz_len_mm = sg->xyz_len_mm, c->len = sg->len;
     c->pose = (const double(*)[KINS_POSE_DIM])a->pose[first];
     c->joints = (const double(*)[KINS_MAX_JOINTS])a->joints[first];
     return n;

@@ -76,7 +76,7 @@ static inline int calm_next(struct motion *m, double dt, struct calm_feed *f,
     memcpy(out->pose, f->c.pose[k], sizeof out->pose);
     memcpy(out->joint_pos, f->c.joints[k], (size_t)m->nj * sizeof *out->joint_pos);
     out->time_elapsed_s = f->c.time_s[k];
-    out->distance_done_mm = f->c.dist_mm[k];
+    out->distance_done_mm = motion_calm_dist(&f->c, k);
     *in_step = f->k == f->c.n;
     return MOTION_OK;
 }
