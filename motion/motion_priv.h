@@ -58,25 +58,33 @@ struct motion_arc {
 };
 
 /* One planned segment: a move, a dwell or a pause. The path parameter s runs over [0, len]
- * (mm along the XYZ path, or deg along the ABC path for rotary-only moves). */
+ * (mm along the XYZ path, or deg along the ABC path for rotary-only moves). (What the
+ * executor reads every period comes first, in the first three cache lines: a check's
+ * servo pass reads each segment once, some time after the planner's thread wrote it.) */
 struct motion_seg {
     enum motion_seg_kind kind;
     int rotary;              /* 1: rotary-only move, s and speeds in deg */
     int line;                /* program line */
+    int tcp;                 /* tool centre point control: the path (start, end, arcs) is the
+                              * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
+                              * gives the platform's pose */
+    int sync;                /* SEG_LINE of G33/G33.1 (enum canon_sync): the spindle drives
+                              * the path position, not the plan's clock (motion_sync.c) */
+    int arc;                 /* index into arcs for SEG_ARC, else -1 */
     const char *file;        /* program file (interned by motion) */
-    double start[KINS_POSE_DIM], end[KINS_POSE_DIM]; /* mm, deg */
+    size_t k0;               /* first knot */
+    size_t nk;               /* knots (>= 2) */
     double len;              /* mm (deg when rotary) */
     double xyz_len_mm;       /* XYZ length, mm (0 for rotary-only, dwell, pause) */
     double dist0_mm;         /* XYZ distance of the program before this segment, mm */
-    double dwell_s;          /* DWELL: seconds */
     double feed;             /* programmed speed, mm/s (deg/s when rotary); 0 = rapid */
+    double tool_len_mm;
     double blend_tol_mm;     /* G64 tolerance in force (blend into the next move), 0 = stop */
-    size_t k0;               /* first knot */
-    size_t nk;               /* knots (>= 2) */
+    double start[KINS_POSE_DIM], end[KINS_POSE_DIM]; /* mm, deg */
     double fine_h;           /* spacing the checks need, mm (deg when rotary); knots are this
                               * close but on very long moves (MAX_INTERVALS), where the checks
                               * sample between them at this spacing */
-    int arc;                 /* index into arcs for SEG_ARC, else -1 */
+    double dwell_s;          /* DWELL: seconds */
     int wait_tool;           /* SEG_WAIT: for a tool change (else for the spindle) */
     int wait_input;          /* SEG_WAIT: for an input (M66): input, its kind and mode */
     int input, input_analog, input_mode;
@@ -91,12 +99,6 @@ struct motion_seg {
      * of such a chord stays within chord_tol (mm), the smallest rounding budget of those
      * arcs (motion_round_tol_mm). */
     double chord_mm[2], chord_k[2], chord_kabc[2], chord_tol[2];
-    int tcp;                 /* tool centre point control: the path (start, end, arcs) is the
-                              * tool tip and orientation; kins_tcp_to_pose with tool_len_mm
-                              * gives the platform's pose */
-    double tool_len_mm;
-    int sync;                /* SEG_LINE of G33/G33.1 (enum canon_sync): the spindle drives
-                              * the path position, not the plan's clock (motion_sync.c) */
     double pitch_mm_rev;     /* K, mm of path per spindle revolution */
     double retract_factor;   /* G33.1's I: the spindle's speed multiple for the way out */
     double sync_rpm;         /* the commanded spindle speed at the move, rpm */
