@@ -555,10 +555,15 @@ int motion_sync_check(struct motion *m, const struct motion_seg *sg, char *err,
  * follower: the calls behind the two first tests.) */
 void motion_sync_spindle(struct motion *m, double dt);
 bool motion_sync_advance_line(struct motion *m, const struct motion_seg *sg, double dt);
-static inline bool motion_sync_advance(struct motion *m, double dt)
+/* The ideal spindle's period (motion_sync_spindle), where it turns or is told to. */
+static inline void motion_sync_turn(struct motion *m, double dt)
 {
     if (m->spindle_ideal && (m->io.dir * m->io.rpm != 0 || m->ideal_rps != 0))
         motion_sync_spindle(m, dt);
+}
+static inline bool motion_sync_advance(struct motion *m, double dt)
+{
+    motion_sync_turn(m, dt);
     const struct motion_seg *sg = &m->run->segs[m->cs];
     if (!sg->sync || sg->kind != SEG_LINE) {
         m->sync.phase = SYNC_IDLE;

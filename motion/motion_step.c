@@ -723,15 +723,20 @@ int motion_step_calm(struct motion *m, double dt, struct motion_calm *c, struct 
         if (e->cs != m->cs || e->tau_s != tau || !(tau < p->total_time_s) ||
             a->status[a->next] != KINS_OK || (e->ci != m->ci && e->ci >= k_leave))
             break;
+        /* (the run's first period passes the commands at the segment, and the periods
+         * after it find none left to pass: the segment is the same) */
         m->ci = e->ci;
         m->io_age++;
-        pass_ios(m);
+        if (n == 0)
+            pass_ios(m);
         m->elapsed_s += dt;
-        motion_sync_advance(m, dt);          /* (the ideal spindle turns; no synchronised
-                                              * move) */
+        motion_sync_turn(m, dt);             /* motion_sync_advance off a synchronised */
+        m->sync.phase = SYNC_IDLE;           /* move: the ideal spindle turns */
         m->tau_s = tau;
-        pass_marks(m);
-        pass_ios(m);
+        if (n == 0) {
+            pass_marks(m);
+            pass_ios(m);
+        }
         c->time_s[n] = m->elapsed_s;
         c->s[n] = e->s;            /* (entry_values' distance from it: motion_calm_dist) */
         a->taken++, a->calm++;

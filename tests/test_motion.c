@@ -267,12 +267,13 @@ START_TEST(test_ahead_same_bits)
 END_TEST
 
 /* A check's calm periods taken several at a time (motion_step_calm) are the periods
- * motion_step gives one by one: the program of test_ahead_same_bits on two machines, one
+ * motion_step gives one by one: the program of test_ahead_same_bits, with the ideal spindle
+ * a check has started by S1200 M3 and stopped by M5 on the way, on two machines, one
  * stepping period by period, the other taking runs of calm periods wherever it can; every
  * period's record equals the other's bit for bit (its brief part), and at the end of every
- * run the executors stand at the same place with the same values. The feed override is
- * raised and lowered and a pause and a resume given where the second machine stands at a
- * period (between runs); most periods were taken in runs. */
+ * run the executors stand at the same place with the same values, the spindle's turns
+ * among them. The feed override is raised and lowered and a pause and a resume given where
+ * the second machine stands at a period (between runs); most periods were taken in runs. */
 START_TEST(test_calm_same_bits)
 {
     struct tm_machine a, b;
@@ -284,9 +285,16 @@ START_TEST(test_calm_same_bits)
     struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
                            .value = 0.01, .ivalue = 640};
     ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
+    struct canon_cmd sp[3] = {{.type = CANON_SPINDLE_SPEED, .line = 2, .file = "test.ngc",
+                               .value = 1200},
+                              {.type = CANON_SPINDLE_ON, .line = 2, .file = "test.ngc",
+                               .value = 1},
+                              {.type = CANON_SPINDLE_STOP, .line = 5, .file = "test.ngc"}};
+    ck_assert(canon_prog_sink(&p, &sp[0]) == 0 && canon_prog_sink(&p, &sp[1]) == 0);
     tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
     tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
     tm_arc(&p, 5, e3, c3, n3, 1, 1800);
+    ck_assert_int_eq(canon_prog_sink(&p, &sp[2]), 0);
     double at[6];
     add_curve(&p, e3, 120, 0.05, 5, at);
     tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
@@ -296,6 +304,8 @@ START_TEST(test_calm_same_bits)
     tm_load_start(b.m, &p);
     motion_set_rates(a.m, false);
     motion_set_rates(b.m, false);
+    motion_set_spindle_ideal(a.m, true);
+    motion_set_spindle_ideal(b.m, true);
     motion_set_brief(a.m, true);
     motion_set_ahead(b.m, true);
     motion_set_brief(b.m, true);
@@ -304,6 +314,7 @@ START_TEST(test_calm_same_bits)
     memset(&oa, 0, sizeof oa);
     long n = 0, paused = 0;
     int step = 0, in_step = 1;
+    double revs = 0;
     do {
         /* (the operator's commands where the second machine stands at the period) */
         if (in_step && step < 3 && n >= (long[]){ 700, 1100, 1500 }[step]) {
@@ -322,8 +333,12 @@ START_TEST(test_calm_same_bits)
         ck_assert_int_eq(motion_step(a.m, DT, &oa), MOTION_OK);
         ck_assert_int_eq(calm_next(b.m, DT, &f, &ob, &in_step), MOTION_OK);
         same_brief(&oa, &ob);
-        if (in_step)
+        if (in_step) {
             same_executor(a.m, b.m);
+            ck_assert(a.m->spindle_revs == b.m->spindle_revs &&
+                      a.m->ideal_rps == b.m->ideal_rps && a.m->sync.phase == b.m->sync.phase);
+            revs = a.m->spindle_revs;
+        }
     } while ((oa.state == MOTION_RUNNING || oa.state == MOTION_PAUSING ||
               oa.state == MOTION_PAUSED) && ++n < 200000);
     ck_assert_int_eq(oa.state, MOTION_DONE);
@@ -336,6 +351,8 @@ START_TEST(test_calm_same_bits)
     ck_assert_msg(f.periods > n / 2 && f.periods > 2 * f.runs, "%ld periods in %ld runs of "
                   "%ld", f.periods, f.runs, n);
     ck_assert_int_eq(b.m->ahead.calm, f.periods);
+    ck_assert_msg(revs > 10 && a.m->ideal_rps == 0, "%.3f turns, %.3f rev/s at the end", revs,
+                  a.m->ideal_rps);
     canon_prog_free(&p);
     tm_close(&a);
     tm_close(&b);
