@@ -76,13 +76,17 @@ static void deviation(const struct check_defer *d, struct check_defer_slot *s)
     const double *p0 = s->p0, *p1 = s->pose;
     for (int i = 0; i < d->kins->njoints; i++)
         Lm[i] = 0.5 * (s->L0[i] + s->L1[i]);
-    if (d->cold_forward)       /* the baseline: every solve from the home pose */
+    if (d->cold_forward) {     /* the baseline: every solve from the home pose */
         memcpy(P, d->kins->home, sizeof P);
-    else                       /* warm: the commanded chord's midpoint is within the
-                                * deviation (um) of the answer, so one Newton step does */
+        s->ok = kins_forward(d->kins, Lm, P, NULL) == KINS_OK;
+    } else {                   /* warm: the commanded chord's midpoint is within about
+                                * 1e-7 mm of the answer (the deviation, and the legs'
+                                * bend along the path), so one Newton step does: its error
+                                * is of the order of its square over the machine's size */
         for (int i = 0; i < KINS_POSE_DIM; i++)
             P[i] = 0.5 * (p0[i] + p1[i]);
-    s->ok = kins_forward(d->kins, Lm, P, NULL) == KINS_OK;
+        s->ok = kins_forward_near(d->kins, Lm, P, CHECK_NEAR_STEP_MM, NULL) == KINS_OK;
+    }
     if (!s->ok)
         return;
     for (int i = 0; i < 3; i++)

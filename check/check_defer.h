@@ -14,6 +14,9 @@
                                       * 10 ms, 40 s of machine time, 3000 measures on dense
                                       * code) */
 
+#define CHECK_NEAR_STEP_MM 1e-6     /* a deviation's forward kinematics: a first Newton step
+                                     * within this ends the solve (error about 1e-13 mm, the
+                                     * rounding of the coordinates) */
 #define CHECK_DEFER_RUN 32           /* slots the pass claims at once when it computes them
                                       * itself (one locked instruction, a full fence on x86,
                                       * for all of them) */

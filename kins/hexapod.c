@@ -409,6 +409,7 @@ const struct kins_ops kins_hexapod_ops = {
     .destroy = hexapod_destroy,
     .inverse = hexapod_inverse,
     .forward = hexapod_forward,
+    .forward_near = hexapod_forward_near,
     .leg_rates = hexapod_leg_rates,
     .check = hexapod_check,
     .tool_point = hexapod_tool_point,

@@ -82,5 +82,8 @@ void hexapod_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
 /* Forward kinematics by Newton-Raphson (hexapod_fwd.c); the kins_ops forward entry. */
 int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
                     struct kins_fwd_info *info);
+/* The kins_ops forward_near entry: a first step within accept_mm ends the solve. */
+int hexapod_forward_near(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                         double accept_mm, struct kins_fwd_info *info);
 
 #endif

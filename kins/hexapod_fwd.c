@@ -159,9 +159,10 @@ static inline double hexapod_residual(const struct hexapod *h, const double q[N]
  * factorisation exists, the correction it gives for the new residual is tried first, and
  * if that correction is below the tolerance it is applied and the solve has converged
  * (the error left is of the order of the correction squared). Otherwise a full Newton step
- * with a fresh analytic Jacobian is taken. The pose is written back only on success. */
-int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
-                    struct kins_fwd_info *info)
+ * with a fresh analytic Jacobian is taken; where accept_mm > 0, a first one within it ends
+ * the solve too (forward_near). The pose is written back only on success. */
+static int forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                   double accept_mm, struct kins_fwd_info *info)
 {
     const struct hexapod *h = (const struct hexapod *)k;
     double q[N], rhs[N], lu[N][N], sn[3], cs[3];
@@ -213,8 +214,12 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
         }
         hexapod_lu_solve(lu, piv, rhs);
         hexapod_apply_step(h, q, sn, cs, rhs);
-        have_lu = 1;
         iter++;
+        if (!have_lu && hexapod_max_abs(rhs) <= accept_mm) {
+            st = KINS_OK;
+            break;
+        }
+        have_lu = 1;
     }
     if (info) {
         info->iterations = iter;
@@ -229,4 +234,16 @@ int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_
     pose[KINS_B] = q[4] * HEXAPOD_DEG_PER_RAD;
     pose[KINS_C] = q[5] * HEXAPOD_DEG_PER_RAD;
     return KINS_OK;
+}
+
+int hexapod_forward(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                    struct kins_fwd_info *info)
+{
+    return forward(k, joints, pose, 0, info);
+}
+
+int hexapod_forward_near(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                         double accept_mm, struct kins_fwd_info *info)
+{
+    return forward(k, joints, pose, accept_mm, info);
 }

@@ -81,6 +81,12 @@ struct kins_ops {
      * on KINS_OK only; on failure it is left unchanged. info may be NULL. */
     int (*forward)(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
                    struct kins_fwd_info *info);
+    /* Optional: forward from a guess known to lie close to the answer (a check's mid-chord
+     * deviation starts from the commanded chord's midpoint, within about 1e-7 mm): a first
+     * Newton step within accept_mm ends the solve, as its error is of the order of the
+     * step's square over the machine's size; otherwise as forward. NULL: forward. */
+    int (*forward_near)(struct kins *k, const double *joints, double pose[KINS_POSE_DIM],
+                        double accept_mm, struct kins_fwd_info *info);
     /* Leg rates (mm/s) from pose and pose velocity (mm/s, deg/s) through the Jacobian. */
     int (*leg_rates)(struct kins *k, const double pose[KINS_POSE_DIM],
                      const double pose_vel[KINS_POSE_DIM], double *rates);
@@ -180,6 +186,12 @@ void kins_inverse_path4(struct kins *k, const double (*pose)[KINS_POSE_DIM],
 static inline int kins_forward(struct kins *k, const double *joints, double *pose,
                                struct kins_fwd_info *info)
 { return k->ops->forward(k, joints, pose, info); }
+static inline int kins_forward_near(struct kins *k, const double *joints, double *pose,
+                                    double accept_mm, struct kins_fwd_info *info)
+{
+    return k->ops->forward_near ? k->ops->forward_near(k, joints, pose, accept_mm, info)
+                                : k->ops->forward(k, joints, pose, info);
+}
 static inline int kins_leg_rates(struct kins *k, const double *pose, const double *vel,
                                  double *rates)
 { return k->ops->leg_rates(k, pose, vel, rates); }

@@ -125,6 +125,43 @@ START_TEST(test_round_trip)
 }
 END_TEST
 
+/* forward_near: from a start within 1e-7 mm of the answer (a check's mid-chord deviation) one
+ * Newton step ends the solve and gives the pose kins_forward gives to within 1e-12 mm and
+ * deg; from 0.05 mm away the first step is too long to stop at, and the solve goes on to
+ * the pose within 1e-9 as forward does (a model without the entry: test_trivial_static). */
+START_TEST(test_forward_near)
+{
+    struct kins *k = make_tmu();
+    uint64_t rng = 777;
+    double worst_pos = 0, worst_ang = 0;
+    for (int n = 0; n < 2000; n++) {
+        double pose[6], legs[6], full[6], near[6], far[6], ep, ea;
+        struct kins_fwd_info info;
+        tk_rand_pose(&rng, pose);
+        ck_assert_int_eq(kins_inverse(k, pose, legs), KINS_OK);
+        for (int j = 0; j < 6; j++) {
+            near[j] = pose[j] + tk_rand(&rng, -1, 1) * 1e-7;
+            far[j] = pose[j] + tk_rand(&rng, -1, 1) * (j < 3 ? 0.05 : 0.01);
+        }
+        memcpy(full, near, sizeof full);
+        ck_assert_int_eq(kins_forward(k, legs, full, &info), KINS_OK);
+        ck_assert_int_eq(info.iterations, 1);     /* (forward checks its step once more) */
+        ck_assert_int_eq(kins_forward_near(k, legs, near, 1e-6, &info), KINS_OK);
+        ck_assert_int_eq(info.iterations, 1);
+        pose_err(full, near, &ep, &ea);
+        worst_pos = fmax(worst_pos, ep);
+        worst_ang = fmax(worst_ang, ea);
+        ck_assert_int_eq(kins_forward_near(k, legs, far, 1e-6, &info), KINS_OK);
+        ck_assert_int_ge(info.iterations, 2);
+        pose_err(pose, far, &ep, &ea);
+        ck_assert(ep <= 1e-9 && ea <= 1e-9);
+    }
+    ck_assert_msg(worst_pos <= 1e-12 && worst_ang <= 1e-12, "%.3g mm, %.3g deg from forward's",
+                  worst_pos, worst_ang);
+    kins_free(k);
+}
+END_TEST
+
 /* Explicit, irregular joints with per-leg offsets: joint value = joint-centre distance -
  * offset (checked against the distance computed by hand), and inverse then forward gives
  * the pose back to 1e-9 over the working region. */
@@ -690,6 +727,9 @@ START_TEST(test_trivial_static)
     ck_assert_double_eq(j[8], 0.0);
     ck_assert_int_eq(kins_forward(k, j, back, NULL), KINS_OK);
     ck_assert_mem_eq(back, pose, sizeof back);
+    memset(back, 0, sizeof back);     /* (no forward_near of its own: forward answers) */
+    ck_assert_int_eq(kins_forward_near(k, j, back, 1e-6, NULL), KINS_OK);
+    ck_assert_mem_eq(back, pose, sizeof back);
     pose[2] = 150;
     ck_assert_int_eq(kins_inverse(k, pose, j), KINS_ERR_UNREACHABLE);
     ck_assert_int_eq(kins_tool_point(k, pose, NULL, NULL), KINS_ERR_ARG);
@@ -719,6 +759,7 @@ static Suite *kins_suite(void)
     TCase *tc = tcase_create("hexapod");
     tcase_add_test(tc, test_home_by_hand);
     tcase_add_test(tc, test_round_trip);
+    tcase_add_test(tc, test_forward_near);
     tcase_add_test(tc, test_offsets_round_trip);
     tcase_add_test(tc, test_leg_rates);
     tcase_add_test(tc, test_inverse_rates);
