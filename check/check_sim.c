@@ -740,7 +740,8 @@ int check_simulate(struct check_machine *mc, const double start[KINS_POSE_DIM],
     memset(&out, 0, sizeof out);
     motion_set_rates(mc->motion, false);   /* rates come from differences of set points */
     motion_set_brief(mc->motion, true);    /* (and the record holds what the pass reads) */
-    motion_set_ahead(mc->motion, true);    /* (four periods' legs at once where it can) */
+    motion_set_ahead(mc->motion, true);    /* (eight periods ahead, four legs' sets at once,
+                                            * where it can; runs of calm periods) */
     /* (calm periods several at a time, motion_step_calm; not where a trace samples them) */
     int calm_on = !(o->trace && !feed);
     struct motion_calm calm;

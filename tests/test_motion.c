@@ -198,7 +198,7 @@ static void ahead_taken(long taken, long fills, long least)
                   fills, taken, least);
 }
 
-/* The check's look-ahead (motion_set_ahead: four periods' poses and legs at once) and its
+/* The check's look-ahead (motion_set_ahead: eight periods' poses and legs ahead) and its
  * short period (motion_step's calm_period, with the brief record a check reads) change
  * nothing a period gives: two machines side by side, rates off in both, the look-ahead and
  * the brief record on in one, through blended and exact-stop five-axis feeds, an arc, dense
@@ -255,7 +255,7 @@ START_TEST(test_ahead_same_bits)
     ck_assert_int_ge(paused, 2);
     for (int i = 0; i < 6; i++)
         ck_assert_double_eq_tol(ob.pose[i], e4[i], 1e-9);
-    /* at the plan's pace three periods in four take an entry filled before them */
+    /* at the plan's pace seven periods in eight take an entry filled before them */
     ahead_taken(b.m->ahead.taken, b.m->ahead.fills, n / 2);
     ck_assert_msg(b.m->ahead.calm > n / 2, "%ld of %ld periods the short way", b.m->ahead.calm, n);
     ck_assert_int_eq(a.m->ahead.fills, 0);

@@ -2,7 +2,7 @@
  * planner and the executor promise.
  *
  * The dense code's way through motion has many shortcuts (merged feeds, blend arcs, the
- * knots' look-ahead, a check's four-period look-ahead and its calm period), each tested on
+ * knots' look-ahead, a check's eight-period look-ahead and its calm periods), each tested on
  * programs written for it. Here each case is a program of 150 to 500 moves of 0.002 to 1 mm
  * (now and then a zero-length one, a longer one, a turn of A B C in place, a small arc either
  * way), collinear, gently or sharply turning, with A B C still, drifting or jumping, under
@@ -15,7 +15,7 @@
  *   - keep the commanded tool within the path tolerance of the programmed moves (G64 P, the
  *     merge's Q, the jerk average's rounding) in every period;
  *   - never pass the largest programmed feed;
- *   - give, run the way a check runs it (rates off, the brief record, the four-period
+ *   - give, run the way a check runs it (rates off, the brief record, the eight-period
  *     look-ahead and, where no operator acts, runs of calm periods taken at once), the same
  *     record in every period and the same executor state wherever both stand at a period.
  * In every third case an operator moves the feed override (0 to 2, every 3 to 800 periods)
