@@ -101,12 +101,22 @@ static void fill_lanes(struct motion *m, int g, int n, bool vec)
     struct motion_ahead_at *at = &a->at[g];
     double (*pose)[KINS_POSE_DIM] = &a->pose[g];
     double sv[MOTION_LANES], vv[MOTION_LANES], tv[MOTION_LANES];
-    if (vec && n == MOTION_LANES && at[0].ci == at[n - 1].ci) {    /* one interval */
+    if (vec && n == MOTION_LANES) {
+        /* the four lanes on vectors, interval by interval (the entries are in order: the
+         * lanes of an interval lie together, and most groups have one, some two) */
         for (int j = 0; j < n; j++)
             tv[j] = at[j].tau_s;
-        plan_at4(p, at[0].ci, tv, sv, vv, &m->phases);
+        for (int j0 = 0; j0 < n;) {
+            int j1 = j0 + 1;
+            while (j1 < n && at[j1].ci == at[j0].ci)
+                j1++;
+            plan_at4(p, at[j0].ci, tv, sv, vv, &m->phases);
+            for (int j = j0; j < j1; j++)
+                at[j].s = sv[j], at[j].vp = vv[j];
+            j0 = j1;
+        }
         for (int j = 0; j < n; j++)
-            at[j].s = sv[j], at[j].vp = vv[j];
+            sv[j] = at[j].s;
     } else {
         for (int j = 0; j < n; j++) {
             struct motion_ahead_at *e = &at[j];
@@ -180,7 +190,7 @@ int motion_ahead(struct motion *m, double dt)
             return a->next++;
         }
     }
-    if (!motion_at_plan_pace(m)) {      /* (else four periods' work would be done for one) */
+    if (!motion_at_plan_pace(m)) {      /* (else eight periods' work would be done for one) */
         a->n = a->next = 0;
         return -1;
     }
