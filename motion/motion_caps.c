@@ -388,13 +388,13 @@ static void leg_caps(const struct motion *m, const struct motion_sample *S, doub
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, d2 = fabs(S->d2L[i]);
         if (d1 > 1e-12) {
-            *vl = motion_min2(*vl, c->joint[i].max_vel_mm_s / d1);
-            *am = motion_min2(*am, (1 - sh.curv) * c->joint[i].max_acc_mm_s2 / d1);
+            *vl = motion_lower(*vl, c->joint[i].max_vel_mm_s / d1);
+            *am = motion_lower(*am, (1 - sh.curv) * c->joint[i].max_acc_mm_s2 / d1);
             if (rest)
-                *rest = motion_min2(*rest, c->joint[i].max_acc_mm_s2 / d1);
+                *rest = motion_lower(*rest, c->joint[i].max_acc_mm_s2 / d1);
         }
         if (d2 > 1e-12)
-            v2 = motion_min2(v2, sh.curv * c->joint[i].max_acc_mm_s2 / (sh.hand * d2));
+            v2 = motion_lower(v2, sh.curv * c->joint[i].max_acc_mm_s2 / (sh.hand * d2));
     }
     if (v2 < HUGE_VAL)
         *vl = motion_min2(*vl, sqrt(v2));
@@ -416,8 +416,8 @@ static double leg_acc_at_speed(const struct motion *m, const struct motion_sampl
     for (int i = 0; i < m->nj; i++) {
         double d1 = fabs(S->dL[i]) + fabs(S->d2L[i]) * hs, aL = c->joint[i].max_acc_mm_s2;
         if (d1 > 1e-12)
-            am = motion_min2(am, motion_max2((1 - sh.curv) * aL,
-                                             aL - sh.hand * fabs(S->d2L[i]) * vh * vh) / d1);
+            am = motion_lower(am, motion_raise((1 - sh.curv) * aL,
+                                               aL - sh.hand * fabs(S->d2L[i]) * vh * vh) / d1);
     }
     return am;
 }
@@ -580,7 +580,7 @@ double motion_junction_speed(struct motion *m, const struct motion_seg *a,
     for (int i = 0; i < m->nj; i++) {
         double dl = fabs(B->dL[i] - A->dL[i]);
         if (dl > 1e-12)
-            v = motion_min2(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
+            v = motion_lower(v, 0.5 * JUMP_SHARE * c->joint[i].max_acc_mm_s2 * T / dl);
     }
     return v;
 }

@@ -23,6 +23,19 @@ static inline double motion_max2(double a, double b)
     double m = a > b ? a : b;
     return b != b ? a : m;
 }
+/* A running minimum acc (or maximum) taken on to b: motion_min2(acc, b) where acc is no NaN
+ * (it starts at a number and only ever takes b's that are not NaN), as one minsd (maxsd):
+ * on a NaN b it gives acc, and on a tie acc (the same number: the caps are no signed
+ * zeros). In the loops over the legs, whose every step waits on the last, motion_min2's
+ * NaN test through the integer registers tripled the chain. */
+static inline double motion_lower(double acc, double b)
+{
+    return b < acc ? b : acc;
+}
+static inline double motion_raise(double acc, double b)
+{
+    return b > acc ? b : acc;
+}
 
 /* What a segment does. */
 enum motion_seg_kind { SEG_LINE, SEG_ARC, SEG_DWELL, SEG_PAUSE,
