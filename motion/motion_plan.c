@@ -273,12 +273,15 @@ static double interval_ds(const struct motion_plan *p, size_t i, const struct mo
 
 /* motion_min2(cap, sqrt(w)), without the square root where the cap is certainly the
  * smaller (cap^2 below w by a margin far beyond rounding: then cap < sqrt(w) exactly). Where
- * caps bind, each knot of a pass then waits on no square root of the knot before it. */
+ * caps bind, each knot of a pass then waits on no square root of the knot before it. (A
+ * cap is a speed, never a NaN; nor is a pass's w, a sum of squares and ramps: the passes
+ * take motion_lower and motion_raise, one instruction each on the chain from knot to
+ * knot.) */
 static inline double cap_or_root(double cap, double w)
 {
     if (cap * cap < w * (1 - 1e-12))
         return cap;
-    return motion_min2(cap, sqrt(w));
+    return motion_lower(cap, sqrt(w));
 }
 
 /* Forward and backward passes over the knots: the fastest speeds that every cap and the
@@ -303,14 +306,14 @@ static void speed_passes(struct motion_plan *p, const struct acc_line *ln)
     for (size_t i = k0; i + 1 < n; i++) {
         while (i >= p->segs[j].k0 + p->segs[j].nk) j++;
         double ds = interval_ds(p, i, &p->segs[j]), w = p->kv[i] * p->kv[i];
-        w = ds > 0 ? motion_max2(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
+        w = ds > 0 ? motion_raise(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
         p->kv[i + 1] = cap_or_root(p->kv[i + 1], w);
     }
     j = p->nseg - 1;
     for (size_t i = n - 1; i-- > k0;) {
         while (i < p->segs[j].k0) j--;
         double ds = interval_ds(p, i, &p->segs[j]), w = p->kv[i + 1] * p->kv[i + 1];
-        w = ds > 0 ? motion_max2(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
+        w = ds > 0 ? motion_raise(w + 2 * p->iacc[i] * ds, ramp_sq(ln, i, w, 2 * ds)) : w;
         p->kv[i] = cap_or_root(p->kv[i], w);
     }
     /* The previous window planned v_enter able to stop within its own tail, which this
