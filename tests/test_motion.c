@@ -198,6 +198,47 @@ static void ahead_taken(long taken, long fills, long least)
                   fills, taken, least);
 }
 
+/* The program the look-ahead's tests run on two TMU hexapods, a and b, loaded and started
+ * with rates off in both, and b with the look-ahead and the brief record a check has:
+ * blended and exact-stop five-axis feeds, an arc, dense code whose blend arcs turn A B C, a
+ * dwell, an M0 and a last feed to e4; with spindle set, S1200 M3 at the start and M5 after
+ * the arc. */
+static void same_bits_program(struct tm_machine *a, struct tm_machine *b, struct canon_prog *p,
+                              int spindle, double e4[6])
+{
+    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
+           e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
+           c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, end[6] = {5, 5, 645, 0, 0, 0};
+    memcpy(e4, end, sizeof end);
+    two_machines(a, b, p, s0);
+    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
+                           .value = 0.01, .ivalue = 640};
+    ck_assert_int_eq(canon_prog_sink(p, &pm), 0);
+    struct canon_cmd sp[3] = {{.type = CANON_SPINDLE_SPEED, .line = 2, .file = "test.ngc",
+                               .value = 1200},
+                              {.type = CANON_SPINDLE_ON, .line = 2, .file = "test.ngc",
+                               .value = 1},
+                              {.type = CANON_SPINDLE_STOP, .line = 5, .file = "test.ngc"}};
+    if (spindle)
+        ck_assert(canon_prog_sink(p, &sp[0]) == 0 && canon_prog_sink(p, &sp[1]) == 0);
+    tm_add(p, CANON_FEED, 3, e1, 1500, 0);
+    tm_add(p, CANON_FEED, 4, e2, 2000, 0);
+    tm_arc(p, 5, e3, c3, n3, 1, 1800);
+    if (spindle)
+        ck_assert_int_eq(canon_prog_sink(p, &sp[2]), 0);
+    double at[6];
+    add_curve(p, e3, 120, 0.05, 5, at);         /* dense code: blend arcs turning A B C */
+    tm_add(p, CANON_DWELL, 6, NULL, 0, 0.25);
+    tm_add(p, CANON_PAUSE, 7, NULL, 0, 0);
+    tm_add(p, CANON_FEED, 8, end, 2400, 0);
+    tm_load_start(a->m, p);
+    tm_load_start(b->m, p);
+    motion_set_rates(a->m, false);
+    motion_set_rates(b->m, false);
+    motion_set_ahead(b->m, true);
+    motion_set_brief(b->m, true);
+}
+
 /* The check's look-ahead (motion_set_ahead: eight periods' poses and legs ahead) and its
  * short period (motion_step's calm_period, with the brief record a check reads) change
  * nothing a period gives: two machines side by side, rates off in both, the look-ahead and
@@ -211,27 +252,8 @@ START_TEST(test_ahead_same_bits)
 {
     struct tm_machine a, b;
     struct canon_prog p;
-    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
-           e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
-           c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, e4[6] = {5, 5, 645, 0, 0, 0};
-    two_machines(&a, &b, &p, s0);
-    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
-                           .value = 0.01, .ivalue = 640};
-    ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
-    tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
-    tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
-    tm_arc(&p, 5, e3, c3, n3, 1, 1800);
-    double at[6];
-    add_curve(&p, e3, 120, 0.05, 5, at);        /* dense code: blend arcs turning A B C */
-    tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
-    tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
-    tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
-    tm_load_start(a.m, &p);
-    tm_load_start(b.m, &p);
-    motion_set_rates(a.m, false);
-    motion_set_rates(b.m, false);
-    motion_set_ahead(b.m, true);
-    motion_set_brief(b.m, true);
+    double e4[6];
+    same_bits_program(&a, &b, &p, 0, e4);
     struct motion_out oa, ob;
     memset(&oa, 0, sizeof oa);
     long n = 0, paused = 0;
@@ -278,41 +300,15 @@ START_TEST(test_calm_same_bits)
 {
     struct tm_machine a, b;
     struct canon_prog p;
-    double s0[6] = {0, 0, 645, 0, 0, 0}, e1[6] = {30, -20, 650, 3, -2, 5},
-           e2[6] = {-10, 15, 640, -2, 4, -6}, e3[6] = {-10, 35, 640, -2, 4, -6},
-           c3[3] = {-10, 25, 640}, n3[3] = {0, 0, 1}, e4[6] = {5, 5, 645, 0, 0, 0};
-    two_machines(&a, &b, &p, s0);
-    struct canon_cmd pm = {.type = CANON_PATH_MODE, .line = 2, .file = "test.ngc",
-                           .value = 0.01, .ivalue = 640};
-    ck_assert_int_eq(canon_prog_sink(&p, &pm), 0);
-    struct canon_cmd sp[3] = {{.type = CANON_SPINDLE_SPEED, .line = 2, .file = "test.ngc",
-                               .value = 1200},
-                              {.type = CANON_SPINDLE_ON, .line = 2, .file = "test.ngc",
-                               .value = 1},
-                              {.type = CANON_SPINDLE_STOP, .line = 5, .file = "test.ngc"}};
-    ck_assert(canon_prog_sink(&p, &sp[0]) == 0 && canon_prog_sink(&p, &sp[1]) == 0);
-    tm_add(&p, CANON_FEED, 3, e1, 1500, 0);
-    tm_add(&p, CANON_FEED, 4, e2, 2000, 0);
-    tm_arc(&p, 5, e3, c3, n3, 1, 1800);
-    ck_assert_int_eq(canon_prog_sink(&p, &sp[2]), 0);
-    double at[6];
-    add_curve(&p, e3, 120, 0.05, 5, at);
-    tm_add(&p, CANON_DWELL, 6, NULL, 0, 0.25);
-    tm_add(&p, CANON_PAUSE, 7, NULL, 0, 0);
-    tm_add(&p, CANON_FEED, 8, e4, 2400, 0);
-    tm_load_start(a.m, &p);
-    tm_load_start(b.m, &p);
-    motion_set_rates(a.m, false);
-    motion_set_rates(b.m, false);
+    double e4[6];
+    same_bits_program(&a, &b, &p, 1, e4);
     motion_set_spindle_ideal(a.m, true);
     motion_set_spindle_ideal(b.m, true);
     motion_set_brief(a.m, true);
-    motion_set_ahead(b.m, true);
-    motion_set_brief(b.m, true);
     struct calm_feed f = { .on = 1 };
     struct motion_out oa, ob;
-    memset(&oa, 0, sizeof oa);
     long n = 0, paused = 0;
+    memset(&oa, 0, sizeof oa);
     int step = 0, in_step = 1;
     double revs = 0;
     do {
