@@ -215,7 +215,7 @@ static int forward(struct kins *k, const double *joints, double pose[KINS_POSE_D
         hexapod_lu_solve(lu, piv, rhs);
         hexapod_apply_step(h, q, sn, cs, rhs);
         iter++;
-        if (!have_lu && hexapod_max_abs(rhs) <= accept_mm) {
+        if (accept_mm > 0 && !have_lu && hexapod_max_abs(rhs) <= accept_mm) {
             st = KINS_OK;
             break;
         }
