@@ -125,10 +125,32 @@ static void fill_lanes(struct motion *m, int g, int n, bool vec)
             sv[j] = e->s;
         }
     }
-    if (!vec || n < MOTION_LANES || at[0].cs != at[n - 1].cs ||
-        !seg_pose4(p, &p->segs[at[0].cs], sv, pose))
-        for (int j = 0; j < n; j++)    /* (over a segment's end: one by one) */
+    if (vec && n == MOTION_LANES) {
+        /* segment by segment as the intervals (a segment whose arc lies beyond seg_pose4's
+         * series: its lanes one by one) */
+        double q[MOTION_LANES][KINS_POSE_DIM];
+        for (int j0 = 0; j0 < n;) {
+            int j1 = j0 + 1;
+            while (j1 < n && at[j1].cs == at[j0].cs)
+                j1++;
+            const struct motion_seg *sg = &p->segs[at[j0].cs];
+            if (j0 == 0 && j1 == n) {
+                if (!seg_pose4(p, sg, sv, pose))
+                    for (int j = 0; j < n; j++)
+                        motion_seg_pose(p, sg, at[j].s, pose[j]);
+            } else if (seg_pose4(p, sg, sv, q)) {
+                for (int j = j0; j < j1; j++)
+                    memcpy(pose[j], q[j], sizeof pose[j]);
+            } else {
+                for (int j = j0; j < j1; j++)
+                    motion_seg_pose(p, sg, at[j].s, pose[j]);
+            }
+            j0 = j1;
+        }
+    } else {
+        for (int j = 0; j < n; j++)
             motion_seg_pose(p, &p->segs[at[j].cs], at[j].s, pose[j]);
+    }
     if (n == MOTION_LANES) {
         kins_inverse4(m->kins, (const double(*)[KINS_POSE_DIM])pose, &a->joints[g],
                       &a->status[g]);
