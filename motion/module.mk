@@ -3,7 +3,7 @@ LIB_SRCS += motion/motion.c motion/motion_config.c motion/motion_path.c motion/m
             motion/motion_caps.c motion/motion_blend.c motion/motion_chord.c \
             motion/motion_step.c motion/motion_rate.c motion/motion_manual.c motion/motion_home.c \
             motion/motion_stream.c motion/motion_merge.c motion/motion_probe.c \
-            motion/motion_jerk.c motion/motion_sync.c motion/motion_ahead.c
+            motion/motion_jerk.c motion/motion_sync.c motion/motion_ahead.c motion/motion_hold.c
 TESTS += test_motion test_motion_run test_motion_legs test_motion_override test_motion_hal \
          test_motion_blend test_motion_chords \
          test_motion_stop test_motion_manual test_motion_spindle test_motion_stream test_motion_merge \

@@ -549,6 +549,12 @@ void motion_jerk_hold(struct motion *m);
 /* Whether the average has come to rest on the executor's pose (always without jerk limits):
  * the machine counts as stopped only then. */
 bool motion_jerk_settled(const struct motion *m);
+/* At the start of a pause or a wait segment sg not yet honoured (motion_hold.c): 1 when the
+ * path holds there this period (the clock at the segment's start, the rate 0): an M0/M1
+ * pauses the machine, a wait holds until the spindle is at speed, the tool changed or the
+ * M66 input answered (or timed out), and with jerk limits any of them first lets the
+ * moving average come to rest; 0 when it goes on. */
+int motion_pause_or_wait_here(struct motion *m, const struct motion_seg *sg);
 /* Homing's latch moved leg i's joint coordinate by shift (the motor's command stays): the
  * average's samples of that leg move with it. */
 void motion_jerk_shift_leg(struct motion *m, int i, double shift);
