@@ -237,8 +237,8 @@ static void abc_rate(const struct blend_rec *b, const struct canon_cmd *c, doubl
 
 /* Writes the blended program: trimmed lines, each followed by its blend arc; abc (out->count
  * entries) marks the arcs and the lines' A B C rates at their ends. */
-static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct canon_prog *out,
-                struct motion_blend_abc *abc, size_t *ends)
+static void emit(const struct canon_prog *in, const struct blend_rec *rec, struct canon_prog *out,
+                 struct motion_blend_abc *abc, size_t *ends)
 {
     memcpy(out->start, in->start, sizeof out->start);
     out->start_tcp = in->start_tcp;
@@ -246,33 +246,28 @@ static int emit(const struct canon_prog *in, const struct blend_rec *rec, struct
     out->start_path_tol_mm = in->start_path_tol_mm;
     out->start_tool_len_mm = in->start_tool_len_mm;
     for (size_t i = 0; i < in->count; i++) {
-        struct canon_cmd c = in->cmds[i];
+        /* straight into out's array (sized for all), without the payloads: motion reads none */
+        struct canon_cmd *c = &out->cmds[out->count++];
+        *c = in->cmds[i];
+        c->text = NULL;
+        c->setting = NULL;
         const struct blend_rec *b = &rec[i];
-        double t1[6];
-        memcpy(t1, c.end, sizeof t1);
         if (b->trim_in_mm > 0 || b->trim_out_mm > 0) {
             double keep = b->len_mm - b->trim_in_mm - b->trim_out_mm;
-            line_pose(b->from, &in->cmds[i], b->len_mm, b->len_mm - b->trim_out_mm, t1);
-            memcpy(c.end, t1, sizeof c.end);
-            if (c.inverse_time_min > 0)   /* G93: the shorter line keeps its speed */
-                c.inverse_time_min *= fmax(keep, 0) / b->len_mm;
+            line_pose(b->from, &in->cmds[i], b->len_mm, b->len_mm - b->trim_out_mm, c->end);
+            if (c->inverse_time_min > 0)   /* G93: the shorter line keeps its speed */
+                c->inverse_time_min *= fmax(keep, 0) / b->len_mm;
         }
-        if (canon_prog_sink(out, &c))
-            return MOTION_ERR_NOMEM;
         if (b->next) {
-            struct canon_cmd a;
-            blend_arc(in, rec, i, t1, &a);
             struct motion_blend_abc *ab = &abc[out->count];
+            blend_arc(in, rec, i, c->end, &out->cmds[out->count++]);
             ab->blend = 1;
             abc_rate(b, &in->cmds[i], ab->rate0);
             abc_rate(&rec[b->next], &in->cmds[b->next], ab->rate1);
-            if (canon_prog_sink(out, &a))
-                return MOTION_ERR_NOMEM;
         }
         if (ends)
             ends[i] = out->count;
     }
-    return MOTION_OK;
 }
 
 /* See motion_blend.h. */
@@ -306,8 +301,9 @@ int motion_blend_program_map(const struct motion_config *c, const struct canon_p
         out->cmds = malloc((in->count + n) * sizeof *out->cmds);
         out->cap = out->cmds ? in->count + n : 0;
     }
-    int st = n && (!ab || !out->cmds) ? MOTION_ERR_NOMEM
-             : n ? emit(in, rec, out, ab, ends) : MOTION_OK;
+    int st = n && (!ab || !out->cmds) ? MOTION_ERR_NOMEM : MOTION_OK;
+    if (n && !st)
+        emit(in, rec, out, ab, ends);
     free(rec);
     if (st || !abc)
         free(ab);

@@ -61,7 +61,8 @@ struct motion_blend_abc {
 };
 
 /* A copy of `in` with every G64 corner between two straight feed moves rounded: the lines
- * trimmed and a plane-0 CANON_ARC inserted (canon.h's convention, as G141/G142 make them).
+ * trimmed and a plane-0 CANON_ARC inserted (canon.h's convention, as G141/G142 make them),
+ * without the commands' payloads (text and setting NULL: motion reads none).
  * out is initialised here and holds the copy only when *nblends > 0 (else it stays empty and
  * `in` is to be used as is); the caller frees it with canon_prog_free. When abc is not NULL
  * and there are blends, *abc receives out->count entries (free() them), else NULL.
