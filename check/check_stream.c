@@ -101,8 +101,10 @@ static void *produce(void *arg)
     return NULL;
 }
 
-/* The servo pass is short of plan: waits for the producer, computing its own measures
- * meanwhile (the planner's thread then finds fewer to take from its planning). 1 to go on,
+/* The servo pass is short of plan: waits for the producer, taking a share of the planner's
+ * work where it offers one (motion_stream_help: the plan it waits for comes sooner), else
+ * computing its own measures (the planner's thread then finds fewer to take from its
+ * planning). 1 to go on,
  * 0 when no more plan will come (the producer ended without finishing the stream). */
 static int feed_wait(void *ctx)
 {
@@ -111,7 +113,7 @@ static int feed_wait(void *ctx)
     while (motion_stream_starving(m)) {
         if (atomic_load(&p->done))
             return !motion_stream_starving(m);
-        if (!check_defer_work(p->defer))
+        if (!motion_stream_help(p->ms) && !check_defer_work(p->defer))
             pause_us(50);
     }
     return 1;
@@ -218,8 +220,9 @@ int check_program(struct check_machine *mc, const char *path, const struct check
         free(p);
         return CHECK_ERR_CONFIG;
     }
-    while (!atomic_load(&p->ready))
-        pause_us(100);
+    while (!atomic_load(&p->ready))     /* (the first window's share: the pass starts sooner) */
+        if (!motion_stream_help(p->ms))
+            pause_us(20);
     struct check_feed feed = { feed_wait, feed_planned, p, p->defer };
     int sim = CHECK_OK;
     double t0 = check_thread_cpu_s();

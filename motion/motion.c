@@ -87,6 +87,7 @@ void motion_destroy(struct motion *m)
     motion_plan_free(&m->plan);
     motion_plan_free(&m->names);
     motion_jerk_free(m);
+    motion_caps_free(m);
     free(m);
 }
 

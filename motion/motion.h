@@ -379,6 +379,10 @@ int motion_stream_sync(struct motion_stream *s);
 void motion_stream_restart_at(struct motion_stream *s, const double pose[KINS_POSE_DIM]);
 /* Whether the executor is about to run out of planned path (a simulated clock waits). */
 bool motion_stream_starving(const struct motion *m);
+/* From a thread that waits for s's plan: one share of the planner's present work (the knot
+ * caps of a window, in jobs the planner takes too); true when it did one, false when none
+ * was on offer. The plan is the same whichever thread does which share. */
+bool motion_stream_help(struct motion_stream *s);
 
 /* ---- Manual motion (motion_manual.c, motion_home.c): allowed in IDLE, DONE (and MANUAL, to
  * change a jog); never while a program runs. Leg positions below are joint positions (leg

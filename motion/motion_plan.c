@@ -1,5 +1,7 @@
 /* motion_plan.c: the velocity profile over the knots of the whole program. */
 #include <math.h>
+#include <sched.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -158,14 +160,60 @@ static void apply_chord_caps(struct motion_plan *p, const struct motion_seg *sg,
     }
 }
 
-/* Caps at every knot (see segment_caps); interval caps into ivp and irho (hard); a knot's
- * speed suits both neighbouring intervals; joints between segments get their speed. */
-static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
-                             struct acc_line *ln, char *err, size_t errlen)
+/* The joint from segment j - 1 into j (j > 0): its speed, the caps of the knots beside it,
+ * and the share of their acceleration its jump takes. prev_end: the end sample of the last
+ * line or arc before j, first: j's first sample (read only where both moves are lines or
+ * arcs). */
+static void joint_caps(struct motion *m, size_t j, const struct motion_sample *prev_end,
+                       const struct motion_sample *first, struct acc_line *ln)
+{
+    struct motion_plan *p = &m->plan;
+    struct motion_seg *sg = &p->segs[j];
+    size_t pk = p->segs[j - 1].k0 + p->segs[j - 1].nk - 1;
+    double vin = motion_junction_speed(m, &p->segs[j - 1], sg, prev_end, first,
+                                       motion_max2(p->iacc[pk], p->iacc[sg->k0]));
+    /* a joint passed no faster than full acceleration reaches in STOP_EQUIV_PERIODS servo
+     * periods (a sharp corner) is a stop in all but name, while the jump would take a share
+     * of the moves' acceleration on both sides: stop there instead */
+    if (vin > 0 && vin < STOP_EQUIV_PERIODS * m->cfg.servo_period_s *
+                             motion_min2(p->iacc[sg->k0], p->iacc[pk]))
+        vin = 0;
+    p->kv[sg->k0] = motion_min2(p->kv[sg->k0], vin);
+    p->kv[pk] = motion_min2(p->kv[pk], vin);
+    if (vin > 0) {                 /* the jump's share of the acceleration, both sides, at
+                                    * the fastest the joint may be passed (hard caps) */
+        double vmax = motion_min2(vin, motion_min2(p->kt[sg->k0], p->kt[pk]));
+        double share = motion_junction_share(m, prev_end, first, vmax);
+        p->iacc[sg->k0] *= 1 - share;
+        p->iacc[pk] *= 1 - share;
+        ln[sg->k0].a0 *= 1 - share, ln[sg->k0].b *= 1 - share;
+        ln[pk].a0 *= 1 - share, ln[pk].b *= 1 - share;
+    }
+}
+
+/* One job of the knot caps (struct motion_caps_work): segments [j0, j1) in order, from the
+ * planner m's copy. Caps at every knot (see segment_caps); interval caps into ivp and irho
+ * (hard); a knot's speed suits both neighbouring intervals; the joints between the job's
+ * segments get their speed, all but the one into j0 (j0 > 0), which all_caps gives once
+ * every job is done: first and end keep the samples it needs. */
+struct motion_caps_job {
+    size_t j0, j1;
+    int status;
+    int has_end;                 /* a line or arc among them: end is the last one's end */
+    struct motion_sample first;  /* segment j0's first sample */
+    struct motion_sample end;
+    size_t samples;
+    int limited_by_legs, limited_by_kin_tol;
+    long fills, taken;           /* the look-ahead's counts */
+    char err[400];
+};
+
+static int caps_in_order(struct motion *m, struct motion_caps_job *J, double *gain,
+                         double *zcap, struct acc_line *ln, char *err, size_t errlen)
 {
     struct motion_plan *p = &m->plan;
     struct motion_sample ends[3], *prev_end = &ends[0], *first = &ends[1], *last = &ends[2];
-    for (size_t j = 0; j < p->nseg; j++) {
+    for (size_t j = J->j0; j < J->j1; j++) {
         struct motion_seg *sg = &p->segs[j];
         int st = segment_caps(m, sg, gain, zcap, ln, first, last, err, errlen);
         if (st)
@@ -184,46 +232,163 @@ static int all_caps_in_order(struct motion *m, double *gain, double *zcap,
             p->kv[k] = c, p->kt[k] = h;
         }
         apply_chord_caps(p, sg, zcap);
-        size_t pk = j > 0 ? p->segs[j - 1].k0 + p->segs[j - 1].nk - 1 : 0;
-        double vin = j > 0 ? motion_junction_speed(m, &p->segs[j - 1], sg, prev_end, first,
-                                                   motion_max2(p->iacc[pk], p->iacc[sg->k0]))
-                           : 0;
-        /* a joint passed no faster than full acceleration reaches in STOP_EQUIV_PERIODS
-         * servo periods (a sharp corner) is a stop in all but name, while the jump would
-         * take a share of the moves' acceleration on both sides: stop there instead */
-        if (vin > 0 && j > 0 && vin < STOP_EQUIV_PERIODS * m->cfg.servo_period_s *
-                                      motion_min2(p->iacc[sg->k0], p->iacc[pk]))
-            vin = 0;
-        p->kv[sg->k0] = motion_min2(p->kv[sg->k0], vin);
-        if (j > 0)
-            p->kv[pk] = motion_min2(p->kv[pk], vin);
-        if (vin > 0) {                 /* the jump's share of the acceleration, both sides,
-                                        * at the fastest the joint may be passed (hard caps) */
-            double vmax = motion_min2(vin, motion_min2(p->kt[sg->k0], p->kt[pk]));
-            double share = motion_junction_share(m, prev_end, first, vmax);
-            p->iacc[sg->k0] *= 1 - share;
-            p->iacc[pk] *= 1 - share;
-            ln[sg->k0].a0 *= 1 - share, ln[sg->k0].b *= 1 - share;
-            ln[pk].a0 *= 1 - share, ln[pk].b *= 1 - share;
-        }
+        if (j == 0)
+            p->kv[sg->k0] = motion_min2(p->kv[sg->k0], 0);   /* from rest */
+        else if (j > J->j0)
+            joint_caps(m, j, prev_end, first, ln);
+        else
+            J->first = *first;             /* (the joint into j0: all_caps) */
         p->kv[lk] = j + 1 < p->nseg ? p->kv[lk] : 0;
         if (sg->kind <= SEG_ARC) {     /* (a dwell's neighbours never pass it blended) */
             struct motion_sample *t = prev_end;
             prev_end = last, last = t;
+            J->has_end = 1;
         }
         p->info.samples += sg->nk;
     }
+    if (J->has_end)
+        J->end = *prev_end;
     return MOTION_OK;
 }
 
-/* all_caps_in_order, with the planner's look-ahead over its knots (motion_caps.c). */
+#define CAPS_JOB_SEGS 128   /* segments a job of the knot caps takes, at least */
+
+/* The knot caps of a plan in jobs of consecutive segments. Each job starts from the same
+ * copy of the planner (tmpl: a Jacobian cache and look-ahead of its own), so the plan is the
+ * same whichever thread computes which job. The planner offers the jobs while it takes them
+ * itself, and a thread waiting for its plan (the check's servo pass, motion_stream_help) may
+ * take one with motion_caps_help. */
+struct motion_caps_work {
+    _Atomic uint64_t offer;  /* (jobs << 32) | the next job to take: none left when equal */
+    _Atomic size_t done;     /* jobs finished */
+    struct motion_caps_job *jobs;
+    size_t cap;
+    struct motion *tmpl;     /* the planner as every job starts from */
+    double *gain, *zcap;     /* the arrays all_caps fills */
+    struct acc_line *ln;
+};
+
+/* Job i of w, from w's copy of the planner. */
+static void run_job(struct motion_caps_work *w, size_t i)
+{
+    struct motion_caps_job *J = &w->jobs[i];
+    struct motion mj;
+    memcpy(&mj, w->tmpl, sizeof mj);
+    memset(&mj.plan.info, 0, sizeof mj.plan.info);
+    motion_knot_ahead(&mj, true);
+    J->status = caps_in_order(&mj, J, w->gain, w->zcap, w->ln, J->err, sizeof J->err);
+    J->samples = mj.plan.info.samples;
+    J->limited_by_legs = mj.plan.info.limited_by_legs;
+    J->limited_by_kin_tol = mj.plan.info.limited_by_kin_tol;
+    J->fills = mj.kahead.fills - w->tmpl->kahead.fills;
+    J->taken = mj.kahead.taken - w->tmpl->kahead.taken;
+    atomic_fetch_add_explicit(&w->done, 1, memory_order_release);
+}
+
+/* Takes the next job on offer, if any: its number, or -1. */
+static long take_job(struct motion_caps_work *w)
+{
+    uint64_t o = atomic_load_explicit(&w->offer, memory_order_acquire);
+    while ((o & 0xffffffffu) < (o >> 32))
+        if (atomic_compare_exchange_weak_explicit(&w->offer, &o, o + 1, memory_order_acq_rel,
+                                                  memory_order_acquire))
+            return (long)(o & 0xffffffffu);
+    return -1;
+}
+
+bool motion_caps_help(struct motion *m)
+{
+    struct motion_caps_work *w = atomic_load_explicit(&m->caps, memory_order_acquire);
+    long i = w ? take_job(w) : -1;
+    if (i < 0)
+        return false;
+    run_job(w, (size_t)i);
+    return true;
+}
+
+void motion_caps_free(struct motion *m)
+{
+    struct motion_caps_work *w = atomic_load(&m->caps);
+    if (w) {
+        free(w->jobs);
+        free(w->tmpl);
+        free(w);
+        atomic_store(&m->caps, NULL);
+    }
+}
+
+/* The plan's segments as jobs into w->jobs (each ends before a line or arc of two knots or
+ * more, or at the plan's end: the joint into it then changes no knot a later segment of its
+ * job reads); their count, or 0 when out of memory. */
+static size_t make_jobs(struct motion_caps_work *w, const struct motion_plan *p)
+{
+    size_t n = 0;
+    for (size_t j0 = 0; j0 < p->nseg;) {
+        size_t j1 = motion_min2(j0 + CAPS_JOB_SEGS, p->nseg);
+        while (j1 < p->nseg && (p->segs[j1].kind > SEG_ARC || p->segs[j1].nk < 2))
+            j1++;
+        if (n == w->cap) {
+            size_t cap = w->cap ? 2 * w->cap : 64;
+            struct motion_caps_job *jb = realloc(w->jobs, cap * sizeof *jb);
+            if (!jb)
+                return 0;
+            w->jobs = jb, w->cap = cap;
+        }
+        w->jobs[n].j0 = j0, w->jobs[n].j1 = j1, w->jobs[n].has_end = 0;
+        n++;
+        j0 = j1;
+    }
+    return n;
+}
+
+/* Caps at every knot, in jobs (struct motion_caps_work) that the planner offers to helpers
+ * while it takes them itself; then the joints between the jobs. */
 static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_line *ln,
                     char *err, size_t errlen)
 {
-    motion_knot_ahead(m, true);
-    int st = all_caps_in_order(m, gain, zcap, ln, err, errlen);
-    motion_knot_ahead(m, false);
-    return st;
+    struct motion_plan *p = &m->plan;
+    struct motion_caps_work *w = atomic_load_explicit(&m->caps, memory_order_relaxed);
+    if (!w) {
+        w = calloc(1, sizeof *w);
+        if (!w || !(w->tmpl = malloc(sizeof *w->tmpl))) {
+            free(w);
+            snprintf(err, errlen, "out of memory planning the program");
+            return MOTION_ERR_NOMEM;
+        }
+        atomic_store_explicit(&m->caps, w, memory_order_release);
+    }
+    size_t n = make_jobs(w, p);
+    if (n == 0) {
+        snprintf(err, errlen, "out of memory planning the program");
+        return MOTION_ERR_NOMEM;
+    }
+    memcpy(w->tmpl, m, sizeof *w->tmpl);
+    w->gain = gain, w->zcap = zcap, w->ln = ln;
+    atomic_store_explicit(&w->done, 0, memory_order_relaxed);
+    atomic_store_explicit(&w->offer, (uint64_t)n << 32, memory_order_release);
+    for (long i; (i = take_job(w)) >= 0;)
+        run_job(w, (size_t)i);
+    while (atomic_load_explicit(&w->done, memory_order_acquire) < n)
+        sched_yield();                     /* a helper's last job: a fraction of a ms */
+    atomic_store_explicit(&w->offer, 0, memory_order_relaxed);
+    for (size_t i = 0; i < n; i++) {
+        struct motion_caps_job *J = &w->jobs[i];
+        if (J->status) {
+            snprintf(err, errlen, "%s", J->err);
+            return J->status;
+        }
+        p->info.samples += J->samples;
+        p->info.limited_by_legs += J->limited_by_legs;
+        p->info.limited_by_kin_tol += J->limited_by_kin_tol;
+        m->kahead.fills += J->fills, m->kahead.taken += J->taken;
+    }
+    for (size_t i = 1; i < n; i++) {
+        const struct motion_caps_job *A = &w->jobs[i - 1], *B = &w->jobs[i];
+        /* (the last line or arc before B: A's, else the segment before B is none, and the
+         * joint is a stop whatever the samples) */
+        joint_caps(m, B->j0, A->has_end ? &A->end : &B->first, &B->first, ln);
+    }
+    return MOTION_OK;
 }
 
 /* Whether the override may run the interval from knot a to b above 1: it moves (both knots'

@@ -436,7 +436,14 @@ struct motion {
     int line;
     const char *file;
     struct motion_jerk *jerk; /* jerk limiting's moving average (motion_jerk.c), or NULL */
+    /* the knot caps' jobs (motion_plan.c), or NULL: set once by the planner, read by helpers */
+    _Atomic(struct motion_caps_work *) caps;
 };
+
+/* The knot caps in jobs that any thread may take (motion_plan.c): one job of the planner
+ * m's, when it has one on offer (true when it did one); freeing them with m. */
+bool motion_caps_help(struct motion *m);
+void motion_caps_free(struct motion *m);
 
 /* Durations of the three phases of an interval of length ds: accelerate from v0 to vp,
  * cruise at vp, decelerate to v1, at acceleration a. */

@@ -441,6 +441,11 @@ void motion_stream_restart_at(struct motion_stream *s, const double pose[KINS_PO
     s->start_len_mm = 0;
 }
 
+bool motion_stream_help(struct motion_stream *s)
+{
+    return motion_caps_help(s->pm);
+}
+
 const char *motion_stream_error(const struct motion_stream *s)
 {
     return s->status ? s->err : "";

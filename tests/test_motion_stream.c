@@ -4,6 +4,9 @@
  * loop 2, with [TRAJ] JERK_WINDOW). */
 #include <check.h>
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -407,6 +410,91 @@ START_TEST(stream_random_dense)
 }
 END_TEST
 
+/* A thread that takes shares of the planner's work (motion_stream_help) until told to stop. */
+struct helper {
+    struct motion_stream *s;
+    _Atomic int stop;
+    long shares;
+};
+
+static void *help_loop(void *arg)
+{
+    struct helper *h = arg;
+    while (!atomic_load(&h->stop))
+        if (motion_stream_help(h->s))
+            h->shares++;
+        else
+            sched_yield();
+    return NULL;
+}
+
+/* Every period's leg commands, kept (the run with and the run without a helper). */
+struct legs_log {
+    struct feed f;
+    double (*L)[6];
+    size_t n, cap;
+};
+
+static int legs_hook(struct motion *m, const struct motion_out *o, int step, void *ctx)
+{
+    (void)m, (void)step;
+    struct legs_log *g = ctx;
+    feed_some(&g->f);
+    if (g->n == g->cap) {
+        g->cap = g->cap ? 2 * g->cap : 65536;
+        g->L = realloc(g->L, g->cap * sizeof *g->L);
+        ck_assert_ptr_nonnull(g->L);
+    }
+    memcpy(g->L[g->n++], o->joint_pos, sizeof g->L[0]);
+    return 0;
+}
+
+/* The knot caps of each window come in jobs that any thread may take (motion_stream_help):
+ * a random dense program streamed while a second thread takes what it can of them gives
+ * every leg command of every period bit for bit as the same program streamed alone. Loop 0
+ * trapezoidal, 1 with jerk limits. */
+START_TEST(stream_helped_same_bits)
+{
+    unsigned long long seed = 0x2545f4914f6cdd1dULL * (unsigned long long)(_i + 3);
+    struct dense d;
+    dense_prog(&d, &seed, 5000, 6000);
+    struct legs_log g[2];
+    long shares = 0;
+    for (int run = 0; run < 2; run++) {
+        struct tm_machine mc;
+        ck_assert_int_eq(tm_open(&mc, stream_cfg(_i), &kins_hexapod_ops), 0);
+        memset(&g[run], 0, sizeof g[run]);
+        struct motion_stream *s = stream_open(&mc, &d.p, &g[run].f, 2);
+        struct helper h = { .s = s };
+        pthread_t t;
+        if (run == 1)
+            ck_assert_int_eq(pthread_create(&t, NULL, help_loop, &h), 0);
+        struct tm_stats st;
+        tm_run(mc.m, DT, 4000000, &st, legs_hook, &g[run]);
+        if (run == 1) {
+            atomic_store(&h.stop, 1);
+            pthread_join(t, NULL);
+            shares = h.shares;
+        }
+        ck_assert_msg(st.last.state == MOTION_DONE, "state %d: %s", st.last.state,
+                      motion_last_error(mc.m));
+        motion_stream_detach(mc.m);
+        motion_stream_destroy(s);
+        tm_close(&mc);
+    }
+    printf("helped stream, %d moves%s: %zu periods, %ld shares taken by the helper\n", d.n,
+           _i ? ", jerk limits" : "", g[1].n, shares);
+    ck_assert_uint_eq(g[0].n, g[1].n);
+    ck_assert_int_gt(shares, 0);
+    for (size_t k = 0; k < g[0].n; k++)
+        ck_assert_msg(!memcmp(g[0].L[k], g[1].L[k], sizeof g[0].L[k]),
+                      "period %zu: leg commands differ", k);
+    free(g[0].L);
+    free(g[1].L);
+    dense_free(&d);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("motion_stream");
@@ -418,6 +506,7 @@ int main(void)
     tcase_add_loop_test(tc, stream_check_reports_line, 0, 2);
     tcase_add_loop_test(tc, stream_sync_on_input_wait, 0, 2);
     tcase_add_loop_test(tc, stream_random_dense, 0, 2);
+    tcase_add_loop_test(tc, stream_helped_same_bits, 0, 2);
     suite_add_tcase(s, tc);
     SRunner *sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
