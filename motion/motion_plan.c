@@ -252,6 +252,8 @@ static int caps_in_order(struct motion *m, struct motion_caps_job *J, double *ga
 }
 
 #define CAPS_JOB_SEGS 128   /* segments a job of the knot caps takes, at least */
+#define CAPS_BATCH 64       /* jobs offered at a time (a window of dense code has about 40; a
+                             * whole program is done batch by batch, in bounded memory) */
 
 /* The knot caps of a plan in jobs of consecutive segments. Each job starts from the same
  * copy of the planner (tmpl: a Jacobian cache and look-ahead of its own), so the plan is the
@@ -261,8 +263,7 @@ static int caps_in_order(struct motion *m, struct motion_caps_job *J, double *ga
 struct motion_caps_work {
     _Atomic uint64_t offer;  /* (jobs << 32) | the next job to take: none left when equal */
     _Atomic size_t done;     /* jobs finished */
-    struct motion_caps_job *jobs;
-    size_t cap;
+    struct motion_caps_job jobs[CAPS_BATCH]; /* the jobs on offer: a batch of the plan's */
     struct motion *tmpl;     /* the planner as every job starts from */
     double *gain, *zcap;     /* the arrays all_caps fills */
     struct acc_line *ln;
@@ -310,30 +311,22 @@ void motion_caps_free(struct motion *m)
 {
     struct motion_caps_work *w = atomic_load(&m->caps);
     if (w) {
-        free(w->jobs);
         free(w->tmpl);
         free(w);
         atomic_store(&m->caps, NULL);
     }
 }
 
-/* The plan's segments as jobs into w->jobs (each ends before a line or arc of two knots or
- * more, or at the plan's end: the joint into it then changes no knot a later segment of its
- * job reads); their count, or 0 when out of memory. */
-static size_t make_jobs(struct motion_caps_work *w, const struct motion_plan *p)
+/* Up to CAPS_BATCH jobs into w->jobs from segment j0 on (each ends before a line or arc of
+ * two knots or more, or at the plan's end: the joint into it then changes no knot a later
+ * segment of its job reads); their count. */
+static size_t make_jobs(struct motion_caps_work *w, const struct motion_plan *p, size_t j0)
 {
     size_t n = 0;
-    for (size_t j0 = 0; j0 < p->nseg;) {
+    while (j0 < p->nseg && n < CAPS_BATCH) {
         size_t j1 = motion_min2(j0 + CAPS_JOB_SEGS, p->nseg);
         while (j1 < p->nseg && (p->segs[j1].kind > SEG_ARC || p->segs[j1].nk < 2))
             j1++;
-        if (n == w->cap) {
-            size_t cap = w->cap ? 2 * w->cap : 64;
-            struct motion_caps_job *jb = realloc(w->jobs, cap * sizeof *jb);
-            if (!jb)
-                return 0;
-            w->jobs = jb, w->cap = cap;
-        }
         w->jobs[n].j0 = j0, w->jobs[n].j1 = j1, w->jobs[n].has_end = 0;
         n++;
         j0 = j1;
@@ -341,8 +334,8 @@ static size_t make_jobs(struct motion_caps_work *w, const struct motion_plan *p)
     return n;
 }
 
-/* Caps at every knot, in jobs (struct motion_caps_work) that the planner offers to helpers
- * while it takes them itself; then the joints between the jobs. */
+/* Caps at every knot, in batches of jobs (struct motion_caps_work) that the planner offers
+ * to helpers while it takes them itself; then the joints between the jobs. */
 static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_line *ln,
                     char *err, size_t errlen)
 {
@@ -357,36 +350,37 @@ static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_lin
         }
         atomic_store_explicit(&m->caps, w, memory_order_release);
     }
-    size_t n = make_jobs(w, p);
-    if (n == 0) {
-        snprintf(err, errlen, "out of memory planning the program");
-        return MOTION_ERR_NOMEM;
-    }
     memcpy(w->tmpl, m, sizeof *w->tmpl);
     w->gain = gain, w->zcap = zcap, w->ln = ln;
-    atomic_store_explicit(&w->done, 0, memory_order_relaxed);
-    atomic_store_explicit(&w->offer, (uint64_t)n << 32, memory_order_release);
-    for (long i; (i = take_job(w)) >= 0;)
-        run_job(w, (size_t)i);
-    while (atomic_load_explicit(&w->done, memory_order_acquire) < n)
-        sched_yield();                     /* a helper's last job: a fraction of a ms */
-    atomic_store_explicit(&w->offer, 0, memory_order_relaxed);
-    for (size_t i = 0; i < n; i++) {
-        struct motion_caps_job *J = &w->jobs[i];
-        if (J->status) {
-            snprintf(err, errlen, "%s", J->err);
-            return J->status;
+    struct motion_sample end;  /* the last batch's last line or arc: its end sample */
+    int has_end = 0;
+    for (size_t j0 = 0; j0 < p->nseg;) {
+        size_t n = make_jobs(w, p, j0);
+        atomic_store_explicit(&w->done, 0, memory_order_relaxed);
+        atomic_store_explicit(&w->offer, (uint64_t)n << 32, memory_order_release);
+        for (long i; (i = take_job(w)) >= 0;)
+            run_job(w, (size_t)i);
+        while (atomic_load_explicit(&w->done, memory_order_acquire) < n)
+            sched_yield();                 /* a helper's last job: a fraction of a ms */
+        atomic_store_explicit(&w->offer, 0, memory_order_relaxed);
+        for (size_t i = 0; i < n; i++) {
+            struct motion_caps_job *J = &w->jobs[i];
+            if (J->status) {
+                snprintf(err, errlen, "%s", J->err);
+                return J->status;
+            }
+            p->info.samples += J->samples;
+            p->info.limited_by_legs += J->limited_by_legs;
+            p->info.limited_by_kin_tol += J->limited_by_kin_tol;
+            m->kahead.fills += J->fills, m->kahead.taken += J->taken;
+            /* the joint into the job (the last line or arc before it: where the segment
+             * before it is none, the joint is a stop whatever the samples) */
+            if (J->j0 > 0)
+                joint_caps(m, J->j0, has_end ? &end : &J->first, &J->first, ln);
+            if (J->has_end)
+                end = J->end, has_end = 1;
         }
-        p->info.samples += J->samples;
-        p->info.limited_by_legs += J->limited_by_legs;
-        p->info.limited_by_kin_tol += J->limited_by_kin_tol;
-        m->kahead.fills += J->fills, m->kahead.taken += J->taken;
-    }
-    for (size_t i = 1; i < n; i++) {
-        const struct motion_caps_job *A = &w->jobs[i - 1], *B = &w->jobs[i];
-        /* (the last line or arc before B: A's, else the segment before B is none, and the
-         * joint is a stop whatever the samples) */
-        joint_caps(m, B->j0, A->has_end ? &A->end : &B->first, &B->first, ln);
+        j0 = w->jobs[n - 1].j1;
     }
     return MOTION_OK;
 }

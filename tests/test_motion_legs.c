@@ -1,6 +1,9 @@
 /* test_motion_legs.c: leg speed and acceleration limits, and the kinematic-error bound. */
 #include <check.h>
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -428,6 +431,55 @@ START_TEST(test_cancel_stops_planning)
 }
 END_TEST
 
+/* A thread that takes jobs of the knot caps (motion_caps_help) until told to stop. */
+struct caps_helper { struct motion *m; _Atomic int stop; long jobs; };
+static void *caps_help_loop(void *arg)
+{
+    struct caps_helper *h = arg;
+    while (!atomic_load(&h->stop))
+        if (motion_caps_help(h->m))
+            h->jobs++;
+        else
+            sched_yield();
+    return NULL;
+}
+
+/* The knot caps come in batches of jobs (motion_plan.c): a move out of reach far into a
+ * long program (past the first batch, 64 jobs of 128 segments) is refused naming its own
+ * line, and of two such moves the first, with or without a thread taking jobs meanwhile. */
+START_TEST(test_unreachable_in_a_later_job)
+{
+    struct tm_machine mc;
+    ck_assert_int_eq(tm_open(&mc, tm_hexapod_cfg(), &kins_hexapod_ops), 0);
+    for (int run = 0; run < 4; run++) {
+        struct canon_prog p;
+        canon_prog_init(&p);
+        double s0[6] = {0, 0, 645, 0, 0, 0}, up[6] = {0, 0, 1000, 0, 0, 0};
+        memcpy(p.start, s0, sizeof s0);
+        for (int i = 1; i <= 10000; i++) {      /* G61 (no path mode): a segment a move */
+            double q[6] = {10 * sin(i * 0.01), 10 * cos(i * 0.01) - 10, 645, 0, 0, 0};
+            int bad = i == 9500 || (run % 2 && i == 9900);
+            tm_add(&p, CANON_FEED, 10 + i, bad ? up : q, 3000, 0);
+        }
+        struct caps_helper h = { .m = mc.m };
+        pthread_t t;
+        if (run >= 2)
+            ck_assert_int_eq(pthread_create(&t, NULL, caps_help_loop, &h), 0);
+        char err[512] = "";
+        int st = motion_load(mc.m, &p, err, sizeof err);
+        if (run >= 2) {
+            atomic_store(&h.stop, 1);
+            pthread_join(t, NULL);
+        }
+        ck_assert_int_eq(st, MOTION_ERR_UNREACHABLE);
+        ck_assert_msg(strstr(err, "test.ngc:9510: the move leaves the machine's reach"),
+                      "message: %s", err);
+        canon_prog_free(&p);
+    }
+    tm_close(&mc);
+}
+END_TEST
+
 /* Blend arcs carry few knots (one interval for a turn under 0.25 rad on an arc under 1 mm,
  * motion_path.c): the caps taken at the knots must hold at every point between them. A
  * zigzag of five-axis moves with turns from 0.05 to 1.3 rad, rounded by G64 P of 0.005 to
@@ -537,6 +589,7 @@ static Suite *legs_suite(void)
     tcase_add_test(tc, test_long_helix_is_reachable);
     tcase_add_test(tc, test_long_helix_out_of_reach_between_knots);
     tcase_add_test(tc, test_cancel_stops_planning);
+    tcase_add_test(tc, test_unreachable_in_a_later_job);
     tcase_add_test(tc, test_blend_arc_knots_conservative);
     suite_add_tcase(s, tc);
     return s;
