@@ -2,7 +2,6 @@
  * by whichever thread has time, their results applied in order by the pass itself. */
 #include <math.h>
 #include <sched.h>
-#include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 

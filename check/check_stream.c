@@ -104,8 +104,8 @@ static void *produce(void *arg)
 /* The servo pass is short of plan: waits for the producer, taking a share of the planner's
  * work where it offers one (motion_stream_help: the plan it waits for comes sooner), else
  * computing its own measures (the planner's thread then finds fewer to take from its
- * planning). 1 to go on,
- * 0 when no more plan will come (the producer ended without finishing the stream). */
+ * planning). 1 to go on, 0 when no more plan will come (the producer ended without
+ * finishing the stream). */
 static int feed_wait(void *ctx)
 {
     struct producer *p = ctx;
