@@ -1,9 +1,6 @@
 /* test_motion_legs.c: leg speed and acceleration limits, and the kinematic-error bound. */
 #include <check.h>
 #include <math.h>
-#include <pthread.h>
-#include <sched.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -431,17 +428,9 @@ START_TEST(test_cancel_stops_planning)
 }
 END_TEST
 
-/* A thread that takes jobs of the knot caps (motion_caps_help) until told to stop. */
-struct caps_helper { struct motion *m; _Atomic int stop; long jobs; };
-static void *caps_help_loop(void *arg)
+static bool take_caps_job(void *m)
 {
-    struct caps_helper *h = arg;
-    while (!atomic_load(&h->stop))
-        if (motion_caps_help(h->m))
-            h->jobs++;
-        else
-            sched_yield();
-    return NULL;
+    return motion_caps_help(m);
 }
 
 /* The knot caps come in batches of jobs (motion_plan.c): a move out of reach far into a
@@ -461,16 +450,13 @@ START_TEST(test_unreachable_in_a_later_job)
             int bad = i == 9500 || (run % 2 && i == 9900);
             tm_add(&p, CANON_FEED, 10 + i, bad ? up : q, 3000, 0);
         }
-        struct caps_helper h = { .m = mc.m };
-        pthread_t t;
+        struct tm_helper h;
         if (run >= 2)
-            ck_assert_int_eq(pthread_create(&t, NULL, caps_help_loop, &h), 0);
+            ck_assert_int_eq(tm_helper_start(&h, take_caps_job, mc.m), 0);
         char err[512] = "";
         int st = motion_load(mc.m, &p, err, sizeof err);
-        if (run >= 2) {
-            atomic_store(&h.stop, 1);
-            pthread_join(t, NULL);
-        }
+        if (run >= 2)
+            tm_helper_stop(&h);
         ck_assert_int_eq(st, MOTION_ERR_UNREACHABLE);
         ck_assert_msg(strstr(err, "test.ngc:9510: the move leaves the machine's reach"),
                       "message: %s", err);

@@ -4,9 +4,6 @@
  * loop 2, with [TRAJ] JERK_WINDOW). */
 #include <check.h>
 #include <math.h>
-#include <pthread.h>
-#include <sched.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -410,22 +407,9 @@ START_TEST(stream_random_dense)
 }
 END_TEST
 
-/* A thread that takes shares of the planner's work (motion_stream_help) until told to stop. */
-struct helper {
-    struct motion_stream *s;
-    _Atomic int stop;
-    long shares;
-};
-
-static void *help_loop(void *arg)
+static bool take_stream_share(void *s)
 {
-    struct helper *h = arg;
-    while (!atomic_load(&h->stop))
-        if (motion_stream_help(h->s))
-            h->shares++;
-        else
-            sched_yield();
-    return NULL;
+    return motion_stream_help(s);
 }
 
 /* Every period's leg commands, kept (the run with and the run without a helper). */
@@ -465,17 +449,13 @@ START_TEST(stream_helped_same_bits)
         ck_assert_int_eq(tm_open(&mc, stream_cfg(_i), &kins_hexapod_ops), 0);
         memset(&g[run], 0, sizeof g[run]);
         struct motion_stream *s = stream_open(&mc, &d.p, &g[run].f, 2);
-        struct helper h = { .s = s };
-        pthread_t t;
+        struct tm_helper h;
         if (run == 1)
-            ck_assert_int_eq(pthread_create(&t, NULL, help_loop, &h), 0);
+            ck_assert_int_eq(tm_helper_start(&h, take_stream_share, s), 0);
         struct tm_stats st;
         tm_run(mc.m, DT, 4000000, &st, legs_hook, &g[run]);
-        if (run == 1) {
-            atomic_store(&h.stop, 1);
-            pthread_join(t, NULL);
-            shares = h.shares;
-        }
+        if (run == 1)
+            shares = tm_helper_stop(&h);
         ck_assert_msg(st.last.state == MOTION_DONE, "state %d: %s", st.last.state,
                       motion_last_error(mc.m));
         motion_stream_detach(mc.m);

@@ -3,6 +3,10 @@
 #define HEXCNC_TEST_MOTION_UTIL_H
 
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -587,6 +591,41 @@ static inline int tm_chord_deviation_at(const struct canon_prog *p, double T_s, 
     canon_prog_free(&out);
     tm_close(&mc);
     return st || a.state != MOTION_DONE ? -1 : 0;
+}
+
+/* A thread that takes shares of a planner's work, take(arg) (a wrapper of
+ * motion_stream_help or motion_caps_help), until tm_helper_stop, which gives their count. */
+struct tm_helper {
+    bool (*take)(void *arg);
+    void *arg;
+    _Atomic int stop;
+    long taken;
+    pthread_t thread;
+};
+
+static inline void *tm_helper_loop(void *arg)
+{
+    struct tm_helper *h = arg;
+    while (!atomic_load(&h->stop))
+        if (h->take(h->arg))
+            h->taken++;
+        else
+            sched_yield();
+    return NULL;
+}
+
+static inline int tm_helper_start(struct tm_helper *h, bool (*take)(void *), void *arg)
+{
+    h->take = take, h->arg = arg, h->taken = 0;
+    atomic_store(&h->stop, 0);
+    return pthread_create(&h->thread, NULL, tm_helper_loop, h);
+}
+
+static inline long tm_helper_stop(struct tm_helper *h)
+{
+    atomic_store(&h->stop, 1);
+    pthread_join(h->thread, NULL);
+    return h->taken;
 }
 
 /* tm_chord_deviation_at with the servo period equal to the set-point period T_s. */
