@@ -264,7 +264,7 @@ struct motion_caps_work {
     _Atomic uint64_t offer;  /* (jobs << 32) | the next job to take: none left when equal */
     _Atomic size_t done;     /* jobs finished */
     struct motion_caps_job jobs[CAPS_BATCH]; /* the jobs on offer: a batch of the plan's */
-    struct motion *tmpl;     /* the planner as every job starts from */
+    struct motion tmpl;      /* the planner as every job starts from */
     double *gain, *zcap;     /* the arrays all_caps fills */
     struct acc_line *ln;
 };
@@ -274,15 +274,15 @@ static void run_job(struct motion_caps_work *w, size_t i)
 {
     struct motion_caps_job *J = &w->jobs[i];
     struct motion mj;
-    memcpy(&mj, w->tmpl, sizeof mj);
+    memcpy(&mj, &w->tmpl, sizeof mj);
     memset(&mj.plan.info, 0, sizeof mj.plan.info);
     motion_knot_ahead(&mj, true);
     J->status = caps_in_order(&mj, J, w->gain, w->zcap, w->ln, J->err, sizeof J->err);
     J->samples = mj.plan.info.samples;
     J->limited_by_legs = mj.plan.info.limited_by_legs;
     J->limited_by_kin_tol = mj.plan.info.limited_by_kin_tol;
-    J->fills = mj.kahead.fills - w->tmpl->kahead.fills;
-    J->taken = mj.kahead.taken - w->tmpl->kahead.taken;
+    J->fills = mj.kahead.fills - w->tmpl.kahead.fills;
+    J->taken = mj.kahead.taken - w->tmpl.kahead.taken;
     atomic_fetch_add_explicit(&w->done, 1, memory_order_release);
 }
 
@@ -310,11 +310,8 @@ bool motion_caps_help(struct motion *m)
 void motion_caps_free(struct motion *m)
 {
     struct motion_caps_work *w = atomic_load(&m->caps);
-    if (w) {
-        free(w->tmpl);
-        free(w);
-        atomic_store(&m->caps, NULL);
-    }
+    free(w);
+    atomic_store(&m->caps, NULL);
 }
 
 /* Up to CAPS_BATCH jobs into w->jobs from segment j0 on (each ends before a line or arc of
@@ -324,7 +321,7 @@ static size_t make_jobs(struct motion_caps_work *w, const struct motion_plan *p,
 {
     size_t n = 0;
     while (j0 < p->nseg && n < CAPS_BATCH) {
-        size_t j1 = motion_min2(j0 + CAPS_JOB_SEGS, p->nseg);
+        size_t j1 = p->nseg - j0 > CAPS_JOB_SEGS ? j0 + CAPS_JOB_SEGS : p->nseg;
         while (j1 < p->nseg && (p->segs[j1].kind > SEG_ARC || p->segs[j1].nk < 2))
             j1++;
         w->jobs[n].j0 = j0, w->jobs[n].j1 = j1, w->jobs[n].has_end = 0;
@@ -343,14 +340,13 @@ static int all_caps(struct motion *m, double *gain, double *zcap, struct acc_lin
     struct motion_caps_work *w = atomic_load_explicit(&m->caps, memory_order_relaxed);
     if (!w) {
         w = calloc(1, sizeof *w);
-        if (!w || !(w->tmpl = malloc(sizeof *w->tmpl))) {
-            free(w);
+        if (!w) {
             snprintf(err, errlen, "out of memory planning the program");
             return MOTION_ERR_NOMEM;
         }
         atomic_store_explicit(&m->caps, w, memory_order_release);
     }
-    memcpy(w->tmpl, m, sizeof *w->tmpl);
+    memcpy(&w->tmpl, m, sizeof w->tmpl);
     w->gain = gain, w->zcap = zcap, w->ln = ln;
     struct motion_sample end;  /* the last batch's last line or arc: its end sample */
     int has_end = 0;
