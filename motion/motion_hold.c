@@ -47,10 +47,18 @@ static bool input_answered(struct motion *m, const struct motion_seg *sg, double
     return done;
 }
 
-/* At the start of a wait for the spindle: hold there until it is at speed. */
-static int wait_here(struct motion *m)
+/* Holds the path at the present knot (a segment's start) this period: 1. */
+static int hold(struct motion *m)
 {
-    const struct motion_seg *sg = &m->run->segs[m->cs];
+    m->tau_s = m->run->kt[m->ci];
+    m->rate = 0;
+    return 1;
+}
+
+/* At the start of a wait segment sg: hold there until the spindle is at speed, the tool
+ * changed or the input answered. */
+static int wait_here(struct motion *m, const struct motion_seg *sg)
+{
     m->waiting = 0;
     if (sg->kind != SEG_WAIT || m->ci != sg->k0 || m->waited_at_seg == m->cs + 1)
         return 0;
@@ -64,9 +72,7 @@ static int wait_here(struct motion *m)
             return 0;
         }
         m->waiting = 3;
-        m->tau_s = m->run->kt[m->ci];
-        m->rate = 0;
-        return 1;
+        return hold(m);
     }
     /* the report counts once the spindle has had the command for MOTION_AT_SPEED_LAG
      * periods: an at-speed that was true for the old speed says nothing of the new */
@@ -77,37 +83,30 @@ static int wait_here(struct motion *m)
         return 0;
     }
     m->waiting = sg->wait_tool ? 2 : 1;
-    m->tau_s = m->run->kt[m->ci];
-    m->rate = 0;
-    return 1;
+    return hold(m);
 }
 
 /* At the start of a pause or a wait not yet honoured, with jerk limits: held there until the
  * moving average has come to rest on it (motion_jerk.c), so that the machine stands still
  * when the pause or the wait begins. */
-static int settle_here(struct motion *m)
+static int settle_here(struct motion *m, const struct motion_seg *sg)
 {
-    const struct motion_seg *sg = &m->run->segs[m->cs];
     bool stop = (sg->kind == SEG_PAUSE && m->paused_at_seg != m->cs + 1) ||
                 (sg->kind == SEG_WAIT && m->waited_at_seg != m->cs + 1 && !m->waiting);
     if (!stop || m->ci != sg->k0 || motion_jerk_settled(m))
         return 0;
-    m->tau_s = m->run->kt[m->ci];
-    m->rate = 0;
-    return 1;
+    return hold(m);
 }
 
 /* See motion_priv.h. */
 int motion_pause_or_wait_here(struct motion *m, const struct motion_seg *sg)
 {
-    if (settle_here(m) || wait_here(m))
+    if (settle_here(m, sg) || wait_here(m, sg))
         return 1;
     if (sg->kind != SEG_PAUSE || m->ci != sg->k0 || m->paused_at_seg == m->cs + 1)
         return 0;
     m->paused_at_seg = m->cs + 1;
-    m->tau_s = m->run->kt[m->ci];
-    m->rate = 0;
     if (m->state == MOTION_RUNNING || m->state == MOTION_PAUSING)
         m->state = MOTION_PAUSED;
-    return 1;
+    return hold(m);
 }
